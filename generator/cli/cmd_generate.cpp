@@ -1,0 +1,131 @@
+// `shadergen generate`: rig + fragment shader + rules → .vert / .spv / header / reflection.
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <iostream>
+#include <set>
+
+#include "cli/commands.h"
+#include "cli/output_files.h"
+#include "emit/reflection.h"
+
+namespace sg {
+
+const char* shadergenVersionString() { return shadergenVersion(); }
+
+void GenerateArgs::add(CLI::App& cmd) {
+  cmd.add_option("--rig", opts.rigPath, "Rig description (YAML)")->required();
+  cmd.add_option("--fragment,-f", opts.fragmentPath, "Fragment shader whose inputs must be fed (GLSL 450)")->required();
+  cmd.add_option("--rules,-r", opts.rulesPaths, "Rules file(s) (YAML)")->required();
+  cmd.add_option("--map", maps, "Map a fragment input to semantics: Name=sem or Name=s1,s2,... (packs)");
+  cmd.add_option("--heuristic", opts.heuristic, "A* heuristic: lmcut (default), hmax, blind")
+      ->check(CLI::IsMember({"lmcut", "hmax", "blind"}));
+  cmd.add_option("--target-env", targetEnv, "vulkan1.0 (default), vulkan1.1, vulkan1.2, vulkan1.3")
+      ->check(CLI::IsMember({"vulkan", "vulkan1.0", "vulkan1.1", "vulkan1.2", "vulkan1.3"}));
+  cmd.add_option("--templates", opts.templateDir, "Directory with vertex.glsl templates");
+  cmd.add_option("--ban", opts.bannedRules, "Exclude a rule from the search (force an alternative)");
+}
+
+GenerateOptions GenerateArgs::resolve() const {
+  GenerateOptions o = opts;
+  parseTargetEnv(targetEnv, o.targetEnv);
+  for (const auto& m : maps) {
+    auto eq = m.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == m.size())
+      throw CLI::ValidationError("--map", "expected Name=semantic[,semantic...], got '" + m + "'");
+    VaryingOverride ov;
+    ov.name = m.substr(0, eq);
+    std::string rest = m.substr(eq + 1);
+    for (size_t start = 0;;) {
+      size_t c = rest.find(',', start);
+      ov.semantics.push_back(rest.substr(start, c == std::string::npos ? std::string::npos : c - start));
+      if (c == std::string::npos) break;
+      start = c + 1;
+    }
+    o.overrides.push_back(ov);
+  }
+  return o;
+}
+
+namespace {
+
+struct GenerateCommand {
+  GenerateArgs args;
+  std::string output;
+  std::vector<std::string> emit{"glsl", "spv"};
+  bool optimize = false;
+  bool depfile = false;
+  std::string depfilePath;
+  bool quiet = false;
+
+  int run() {
+    GenerateOptions o = args.resolve();
+    o.optimize = optimize;
+    std::set<std::string> kinds(emit.begin(), emit.end());
+    std::string stem = output;
+    auto ext = std::filesystem::path(output).extension().string();
+    bool single = kinds.size() == 1 && !output.empty();
+    if (output.empty()) stem = std::filesystem::path(o.fragmentPath).stem().string();
+    else if (ext == ".spv" || ext == ".vert" || ext == ".json" || ext == ".h") stem = output.substr(0, output.size() - ext.size());
+    auto pathFor = [&](const std::string& kind) {
+      if (single) return output;
+      if (kind == "glsl") return stem + ".vert";
+      if (kind == "spv") return stem + ".spv";
+      if (kind == "header") return stem + ".spv.h";
+      return stem + ".json";
+    };
+    o.outputName = pathFor("glsl");
+
+    GenerateResult r = generate(o);
+
+    std::vector<PendingFile> files;
+    if (kinds.count("glsl")) files.push_back({pathFor("glsl"), r.glsl.text});
+    if (kinds.count("spv")) {
+      std::string bytes(reinterpret_cast<const char*>(r.spirv.words.data()), r.spirv.words.size() * 4);
+      files.push_back({pathFor("spv"), bytes});
+    }
+    if (kinds.count("header")) {
+      std::string sym = std::filesystem::path(stem).filename().string();
+      for (auto& c : sym)
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+      files.push_back({pathFor("header"), spirvHeader(r.spirv.words, sym + "_spv")});
+    }
+    if (kinds.count("reflection")) files.push_back({pathFor("reflection"), reflectionJson(r.in.rig, r.glsl, r.spirv)});
+    if (depfile || !depfilePath.empty()) {
+      std::string dpath = depfilePath.empty() ? files.front().path + ".d" : depfilePath;
+      files.push_back({dpath, makeDepfile(files.front().path, r.inputsRead)});
+    }
+    writeFilesAtomically(files);
+    if (!quiet) {
+      std::cout << fmt::format("plan for rig '{}' ({} rules, {} expanded, {} heuristic):\n", r.in.rig.name,
+                               r.plan.actions.size(), r.stats.expanded, o.heuristic);
+      std::cout << describePlan(r.in.problem, r.plan);
+      for (const auto& f : files) std::cout << "wrote " << f.path << "\n";
+    }
+    return 0;
+  }
+};
+
+}  // namespace
+
+void registerGenerate(CLI::App& app, CliState& state) {
+  auto cmd = std::make_shared<GenerateCommand>();
+  CLI::App* sub = app.add_subcommand("generate", "Generate the cheapest vertex shader (GLSL + SPIR-V)");
+  cmd->args.add(*sub);
+  sub->add_option("-o", cmd->output, "Output path (a file if one --emit kind, else the stem for all)");
+  sub->add_option("--emit", cmd->emit, "What to write: glsl, spv, header, reflection (comma-separated)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"glsl", "spv", "header", "reflection"}));
+  sub->add_flag("-O", cmd->optimize, "Optimise the SPIR-V (spirv-opt -O)");
+  sub->add_flag("--MD", cmd->depfile, "Write a depfile (<first output>.d) listing every input read");
+  sub->add_option("--MF", cmd->depfilePath, "Depfile path (implies -MD)");
+  sub->add_flag("-q,--quiet", cmd->quiet, "Do not print the plan");
+  sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
+}
+
+void registerCommands(CLI::App& app, CliState& state) {
+  registerGenerate(app, state);
+  registerValidate(app, state);
+}
+
+}  // namespace sg

@@ -1,0 +1,32 @@
+// Subcommands of the CLI. Each registers its options and sets CliState::run.
+#pragma once
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "pipeline/generate.h"
+
+namespace sg {
+
+struct CliState {
+  std::function<int()> run;
+};
+
+const char* shadergenVersionString();
+
+// Options shared by every command that generates: --rig, --fragment, --rules, --map...
+struct GenerateArgs {
+  GenerateOptions opts;
+  std::vector<std::string> maps;  // "Name=sem[,sem...]"
+  std::string targetEnv = "vulkan1.0";
+  void add(CLI::App& cmd);
+  GenerateOptions resolve() const;  // parses --map and --target-env (throws CLI::ValidationError)
+};
+
+void registerCommands(CLI::App& app, CliState& state);
+void registerGenerate(CLI::App& app, CliState& state);
+void registerValidate(CLI::App& app, CliState& state);
+
+}  // namespace sg

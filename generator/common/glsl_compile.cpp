@@ -1,0 +1,99 @@
+#include "common/glsl_compile.h"
+
+#include <glslang/Public/ResourceLimits.h>
+#include <glslang/Public/ShaderLang.h>
+#include <glslang/SPIRV/GlslangToSpv.h>
+
+#include <mutex>
+#include <regex>
+#include <sstream>
+
+namespace sg {
+
+bool parseTargetEnv(const std::string& s, TargetEnv& out) {
+  if (s == "vulkan1.0" || s == "vulkan") out = TargetEnv::Vulkan1_0;
+  else if (s == "vulkan1.1") out = TargetEnv::Vulkan1_1;
+  else if (s == "vulkan1.2") out = TargetEnv::Vulkan1_2;
+  else if (s == "vulkan1.3") out = TargetEnv::Vulkan1_3;
+  else return false;
+  return true;
+}
+
+const char* targetEnvName(TargetEnv e) {
+  switch (e) {
+    case TargetEnv::Vulkan1_0: return "vulkan1.0";
+    case TargetEnv::Vulkan1_1: return "vulkan1.1";
+    case TargetEnv::Vulkan1_2: return "vulkan1.2";
+    case TargetEnv::Vulkan1_3: return "vulkan1.3";
+  }
+  return "vulkan1.0";
+}
+
+void ensureGlslangInitialized() {
+  static std::once_flag once;
+  std::call_once(once, [] { glslang::InitializeProcess(); });
+}
+
+std::vector<Diagnostic> parseGlslangLog(const std::string& log, const GlslUnit& unit) {
+  std::vector<Diagnostic> out;
+  static const std::regex re(R"(^(ERROR|WARNING): (\d+):(\d+): (.*)$)");
+  std::istringstream in(log);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::smatch m;
+    if (!std::regex_match(line, m, re)) {
+      // Unlocated messages (e.g. linker errors) still matter.
+      if (line.rfind("ERROR: ", 0) == 0 && line.find("compilation errors") == std::string::npos)
+        out.push_back(Diagnostic{Severity::Error, SourceLoc{unit.fileName, 0, 0}, line.substr(7)});
+      continue;
+    }
+    Diagnostic d;
+    d.severity = m[1] == "ERROR" ? Severity::Error : Severity::Warning;
+    size_t src = std::stoul(m[2]);
+    d.loc.file = (src >= 1 && src <= unit.sourceFiles.size()) ? unit.sourceFiles[src - 1] : unit.fileName;
+    d.loc.line = std::stoi(m[3]);
+    d.message = m[4];
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
+CompileResult compileGlsl(const GlslUnit& unit, TargetEnv env) {
+  ensureGlslangInitialized();
+  CompileResult res;
+  EShLanguage lang = unit.stage == Stage::Vertex ? EShLangVertex : EShLangFragment;
+  glslang::TShader shader(lang);
+  const char* src = unit.text.c_str();
+  const char* names = unit.fileName.c_str();
+  shader.setStringsWithLengthsAndNames(&src, nullptr, &names, 1);
+  glslang::EShTargetClientVersion client = glslang::EShTargetVulkan_1_0;
+  glslang::EShTargetLanguageVersion spv = glslang::EShTargetSpv_1_0;
+  switch (env) {
+    case TargetEnv::Vulkan1_0: break;
+    case TargetEnv::Vulkan1_1: client = glslang::EShTargetVulkan_1_1; spv = glslang::EShTargetSpv_1_3; break;
+    case TargetEnv::Vulkan1_2: client = glslang::EShTargetVulkan_1_2; spv = glslang::EShTargetSpv_1_5; break;
+    case TargetEnv::Vulkan1_3: client = glslang::EShTargetVulkan_1_3; spv = glslang::EShTargetSpv_1_6; break;
+  }
+  shader.setEnvInput(glslang::EShSourceGlsl, lang, glslang::EShClientVulkan, 100);
+  shader.setEnvClient(glslang::EShClientVulkan, client);
+  shader.setEnvTarget(glslang::EShTargetSpv, spv);
+  auto messages = static_cast<EShMessages>(EShMsgSpvRules | EShMsgVulkanRules);
+  bool ok = shader.parse(GetDefaultResources(), 450, ECoreProfile, false, false, messages);
+  res.diagnostics = parseGlslangLog(shader.getInfoLog(), unit);
+  if (!ok) return res;
+  glslang::TProgram program;
+  program.addShader(&shader);
+  if (!program.link(messages)) {
+    auto more = parseGlslangLog(program.getInfoLog(), unit);
+    res.diagnostics.insert(res.diagnostics.end(), more.begin(), more.end());
+    return res;
+  }
+  glslang::SpvOptions opts;
+  opts.disableOptimizer = true;
+  opts.validate = false;
+  glslang::GlslangToSpv(*program.getIntermediate(lang), res.spirv, &opts);
+  res.ok = true;
+  return res;
+}
+
+}  // namespace sg

@@ -1,0 +1,271 @@
+#include "emit/glsl_emitter.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <set>
+
+namespace sg {
+
+std::string tempName(const std::string& fact) {
+  std::string s = "t_";
+  for (char c : fact) {
+    if (c == '.' || c == '[') s += '_';
+    else if (c != ']') s += c;
+  }
+  return s;
+}
+
+namespace {
+
+std::string baseName(const std::string& path) { return std::filesystem::path(path).filename().string(); }
+
+class Emitter {
+ public:
+  Emitter(const Rig& rig, const Problem& p, const Plan& plan, const std::vector<Varying>& varyings,
+          const TemplateSet& t, const EmitOptions& opts)
+      : rig_(rig), p_(p), plan_(plan), varyings_(varyings), t_(t), opts_(opts) {}
+
+  EmittedGlsl run(const std::string& fragmentName) {
+    collectUsedFacts();
+    declareInputs();
+    declareUniforms();
+    std::string outputs = declareOutputs();
+    std::string inputs;
+    for (const auto& in : out_.inputs)
+      inputs += t_.fill("input", {{"location", std::to_string(in.location)},
+                                  {"type", std::string(glslName(in.type))},
+                                  {"name", in.name}}) + "\n";
+    std::string uniforms;
+    if (!out_.uniforms.empty()) {
+      std::string members;
+      for (const auto& u : out_.uniforms) {
+        const RigUniform& ru = rig_.uniforms[u.uniform];
+        if (!members.empty()) members += "\n";
+        members += t_.fill("uniform_member", {{"type", std::string(glslName(ru.type))},
+                                              {"name", u.name},
+                                              {"array", ru.arraySize ? fmt::format("[{}]", ru.arraySize) : ""}});
+      }
+      uniforms = t_.fill("uniform_block", {{"members", members}}) + "\n";
+    }
+    std::string stores;
+    for (const auto& o : out_.outputs) {
+      std::string value;
+      if (o.semantics.size() == 1) {
+        value = factExpr(p_.findFact(o.semantics[0]));
+      } else {
+        std::string args;
+        for (const auto& s : o.semantics) args += (args.empty() ? "" : ", ") + factExpr(p_.findFact(s));
+        value = t_.fill("pack", {{"type", std::string(glslName(o.type))}, {"args", args}});
+      }
+      if (!stores.empty()) stores += "\n";
+      stores += t_.fill("store", {{"name", o.name}, {"value", value}});
+    }
+    // Fill with a marker for the body first: its #line directives need absolute line numbers.
+    const std::string marker = "\x03BODY\x03";
+    std::map<std::string, std::string> v{
+        {"version", opts_.version},
+        {"extensions", ""},
+        {"rig", rig_.name},
+        {"fragment", baseName(fragmentName)},
+        {"cost", std::to_string(plan_.cost)},
+        {"heuristic", opts_.heuristic},
+        {"sources", sourcesList()},
+        {"inputs", inputs},
+        {"uniforms", uniforms},
+        {"outputs", outputs},
+        {"body", marker},
+        {"stores", stores}};
+    std::string text = t_.fill("shader", v);
+    size_t at = text.find(marker);
+    int bodyLine = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
+    text.replace(at, marker.size(), body(bodyLine));
+    if (text.empty() || text.back() != '\n') text += '\n';
+    out_.text = std::move(text);
+    return std::move(out_);
+  }
+
+ private:
+  void collectUsedFacts() {
+    used_.assign(p_.facts.size(), false);
+    for (int a : plan_.actions) {
+      used_[p_.actions[a].add] = true;
+      for (const auto& line : p_.actions[a].code) markRefs(line.text);
+    }
+    for (const auto& v : varyings_)
+      for (const auto& s : v.semantics) used_[p_.findFact(s)] = true;
+  }
+
+  void markRefs(const std::string& s) {
+    for (size_t i = s.find(kFactRefBegin); i != std::string::npos; i = s.find(kFactRefBegin, i + 1))
+      used_[std::stoi(s.substr(i + 1))] = true;
+  }
+
+  void declareInputs() {
+    // Dense locations in rig order, only for attributes the plan reads.
+    std::set<std::pair<int, int>> needed;  // (attribute, target)
+    for (size_t f = 0; f < p_.facts.size(); ++f)
+      if (used_[f] && p_.facts[f].source == Fact::Source::Attribute)
+        needed.insert({p_.facts[f].rigIndex, p_.facts[f].target});
+    int loc = 0;
+    for (const auto& [attr, target] : needed) {
+      const RigAttribute& a = rig_.attributes[attr];
+      EmittedInput in;
+      in.name = target >= 0 ? fmt::format("a_{}{}", a.name, target) : "a_" + a.name;
+      in.location = loc++;
+      in.attribute = attr;
+      in.target = target;
+      in.type = a.shaderType;
+      out_.inputs.push_back(in);
+    }
+  }
+
+  void declareUniforms() {
+    std::set<int> needed;
+    for (size_t f = 0; f < p_.facts.size(); ++f)
+      if (used_[f] && p_.facts[f].source == Fact::Source::Uniform) needed.insert(p_.facts[f].rigIndex);
+    for (int u : needed) out_.uniforms.push_back(EmittedUniform{"u_" + rig_.uniforms[u].name, u});
+  }
+
+  std::string declareOutputs() {
+    uint32_t offset = 0;
+    for (const auto& v : varyings_) {
+      EmittedOutput o;
+      o.name = v.name;
+      o.location = v.location;
+      o.type = v.type;
+      o.semantics = v.semantics;
+      o.captureOffset = offset;
+      offset += 4u * static_cast<uint32_t>(componentCount(v.type));
+      out_.outputs.push_back(o);
+    }
+    out_.captureStride = offset;
+    std::string text;
+    if (opts_.capture)
+      text += t_.fill("position_block", {{"stride", std::to_string(offset)}}) + "\n";
+    for (const auto& o : out_.outputs) {
+      if (o.location < 0) continue;
+      std::string xfb = opts_.capture ? t_.fill("xfb", {{"offset", std::to_string(o.captureOffset)},
+                                                         {"stride", std::to_string(offset)}})
+                                      : "";
+      const Varying* v = nullptr;
+      for (const auto& x : varyings_)
+        if (x.name == o.name) v = &x;
+      text += t_.fill("output", {{"location", std::to_string(o.location)},
+                                 {"xfb", xfb},
+                                 {"qualifier", v && v->flat ? "flat " : ""},
+                                 {"type", std::string(glslName(o.type))},
+                                 {"name", o.name}}) + "\n";
+    }
+    return text;
+  }
+
+  std::string factExpr(int f) const {
+    const Fact& fact = p_.facts[f];
+    switch (fact.source) {
+      case Fact::Source::Computed:
+        return tempName(fact.name);
+      case Fact::Source::Uniform:
+        return "u_" + rig_.uniforms[fact.rigIndex].name;
+      case Fact::Source::Attribute: {
+        for (const auto& in : out_.inputs)
+          if (in.attribute == fact.rigIndex && in.target == fact.target)
+            return fact.swizzle.empty() ? in.name : in.name + "." + fact.swizzle;
+        return "?";
+      }
+    }
+    return "?";
+  }
+
+  std::string resolve(const std::string& s) const {
+    std::string out;
+    size_t i = 0;
+    while (i < s.size()) {
+      size_t b = s.find(kFactRefBegin, i);
+      if (b == std::string::npos) {
+        out += s.substr(i);
+        break;
+      }
+      size_t e = s.find(kFactRefEnd, b);
+      out += s.substr(i, b - i);
+      out += factExpr(std::stoi(s.substr(b + 1, e - b - 1)));
+      i = e + 1;
+    }
+    return out;
+  }
+
+  int sourceIndex(const std::string& file) {
+    auto it = std::find(out_.sourceFiles.begin(), out_.sourceFiles.end(), file);
+    if (it != out_.sourceFiles.end()) return static_cast<int>(it - out_.sourceFiles.begin()) + 1;
+    out_.sourceFiles.push_back(file);
+    return static_cast<int>(out_.sourceFiles.size());
+  }
+
+  std::string sourcesList() {
+    // Register files in plan order so numbering is stable for the same inputs.
+    for (int a : plan_.actions)
+      for (const auto& l : p_.actions[a].code) sourceIndex(l.loc.file);
+    std::string s = t_.fill("source", {{"index", "0"}, {"file", "this file"}});
+    for (size_t i = 0; i < out_.sourceFiles.size(); ++i)
+      s += "\n" + t_.fill("source", {{"index", std::to_string(i + 1)}, {"file", baseName(out_.sourceFiles[i])}});
+    return s;
+  }
+
+  std::string body(int firstLine) {
+    std::vector<std::string> lines;
+    auto push = [&](const std::string& chunk) {
+      size_t start = 0;
+      for (;;) {
+        size_t nl = chunk.find('\n', start);
+        lines.push_back(chunk.substr(start, nl == std::string::npos ? std::string::npos : nl - start));
+        if (nl == std::string::npos) break;
+        start = nl + 1;
+      }
+    };
+    for (int a : plan_.actions) {
+      const Action& act = p_.actions[a];
+      const Fact& f = p_.facts[act.add];
+      push(t_.fill("rule", {{"rule", act.name},
+                            {"semantic", f.name},
+                            {"cost", std::to_string(act.cost)},
+                            {"type", std::string(glslName(f.type))},
+                            {"name", tempName(f.name)}}));
+      int expectLine = -1, expectSrc = -1;
+      for (const auto& cl : act.code) {
+        int src = sourceIndex(cl.loc.file);
+        if (cl.loc.line != expectLine || src != expectSrc)
+          push(t_.fill("line", {{"line", std::to_string(cl.loc.line)}, {"source", std::to_string(src)}}));
+        push("  " + resolve(cl.text));
+        expectLine = cl.loc.line + 1;
+        expectSrc = src;
+      }
+      if (!act.code.empty()) {
+        // Back to this file's own numbering: the line after the directive.
+        int next = firstLine + static_cast<int>(lines.size()) + 1;
+        push(t_.fill("line", {{"line", std::to_string(next)}, {"source", "0"}}));
+      }
+    }
+    std::string out;
+    for (size_t i = 0; i < lines.size(); ++i) out += (i ? "\n" : "") + lines[i];
+    return out;
+  }
+
+  const Rig& rig_;
+  const Problem& p_;
+  const Plan& plan_;
+  const std::vector<Varying>& varyings_;
+  const TemplateSet& t_;
+  EmitOptions opts_;
+  std::vector<bool> used_;
+  EmittedGlsl out_;
+};
+
+}  // namespace
+
+EmittedGlsl emitGlsl(const Rig& rig, const Problem& p, const Plan& plan, const std::vector<Varying>& varyings,
+                     const TemplateSet& templates, const std::string& fragmentName, const EmitOptions& opts) {
+  return Emitter(rig, p, plan, varyings, templates, opts).run(fragmentName);
+}
+
+}  // namespace sg

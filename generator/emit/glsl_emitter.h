@@ -1,0 +1,60 @@
+// Plan → Vulkan GLSL 450 text, filled from templates/vertex.glsl. Every snippet line
+// is preceded by a `#line L S` directive mapping it to its rules file (S indexes
+// EmittedGlsl::sourceFiles), so compiler errors land on the rule's YAML line.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/types.h"
+#include "emit/templates.h"
+#include "interface/fragment_interface.h"
+#include "rig/rig.h"
+#include "search/plan.h"
+#include "search/problem.h"
+
+namespace sg {
+
+struct EmitOptions {
+  bool capture = false;  // add transform-feedback qualifiers (validation builds only)
+  std::string heuristic = "lmcut";
+  std::string version;  // shadergen version printed in the header
+};
+
+struct EmittedInput {
+  std::string name;  // a_normal, a_morph_position3
+  int location = 0;
+  int attribute = -1;  // index in Rig::attributes
+  int target = -1;     // morph target for per-target attributes
+  Type type = Type::Vec4;
+};
+
+struct EmittedUniform {
+  std::string name;  // u_bones
+  int uniform = -1;  // index in Rig::uniforms
+};
+
+struct EmittedOutput {
+  std::string name;
+  int location = -1;  // -1: gl_Position
+  Type type = Type::Vec4;
+  std::vector<std::string> semantics;
+  uint32_t captureOffset = 0;  // byte offset in the transform-feedback record
+};
+
+struct EmittedGlsl {
+  std::string text;
+  std::vector<std::string> sourceFiles;  // #line source string S → sourceFiles[S-1]
+  std::vector<EmittedInput> inputs;      // by location
+  std::vector<EmittedUniform> uniforms;  // in block order
+  std::vector<EmittedOutput> outputs;    // gl_Position first, then by location
+  uint32_t captureStride = 0;
+};
+
+EmittedGlsl emitGlsl(const Rig& rig, const Problem& p, const Plan& plan, const std::vector<Varying>& varyings,
+                     const TemplateSet& templates, const std::string& fragmentName, const EmitOptions& opts);
+
+// GLSL identifier for a computed fact: "world.normal" → "t_world_normal", "a[2]" → "t_a_2".
+std::string tempName(const std::string& fact);
+
+}  // namespace sg

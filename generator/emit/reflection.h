@@ -1,0 +1,17 @@
+// The interface the application must bind, as JSON: vertex inputs (location, format,
+// semantics), the uniform block (std140 offsets as compiled), and the outputs.
+#pragma once
+#include <string>
+
+#include "emit/glsl_emitter.h"
+#include "emit/spirv.h"
+#include "rig/rig.h"
+
+namespace sg {
+
+std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spirv);
+
+// A C/C++ header defining `static const uint32_t <symbol>[]` with the SPIR-V words.
+std::string spirvHeader(const std::vector<uint32_t>& words, const std::string& symbol);
+
+}  // namespace sg

@@ -1,0 +1,64 @@
+// The whole generator as one call: load → problem → A* → emit → SPIR-V → checks.
+// The CLI, the validator and the tests all go through here.
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/glsl_compile.h"
+#include "emit/glsl_emitter.h"
+#include "emit/spirv.h"
+#include "interface/fragment_interface.h"
+#include "rig/rig.h"
+#include "rules/rules.h"
+#include "search/astar.h"
+#include "search/plan.h"
+#include "search/problem.h"
+
+namespace sg {
+
+struct GenerateOptions {
+  std::string rigPath;
+  std::string fragmentPath;
+  std::vector<std::string> rulesPaths;
+  std::vector<VaryingOverride> overrides;
+  std::vector<std::string> bannedRules;  // force alternatives (cross-check, explain)
+  std::string heuristic = "lmcut";
+  std::string templateDir;  // "" = defaultTemplateDir()
+  TargetEnv targetEnv = TargetEnv::Vulkan1_0;
+  bool optimize = false;
+  bool capture = false;  // transform-feedback build for validation
+  std::string outputName = "shader.vert";  // how the GLSL is named in diagnostics
+};
+
+// Everything loaded (kept so later stages and explain/validate reuse it).
+struct LoadedInputs {
+  Rig rig;
+  RuleSet rules;
+  FragmentInterface fragment;
+  std::vector<Varying> varyings;
+  Problem problem;
+};
+
+struct GenerateResult {
+  LoadedInputs in;
+  Plan plan;
+  SearchStats stats;
+  EmittedGlsl glsl;
+  SpirvModule spirv;
+  std::vector<std::string> inputsRead;  // every file read (for depfiles)
+};
+
+const char* shadergenVersion();
+
+LoadedInputs loadInputs(const GenerateOptions& opts);
+
+// Throws InputError for bad inputs or unsatisfiable requests (naming the missing values).
+GenerateResult generate(const GenerateOptions& opts);
+// Same, from already loaded inputs (cross-check runs reuse one load).
+GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts);
+
+// For an unsolvable problem: why each unreachable goal cannot be produced.
+std::string explainUnreachable(const Problem& p, const RuleSet& rules);
+
+}  // namespace sg

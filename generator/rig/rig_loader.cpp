@@ -1,0 +1,218 @@
+// Loads the rig YAML (format documented in docs/rig-format.md).
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <set>
+
+#include "common/yaml_util.h"
+#include "rig/rig.h"
+
+namespace sg {
+namespace {
+
+struct FormatInfo {
+  VertexFormat format;
+  const char* name;
+  int components;
+  int bytes;
+  bool integer;
+};
+constexpr std::array<FormatInfo, 9> kFormats{{
+    {VertexFormat::Float32x1, "float32", 1, 4, false},
+    {VertexFormat::Float32x2, "float32x2", 2, 8, false},
+    {VertexFormat::Float32x3, "float32x3", 3, 12, false},
+    {VertexFormat::Float32x4, "float32x4", 4, 16, false},
+    {VertexFormat::Unorm8x4, "unorm8x4", 4, 4, false},
+    {VertexFormat::Uint8x4, "uint8x4", 4, 4, true},
+    {VertexFormat::Unorm16x4, "unorm16x4", 4, 8, false},
+    {VertexFormat::Uint16x4, "uint16x4", 4, 8, true},
+    {VertexFormat::Uint32x4, "uint32x4", 4, 16, true},
+}};
+const FormatInfo& finfo(VertexFormat f) { return kFormats[static_cast<size_t>(f)]; }
+
+bool validSwizzle(const std::string& s, int components) {
+  if (s.empty() || s.size() > 4) return false;
+  static const std::string xyzw = "xyzw";
+  for (char c : s) {
+    auto p = xyzw.find(c);
+    if (p == std::string::npos || static_cast<int>(p) >= components) return false;
+  }
+  return true;
+}
+
+bool validSemanticName(const std::string& s) {
+  if (s.empty()) return false;
+  for (char c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '[' || c == ']')) return false;
+  return std::isalpha(static_cast<unsigned char>(s[0]));
+}
+
+bool validIdentifier(const std::string& s) {
+  if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
+  for (char c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) return false;
+  return s.rfind("gl_", 0) != 0;
+}
+
+}  // namespace
+
+const char* formatName(VertexFormat f) { return finfo(f).name; }
+int formatComponents(VertexFormat f) { return finfo(f).components; }
+int formatBytes(VertexFormat f) { return finfo(f).bytes; }
+bool formatIsInteger(VertexFormat f) { return finfo(f).integer; }
+bool parseFormat(const std::string& name, VertexFormat& out) {
+  for (const auto& i : kFormats)
+    if (name == i.name) {
+      out = i.format;
+      return true;
+    }
+  return false;
+}
+
+int64_t Rig::param(const std::string& key, int64_t fallback) const {
+  auto it = params.find(key);
+  return it == params.end() ? fallback : it->second;
+}
+
+Rig loadRigFile(const std::string& path) { return loadRigText(readInputFile(path), path); }
+
+Rig loadRigText(const std::string& text, const std::string& fileName) {
+  YamlCtx y{fileName};
+  YAML::Node root = parseYaml(text, fileName);
+  if (!root.IsDefined() || root.IsNull()) throw InputError(SourceLoc{fileName, 1, 1}, "empty rig file");
+  y.expectMap(root, "a rig file");
+  y.checkKeys(root, {"rig", "deformers", "attributes", "uniforms"});
+
+  Rig rig;
+  rig.file = fileName;
+  if (!root["rig"]) y.fail(root, "missing 'rig' (the rig's name)");
+  rig.name = y.scalar(root["rig"], "'rig'");
+
+  rig.params = {{"bones", 0}, {"influences", 0}, {"morph_targets", 0}};
+  if (auto d = root["deformers"]) {
+    y.expectMap(d, "'deformers'");
+    for (auto it = d.begin(); it != d.end(); ++it) {
+      std::string key = y.scalar(it->first, "a deformer key");
+      if (key == "morphs") {
+        y.expectSeq(it->second, "'morphs'");
+        for (const auto& m : it->second) {
+          std::string a = y.scalar(m, "a morphed attribute");
+          if (a != "position" && a != "normal" && a != "tangent")
+            y.fail(m, fmt::format("morph targets can move position, normal or tangent, not '{}'", a));
+          rig.morphedAttributes.push_back(a);
+        }
+        continue;
+      }
+      if (!validIdentifier(key)) y.fail(it->first, fmt::format("'{}' is not a valid parameter name", key));
+      long long v = y.integer(it->second, fmt::format("deformer '{}'", key).c_str());
+      if (v < 0 || v > 65535) y.fail(it->second, fmt::format("deformer '{}' = {} is out of range 0..65535", key, v));
+      rig.params[key] = v;
+      rig.paramLocs[key] = locOf(it->second, fileName);
+    }
+  }
+  if (rig.param("influences") > 8)
+    throw InputError(rig.paramLocs["influences"], "at most 8 bone influences per vertex are supported");
+
+  if (!root["attributes"]) y.fail(root, "missing 'attributes'");
+  y.expectMap(root["attributes"], "'attributes'");
+  std::set<std::string> providedSemantics;
+  for (auto it = root["attributes"].begin(); it != root["attributes"].end(); ++it) {
+    RigAttribute a;
+    a.name = y.scalar(it->first, "an attribute name");
+    a.loc = locOf(it->first, fileName);
+    if (!validIdentifier(a.name)) y.fail(it->first, fmt::format("'{}' is not a valid attribute name", a.name));
+    const YAML::Node& body = it->second;
+    y.expectMap(body, "an attribute");
+    y.checkKeys(body, {"format", "provides", "per_target", "doc"});
+    if (!body["format"]) y.fail(body, fmt::format("attribute '{}' has no 'format'", a.name));
+    std::string fmtName = y.scalar(body["format"], "'format'");
+    if (!parseFormat(fmtName, a.format)) {
+      std::string all;
+      for (const auto& f : kFormats) all += (all.empty() ? "" : ", ") + std::string(f.name);
+      y.fail(body["format"], fmt::format("unknown vertex format '{}' (expected one of: {})", fmtName, all));
+    }
+    int n = formatComponents(a.format);
+    a.shaderType = *vectorType(formatIsInteger(a.format) ? ScalarKind::UInt : ScalarKind::Float, n);
+    if (body["per_target"]) a.perMorphTarget = y.boolean(body["per_target"], "'per_target'");
+    const YAML::Node& prov = body["provides"];
+    if (!prov) y.fail(body, fmt::format("attribute '{}' provides no semantic ('provides')", a.name));
+    auto addPart = [&](const YAML::Node& semNode, const YAML::Node* swzNode) {
+      ProvidedPart p;
+      p.semantic = y.scalar(semNode, "a semantic name");
+      if (!validSemanticName(p.semantic)) y.fail(semNode, fmt::format("'{}' is not a valid semantic name", p.semantic));
+      if (swzNode) {
+        p.swizzle = y.scalar(*swzNode, "a swizzle");
+        if (!validSwizzle(p.swizzle, n))
+          y.fail(*swzNode, fmt::format("'{}' is not a valid swizzle of a {}-component attribute", p.swizzle, n));
+      }
+      if (!providedSemantics.insert(p.semantic).second)
+        y.fail(semNode, fmt::format("semantic '{}' is provided twice", p.semantic));
+      a.provides.push_back(p);
+    };
+    if (prov.IsScalar()) {
+      addPart(prov, nullptr);
+    } else {
+      y.expectMap(prov, "'provides'");
+      for (auto p = prov.begin(); p != prov.end(); ++p) addPart(p->first, &p->second);
+    }
+    rig.attributes.push_back(std::move(a));
+  }
+
+  if (auto u = root["uniforms"]) {
+    y.expectMap(u, "'uniforms'");
+    for (auto it = u.begin(); it != u.end(); ++it) {
+      RigUniform un;
+      un.name = y.scalar(it->first, "a uniform name");
+      un.loc = locOf(it->first, fileName);
+      if (!validIdentifier(un.name)) y.fail(it->first, fmt::format("'{}' is not a valid uniform name", un.name));
+      const YAML::Node& body = it->second;
+      y.expectMap(body, "a uniform");
+      y.checkKeys(body, {"type", "semantic", "array", "doc"});
+      if (!body["type"]) y.fail(body, fmt::format("uniform '{}' has no 'type'", un.name));
+      std::string t = y.scalar(body["type"], "'type'");
+      auto ty = parseType(t);
+      if (!ty) y.fail(body["type"], fmt::format("unknown type '{}'", t));
+      un.type = *ty;
+      if (!body["semantic"]) y.fail(body, fmt::format("uniform '{}' has no 'semantic'", un.name));
+      un.semantic = y.scalar(body["semantic"], "'semantic'");
+      if (!validSemanticName(un.semantic)) y.fail(body["semantic"], fmt::format("'{}' is not a valid semantic name", un.semantic));
+      if (!providedSemantics.insert(un.semantic).second)
+        y.fail(body["semantic"], fmt::format("semantic '{}' is provided twice", un.semantic));
+      if (body["array"]) {
+        un.arraySizeParam = y.scalar(body["array"], "'array'");
+        if (!rig.params.count(un.arraySizeParam))
+          y.fail(body["array"], fmt::format("array size '{}' is not a deformer parameter of this rig", un.arraySizeParam));
+        un.arraySize = static_cast<int>(rig.param(un.arraySizeParam));
+      }
+      rig.uniforms.push_back(std::move(un));
+    }
+  }
+  checkRig(rig);
+  return rig;
+}
+
+void checkRig(const Rig& rig) {
+  std::set<std::string> names;
+  int morphStreams = 0;
+  for (const auto& a : rig.attributes) {
+    if (!names.insert(a.name).second) throw InputError(a.loc, fmt::format("attribute '{}' is declared twice", a.name));
+    if (a.perMorphTarget) {
+      ++morphStreams;
+      if (rig.morphTargets() == 0)
+        throw InputError(a.loc, fmt::format("attribute '{}' is per morph target but the rig has morph_targets: 0", a.name));
+    }
+  }
+  if (rig.morphTargets() > 0 && morphStreams == 0) {
+    auto it = rig.paramLocs.find("morph_targets");
+    throw InputError(it != rig.paramLocs.end() ? it->second : SourceLoc{rig.file, 1, 1},
+                     "the rig has morph targets but no per_target attribute carries their deltas");
+  }
+  for (const auto& u : rig.uniforms) {
+    if (!names.insert(u.name).second) throw InputError(u.loc, fmt::format("name '{}' is used twice", u.name));
+    if (!u.arraySizeParam.empty() && u.arraySize <= 0)
+      throw InputError(u.loc, fmt::format("uniform array '{}' has size {} ({} = 0)", u.name, u.arraySize, u.arraySizeParam));
+  }
+}
+
+}  // namespace sg

@@ -1,0 +1,37 @@
+// Integer expressions used by rules (`when:`, `cost:`, semantic `count:`, snippet `${...}`
+// and `@for`/`@if`): literals, identifiers (rig parameters, loop variables),
+// has(semantic), + - * / % comparisons && || ! and parentheses.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "common/diagnostics.h"
+
+namespace sg {
+
+struct ExprEnv {
+  // Value of an identifier, or nullopt-like false return if unknown.
+  std::function<bool(const std::string& name, int64_t& value)> lookup;
+  // has(semantic): does the rig provide it (or any instance of an array semantic)?
+  std::function<bool(const std::string& semantic)> has;
+};
+
+class Expr {
+ public:
+  Expr() = default;
+  // Parses `text`; `loc` is where text starts in its file (errors point inside it).
+  static Expr parse(const std::string& text, const SourceLoc& loc);
+  int64_t eval(const ExprEnv& env) const;  // throws InputError (unknown name, division by zero)
+  const std::string& text() const { return text_; }
+  bool empty() const { return !root_; }
+  struct Node;
+
+ private:
+  std::string text_;
+  SourceLoc loc_;
+  std::shared_ptr<const Node> root_;
+};
+
+}  // namespace sg

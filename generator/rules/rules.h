@@ -1,0 +1,75 @@
+// A rules file: typed semantics, varying names, and rules that produce one semantic
+// from others at a cost, under conditions on the rig, with a GLSL snippet template.
+// Format: docs/rules-format.md.
+#pragma once
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/diagnostics.h"
+#include "common/types.h"
+#include "rules/expr.h"
+
+namespace sg {
+
+struct SemanticDecl {
+  std::string name;  // "world.normal"
+  Type type = Type::Vec3;
+  int arraySize = 0;       // uniform arrays (mat4[bones]): resolved against the rig, 0 = scalar
+  std::string arrayParam;  // rig parameter giving the uniform array size
+  Expr count;              // indexed family (morph.position[i]): instance count expression
+  std::string doc;
+  SourceLoc loc;
+};
+
+// A reference to a semantic in `needs:`: "world.position", "morph.position[*]", "skin.joints[k/4]".
+struct SemanticRef {
+  std::string name;
+  std::string index;  // "" none, "*" all instances, else an index expression
+  SourceLoc loc;
+};
+
+// One line of a snippet template, with where it sits in the rules file.
+struct TemplateLine {
+  std::string text;
+  SourceLoc loc;  // line and column of the first character of text
+};
+
+struct Rule {
+  std::string name;
+  std::string produces;
+  std::vector<SemanticRef> needs;
+  Expr when;            // empty = always
+  Expr cost;            // evaluated against the rig
+  bool costAuto = false;
+  std::vector<TemplateLine> glsl;
+  std::string doc;
+  SourceLoc loc;         // the rule's 'name' key
+  SourceLoc producesLoc;
+};
+
+// How a fragment input name maps to semantics: one, or several packed into a vector.
+struct VaryingMapping {
+  std::string name;
+  std::vector<std::string> semantics;
+  SourceLoc loc;
+};
+
+struct RuleSet {
+  std::vector<std::string> files;  // every file read (includes too), in load order
+  std::vector<SemanticDecl> semantics;
+  std::vector<Rule> rules;
+  std::vector<VaryingMapping> varyings;
+
+  const SemanticDecl* findSemantic(const std::string& name) const;
+  const VaryingMapping* findVarying(const std::string& name) const;
+};
+
+// Loads rule files (and their `include:`s, relative to the including file) into one set.
+// Throws InputError: malformed YAML, unknown keys, duplicate names, bad types...
+RuleSet loadRules(const std::vector<std::string>& paths);
+void loadRulesInto(RuleSet& set, const std::string& path);
+void loadRulesText(RuleSet& set, const std::string& text, const std::string& fileName);
+
+}  // namespace sg

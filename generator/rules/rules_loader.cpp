@@ -1,0 +1,252 @@
+// Loads rules YAML (format: docs/rules-format.md) with located diagnostics.
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include "common/yaml_util.h"
+#include "rules/rules.h"
+
+namespace sg {
+namespace {
+
+std::vector<std::string> splitLines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::string cur;
+  for (char c : text) {
+    if (c == '\n') {
+      if (!cur.empty() && cur.back() == '\r') cur.pop_back();
+      lines.push_back(cur);
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  lines.push_back(cur);
+  return lines;
+}
+
+bool validSemanticName(const std::string& s) {
+  if (s.empty() || !std::isalpha(static_cast<unsigned char>(s[0]))) return false;
+  for (char c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.')) return false;
+  return s.back() != '.';
+}
+
+bool validRuleName(const std::string& s) {
+  if (s.empty()) return false;
+  for (char c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.')) return false;
+  return true;
+}
+
+SourceLoc exprLoc(const YAML::Node& n, const std::string& file) {
+  SourceLoc l = locOf(n, file);
+  // Quoted scalars start one column after the mark.
+  if (n.Tag() == "!" && l.col > 0) l.col += 1;
+  return l;
+}
+
+SemanticRef parseRef(const YamlCtx& y, const YAML::Node& n) {
+  std::string s = y.scalar(n, "a semantic reference");
+  SemanticRef r;
+  r.loc = locOf(n, y.file);
+  auto lb = s.find('[');
+  if (lb != std::string::npos) {
+    if (s.back() != ']') y.fail(n, fmt::format("malformed semantic reference '{}' (missing ']')", s));
+    r.index = s.substr(lb + 1, s.size() - lb - 2);
+    if (r.index.empty()) y.fail(n, fmt::format("empty index in '{}'", s));
+    s = s.substr(0, lb);
+  }
+  if (!validSemanticName(s)) y.fail(n, fmt::format("'{}' is not a valid semantic name", s));
+  r.name = s;
+  return r;
+}
+
+void loadSemantics(RuleSet& set, const YamlCtx& y, const YAML::Node& sems) {
+  y.expectMap(sems, "'semantics'");
+  for (auto it = sems.begin(); it != sems.end(); ++it) {
+    SemanticDecl d;
+    d.name = y.scalar(it->first, "a semantic name");
+    d.loc = locOf(it->first, y.file);
+    if (!validSemanticName(d.name)) y.fail(it->first, fmt::format("'{}' is not a valid semantic name", d.name));
+    if (const SemanticDecl* prev = set.findSemantic(d.name)) {
+      if (prev->loc.file == d.loc.file && prev->loc.line == d.loc.line) continue;  // same file included twice
+      y.fail(it->first, fmt::format("semantic '{}' is declared twice (first at {}:{})", d.name, prev->loc.file,
+                                    prev->loc.line));
+    }
+    const YAML::Node& body = it->second;
+    std::string typeName;
+    if (body.IsScalar()) {
+      typeName = body.Scalar();
+    } else {
+      y.expectMap(body, "a semantic declaration");
+      y.checkKeys(body, {"type", "count", "array", "doc"});
+      if (!body["type"]) y.fail(body, fmt::format("semantic '{}' has no 'type'", d.name));
+      typeName = y.scalar(body["type"], "'type'");
+      if (body["count"]) d.count = Expr::parse(y.scalar(body["count"], "'count'"), exprLoc(body["count"], y.file));
+      if (body["array"]) d.arrayParam = y.scalar(body["array"], "'array'");
+      if (body["doc"]) d.doc = y.scalar(body["doc"], "'doc'");
+    }
+    auto t = parseType(typeName);
+    if (!t) y.fail(body.IsMap() ? body["type"] : body, fmt::format("unknown type '{}' for semantic '{}'", typeName, d.name));
+    d.type = *t;
+    set.semantics.push_back(std::move(d));
+  }
+}
+
+void loadVaryings(RuleSet& set, const YamlCtx& y, const YAML::Node& vars) {
+  y.expectMap(vars, "'varyings'");
+  for (auto it = vars.begin(); it != vars.end(); ++it) {
+    VaryingMapping v;
+    v.name = y.scalar(it->first, "a varying name");
+    v.loc = locOf(it->first, y.file);
+    if (set.findVarying(v.name)) y.fail(it->first, fmt::format("varying '{}' is mapped twice", v.name));
+    if (it->second.IsScalar()) {
+      v.semantics.push_back(it->second.Scalar());
+    } else {
+      y.expectSeq(it->second, "a varying mapping");
+      for (const auto& s : it->second) v.semantics.push_back(y.scalar(s, "a semantic name"));
+      if (v.semantics.empty()) y.fail(it->second, fmt::format("varying '{}' maps to no semantic", v.name));
+    }
+    set.varyings.push_back(std::move(v));
+  }
+}
+
+std::vector<TemplateLine> snippetLines(const YamlCtx& y, const YAML::Node& n, const std::vector<std::string>& raw) {
+  std::string text = y.scalar(n, "'glsl'");
+  SourceLoc at = locOf(n, y.file);
+  std::vector<std::string> lines = splitLines(text);
+  while (!lines.empty() && lines.back().empty()) lines.pop_back();
+  std::vector<TemplateLine> out;
+  // Block scalars ('|') start on the line after the indicator; others on the mark.
+  bool block = at.line > 0 && at.line <= static_cast<int>(raw.size()) && at.col > 0 &&
+               raw[at.line - 1].size() >= static_cast<size_t>(at.col) &&
+               (raw[at.line - 1][at.col - 1] == '|' || raw[at.line - 1][at.col - 1] == '>');
+  for (size_t i = 0; i < lines.size(); ++i) {
+    TemplateLine tl;
+    tl.text = lines[i];
+    tl.loc = at;
+    if (block) {
+      tl.loc.line = at.line + 1 + static_cast<int>(i);
+      const std::string& r = tl.loc.line <= static_cast<int>(raw.size()) ? raw[tl.loc.line - 1] : std::string();
+      size_t pos = (!tl.text.empty() && r.size() >= tl.text.size() && r.compare(r.size() - tl.text.size(), tl.text.size(), tl.text) == 0)
+                       ? r.size() - tl.text.size()
+                       : r.find_first_not_of(' ');
+      tl.loc.col = static_cast<int>(pos == std::string::npos ? 0 : pos) + 1;
+    } else if (n.Tag() == "!") {
+      tl.loc.col += 1;  // quoted
+    }
+    out.push_back(std::move(tl));
+  }
+  return out;
+}
+
+void loadRule(RuleSet& set, const YamlCtx& y, const YAML::Node& r, const std::vector<std::string>& raw) {
+  y.expectMap(r, "a rule");
+  y.checkKeys(r, {"name", "produces", "needs", "when", "cost", "glsl", "doc"});
+  Rule rule;
+  if (!r["name"]) y.fail(r, "rule has no 'name'");
+  rule.name = y.scalar(r["name"], "'name'");
+  rule.loc = locOf(r["name"], y.file);
+  if (!validRuleName(rule.name)) y.fail(r["name"], fmt::format("'{}' is not a valid rule name", rule.name));
+  for (const auto& other : set.rules)
+    if (other.name == rule.name) {
+      if (other.loc.file == rule.loc.file && other.loc.line == rule.loc.line) return;  // same file included twice
+      y.fail(r["name"], fmt::format("rule '{}' is defined twice (first at {}:{})", rule.name, other.loc.file, other.loc.line));
+    }
+  if (!r["produces"]) y.fail(r, fmt::format("rule '{}' has no 'produces'", rule.name));
+  rule.produces = y.scalar(r["produces"], "'produces'");
+  rule.producesLoc = locOf(r["produces"], y.file);
+  if (!validSemanticName(rule.produces))
+    y.fail(r["produces"], fmt::format("'{}' is not a valid semantic name", rule.produces));
+  if (auto needs = r["needs"]) {
+    if (needs.IsScalar()) {
+      rule.needs.push_back(parseRef(y, needs));
+    } else {
+      y.expectSeq(needs, "'needs'");
+      for (const auto& n : needs) rule.needs.push_back(parseRef(y, n));
+    }
+  }
+  if (r["when"]) rule.when = Expr::parse(y.scalar(r["when"], "'when'"), exprLoc(r["when"], y.file));
+  if (!r["cost"]) y.fail(r, fmt::format("rule '{}' has no 'cost' (a number, an expression, or 'auto')", rule.name));
+  std::string cost = y.scalar(r["cost"], "'cost'");
+  if (cost == "auto") rule.costAuto = true;
+  else rule.cost = Expr::parse(cost, exprLoc(r["cost"], y.file));
+  if (!r["glsl"]) y.fail(r, fmt::format("rule '{}' has no 'glsl' snippet", rule.name));
+  rule.glsl = snippetLines(y, r["glsl"], raw);
+  if (r["doc"]) rule.doc = y.scalar(r["doc"], "'doc'");
+  set.rules.push_back(std::move(rule));
+}
+
+void loadFile(RuleSet& set, const std::string& path, std::vector<std::string>& stack);
+
+void loadParsed(RuleSet& set, const std::string& text, const std::string& path, std::vector<std::string>& stack) {
+  YamlCtx y{path};
+  YAML::Node root = parseYaml(text, path);
+  if (!root.IsDefined() || root.IsNull()) throw InputError(SourceLoc{path, 1, 1}, "empty rules file");
+  y.expectMap(root, "a rules file");
+  y.checkKeys(root, {"include", "semantics", "varyings", "rules", "doc"});
+  set.files.push_back(path);
+  std::vector<std::string> raw = splitLines(text);
+  if (auto inc = root["include"]) {
+    y.expectSeq(inc, "'include'");
+    for (const auto& i : inc) {
+      std::string rel = y.scalar(i, "an include path");
+      std::filesystem::path p = std::filesystem::path(path).parent_path() / rel;
+      std::string incPath = p.lexically_normal().string();
+      if (std::find(stack.begin(), stack.end(), incPath) != stack.end())
+        y.fail(i, fmt::format("include cycle: '{}' includes itself", incPath));
+      if (std::find(set.files.begin(), set.files.end(), incPath) != set.files.end()) continue;  // already loaded
+      if (!std::filesystem::exists(p)) y.fail(i, fmt::format("included file '{}' does not exist", incPath));
+      loadFile(set, incPath, stack);
+    }
+  }
+  if (auto s = root["semantics"]) loadSemantics(set, y, s);
+  if (auto v = root["varyings"]) loadVaryings(set, y, v);
+  if (auto rs = root["rules"]) {
+    y.expectSeq(rs, "'rules'");
+    for (const auto& r : rs) loadRule(set, y, r, raw);
+  }
+}
+
+void loadFile(RuleSet& set, const std::string& path, std::vector<std::string>& stack) {
+  stack.push_back(path);
+  loadParsed(set, readInputFile(path), path, stack);
+  stack.pop_back();
+}
+
+}  // namespace
+
+const SemanticDecl* RuleSet::findSemantic(const std::string& name) const {
+  for (const auto& s : semantics)
+    if (s.name == name) return &s;
+  return nullptr;
+}
+
+const VaryingMapping* RuleSet::findVarying(const std::string& name) const {
+  for (const auto& v : varyings)
+    if (v.name == name) return &v;
+  return nullptr;
+}
+
+void loadRulesInto(RuleSet& set, const std::string& path) {
+  std::string norm = std::filesystem::path(path).lexically_normal().string();
+  if (std::find(set.files.begin(), set.files.end(), norm) != set.files.end()) return;
+  std::vector<std::string> stack;
+  loadFile(set, norm, stack);
+}
+
+void loadRulesText(RuleSet& set, const std::string& text, const std::string& fileName) {
+  std::vector<std::string> stack{fileName};
+  loadParsed(set, text, fileName, stack);
+}
+
+RuleSet loadRules(const std::vector<std::string>& paths) {
+  RuleSet set;
+  for (const auto& p : paths) loadRulesInto(set, p);
+  return set;
+}
+
+}  // namespace sg

@@ -1,0 +1,67 @@
+// The search problem: rules instantiated against a rig. Facts are semantic
+// instances; actions are rule instances (one product, a set of preconditions, a
+// cost, and their unrolled snippet). Delete-free: applying an action only adds.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/diagnostics.h"
+#include "common/types.h"
+
+namespace sg {
+
+struct Rig;
+struct RuleSet;
+struct Varying;
+
+struct Fact {
+  enum class Source { Computed, Attribute, Uniform };
+  std::string name;  // "world.normal", "morph.position[3]"
+  Type type = Type::Vec3;
+  int arraySize = 0;  // uniform arrays
+  Source source = Source::Computed;
+  int rigIndex = -1;    // attribute or uniform index in the rig
+  int target = -1;      // morph target of a per-target attribute
+  std::string swizzle;  // part of the attribute ("" = whole)
+};
+
+// One line of instantiated snippet. Fact references are encoded as
+// kFactRefBegin <id> kFactRefEnd so the emitter picks the GLSL names.
+struct CodeLine {
+  std::string text;
+  SourceLoc loc;  // where the template line sits in the rules file
+};
+constexpr char kFactRefBegin = '\x01';
+constexpr char kFactRefEnd = '\x02';
+std::string factRef(int fact);
+
+struct Action {
+  std::string name;  // rule name
+  int rule = -1;     // index in RuleSet::rules
+  std::vector<int> pre;  // sorted, unique
+  int add = -1;
+  int64_t cost = 0;
+  std::vector<CodeLine> code;
+};
+
+struct Problem {
+  std::vector<Fact> facts;
+  std::vector<Action> actions;
+  std::vector<int> init;   // provided facts
+  std::vector<int> goals;  // requested facts (sorted, unique)
+  // Rules skipped at instantiation and why (for explain/check): "when is false", ...
+  std::vector<std::pair<int, std::string>> skippedRules;
+
+  int findFact(const std::string& name) const;  // -1 if absent
+};
+
+// Instantiates `rules` against `rig` for the requested `varyings`. Throws InputError for
+// inconsistent inputs (rig semantics unknown to the rules, type mismatches, bad snippet
+// templates, references to semantics not listed in `needs`, negative costs).
+Problem buildProblem(const Rig& rig, const RuleSet& rules, const std::vector<Varying>& varyings);
+
+// Same problem without the actions of the named rules (to force alternatives).
+Problem withoutRules(const Problem& p, const std::vector<std::string>& ruleNames);
+
+}  // namespace sg

@@ -1,0 +1,49 @@
+// Vertex data and poses for running generated shaders and the GLM reference.
+// Streams are keyed by the semantic they carry (docs/semantics.md), so the same
+// mesh feeds both the Vulkan harness (through the rig's attribute layout) and
+// the reference (which only knows semantics).
+#pragma once
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace sg::rt {
+
+struct Mesh {
+  std::string name;
+  size_t vertexCount = 0;
+  // Per-vertex values by semantic: "vertex.position", "vertex.normal", "vertex.occlusion",
+  // "vertex.tangent", "vertex.handedness", "vertex.texcoord0", "vertex.color0",
+  // "morph.position[i]", "morph.normal[i]", "morph.occlusion[i]", "morph.tangent[i]",
+  // "skin.joints[s]" (integral values stored as floats), "skin.weights[s]".
+  // Unused components are 0. Scalars live in .x.
+  std::map<std::string, std::vector<glm::vec4>> streams;
+
+  bool has(const std::string& semantic) const { return streams.count(semantic) != 0; }
+  const std::vector<glm::vec4>& at(const std::string& semantic) const { return streams.at(semantic); }
+};
+
+// Uniform values for one frame. Matrices are column-major (GLM / GLSL convention).
+struct Pose {
+  std::vector<glm::mat4> bones;       // skin.bones
+  std::vector<float> morphWeights;    // morph.weights
+  glm::vec3 cameraPosition{0.0f};     // camera.position (world space)
+  glm::mat4 view{1.0f};               // camera.view (rigid: rotation + translation)
+  glm::mat4 projection{1.0f};         // camera.projection
+  glm::mat4 model{1.0f};              // model.matrix
+  glm::mat4 dapple{1.0f};             // dapple.matrix
+  glm::mat4 viewProjection() const { return projection * view; }  // camera.view_projection
+};
+
+// Rig parameters the reference needs (mirrors the rig's deformers).
+struct RigShape {
+  int bones = 0;
+  int influences = 0;     // 0 = unskinned, 1 = rigid, 2/4/8 = linear blend
+  int morphTargets = 0;
+  bool hasModelMatrix = false;  // unskinned rigs transform by model.matrix when provided
+};
+
+}  // namespace sg::rt

@@ -1,0 +1,73 @@
+// Headless Vulkan harness: runs a vertex shader over N vertices and captures its
+// outputs with VK_EXT_transform_feedback. Generic on purpose: it knows bytes, formats
+// and strides, never semantics, so the validator and applications share it.
+#pragma once
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace sg::rt {
+
+// One vertex buffer binding per stream, per-vertex rate, attribute at offset 0.
+struct VertexStream {
+  uint32_t location = 0;
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  uint32_t stride = 0;
+  std::vector<uint8_t> data;  // at least vertexCount * stride bytes
+};
+
+// The shader's xfb_stride (a single capture buffer, xfb_buffer 0).
+struct CaptureLayout {
+  uint32_t strideBytes = 0;
+};
+
+struct RunRequest {
+  // Vertex shader with xfb_buffer/xfb_offset/xfb_stride on every captured output
+  // (gl_Position through a redeclared gl_PerVertex).
+  std::vector<uint32_t> spirv;
+  std::vector<VertexStream> streams;
+  // Contents of the uniform block at set 0, binding 0; empty = no descriptor set.
+  std::vector<uint8_t> uniformData;
+  uint32_t vertexCount = 0;
+  CaptureLayout capture;
+};
+
+struct RunTimings {
+  double setupMs = 0, uploadMs = 0, runMs = 0, readbackMs = 0;
+};
+
+struct RunResult {
+  std::vector<uint8_t> captured;  // vertexCount * capture.strideBytes; bytes no output wrote are 0
+  RunTimings timings;
+};
+
+struct HarnessOptions {
+  std::string deviceName;   // substring of the device name; empty = lavapipe (VK_DRIVER_ID_MESA_LLVMPIPE)
+  bool validation = true;   // enable VK_LAYER_KHRONOS_validation if it is installed
+};
+
+class Harness {
+ public:
+  // Throws std::runtime_error if there is no Vulkan, no matching device, or no transform feedback.
+  explicit Harness(const HarnessOptions& options = {});
+  ~Harness();
+  Harness(const Harness&) = delete;
+  Harness& operator=(const Harness&) = delete;
+
+  // Throws std::runtime_error on failure (bad request or Vulkan error).
+  RunResult run(const RunRequest& request);
+
+  // Every debug-utils message (warning and error severities, all types) since construction.
+  const std::vector<std::string>& validationMessages() const;
+  std::string deviceName() const;
+  bool validationEnabled() const;  // whether the layer was found and enabled
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sg::rt
