@@ -122,8 +122,10 @@ struct ReferenceEvaluator::State {
   std::optional<std::vector<dvec3>> objPos, objNormal, objTangent;
   std::optional<std::vector<double>> objOcc;
   std::optional<std::vector<dvec3>> worldPos, worldNormal, worldTangent;
-  std::optional<std::vector<dmat4>> skin;  // one matrix per vertex, or a single one if uniform
-  bool skinUniform = false;
+  bool skinReady = false;  // prepareSkinning() done
+  dmat4 skinUniform{1.0};  // K = 0
+  std::vector<dmat4> skinBones;
+  std::vector<const std::vector<glm::vec4>*> skinJoints, skinWeights;
 
   State(const Mesh& m, const Pose& p, const RigShape& s)
       : mesh(m), pose(p), shape(s), n(m.vertexCount) {}
@@ -226,60 +228,59 @@ struct ReferenceEvaluator::State {
 
   // skin.matrix: M = Σ_{k<K} weight_k·B_{joint_k}; K = 1: B_{joint_0}; K = 0: model.matrix if
   // provided, else identity. Influence k lives in skin.joints[k/4][k%4], skin.weights[k/4][k%4].
-  const std::vector<dmat4>& skinMatrices() {
-    if (skin) return *skin;
+  // The streams are resolved and every joint index checked once; M itself is recomputed per
+  // vertex by skinAt (cheaper than storing 128 bytes per vertex).
+  void prepareSkinning() {
+    if (skinReady) return;
     const int K = shape.influences;
     if (K < 0) fail("rig has a negative influence count (" + std::to_string(K) + ")");
+    skinJoints.clear();
+    skinWeights.clear();
     if (K == 0) {
-      skin = std::vector<dmat4>{shape.hasModelMatrix ? dmat4(pose.model) : dmat4(1.0)};
-      skinUniform = true;
-      return *skin;
+      skinUniform = shape.hasModelMatrix ? dmat4(pose.model) : dmat4(1.0);
+      skinReady = true;
+      return;
     }
     const int sets = (K + 3) / 4;
-    std::vector<const std::vector<glm::vec4>*> joints, weights;
     for (int s = 0; s < sets; ++s) {
-      joints.push_back(&stream("skin.joints[" + std::to_string(s) + "]"));
-      if (K > 1) weights.push_back(&stream("skin.weights[" + std::to_string(s) + "]"));
+      skinJoints.push_back(&stream("skin.joints[" + std::to_string(s) + "]"));
+      if (K > 1) skinWeights.push_back(&stream("skin.weights[" + std::to_string(s) + "]"));
     }
     if (pose.bones.empty())
       throw std::invalid_argument(requested + " needs skin.bones, which the pose does not have");
-    std::vector<dmat4> bones(pose.bones.begin(), pose.bones.end());
-
-    auto jointAt = [&](size_t v, int k) -> const dmat4& {
-      float j = (*joints[static_cast<size_t>(k / 4)])[v][k % 4];
-      if (!(j >= 0.0f) || j != std::floor(j) || static_cast<double>(j) >= static_cast<double>(bones.size()))
-        fail("skin.joints[" + std::to_string(k / 4) + "] of mesh '" + mesh.name +
-             "' has joint index " + std::to_string(j) + " at vertex " + std::to_string(v) +
-             " (component " + std::to_string(k % 4) + "), but the pose has " +
-             std::to_string(bones.size()) + " bones");
-      return bones[static_cast<size_t>(j)];
-    };
-
-    std::vector<dmat4> out(n);
+    skinBones.assign(pose.bones.begin(), pose.bones.end());
+    const double boneCount = static_cast<double>(skinBones.size());
     for (size_t v = 0; v < n; ++v) {
-      if (K == 1) {
-        out[v] = jointAt(v, 0);
-        continue;
-      }
-      dmat4 M(0.0);
       for (int k = 0; k < K; ++k) {
-        double w = (*weights[static_cast<size_t>(k / 4)])[v][k % 4];
-        M += w * jointAt(v, k);
+        const float j = (*skinJoints[static_cast<size_t>(k / 4)])[v][k % 4];
+        if (!(j >= 0.0f) || j != std::floor(j) || static_cast<double>(j) >= boneCount)
+          fail("skin.joints[" + std::to_string(k / 4) + "] of mesh '" + mesh.name +
+               "' has joint index " + std::to_string(j) + " at vertex " + std::to_string(v) +
+               " (component " + std::to_string(k % 4) + "), but the pose has " +
+               std::to_string(skinBones.size()) + " bones");
       }
-      out[v] = M;
     }
-    skin = std::move(out);
-    skinUniform = false;
-    return *skin;
+    skinReady = true;
   }
 
-  const dmat4& skinAt(size_t v) const { return (*skin)[skinUniform ? 0 : v]; }
+  dmat4 skinAt(size_t v) const {
+    const int K = shape.influences;
+    if (K == 0) return skinUniform;
+    auto joint = [&](int k) -> const dmat4& {
+      return skinBones[static_cast<size_t>((*skinJoints[static_cast<size_t>(k / 4)])[v][k % 4])];
+    };
+    if (K == 1) return joint(0);
+    dmat4 M(0.0);
+    for (int k = 0; k < K; ++k)
+      M += static_cast<double>((*skinWeights[static_cast<size_t>(k / 4)])[v][k % 4]) * joint(k);
+    return M;
+  }
 
   // world.position = (M·vec4(object.position, 1)).xyz
   const std::vector<dvec3>& worldPosition() {
     if (worldPos) return *worldPos;
     const auto& p = objectPosition();
-    skinMatrices();
+    prepareSkinning();
     std::vector<dvec3> out(n);
     for (size_t v = 0; v < n; ++v) out[v] = dvec3(skinAt(v) * dvec4(p[v], 1.0));
     worldPos = std::move(out);
@@ -290,7 +291,7 @@ struct ReferenceEvaluator::State {
   const std::vector<dvec3>& worldNormalValues() {
     if (worldNormal) return *worldNormal;
     const auto& N = objectNormal();
-    skinMatrices();
+    prepareSkinning();
     std::vector<dvec3> out(n);
     for (size_t v = 0; v < n; ++v) out[v] = glm::normalize(dmat3(skinAt(v)) * N[v]);
     worldNormal = std::move(out);
@@ -301,7 +302,7 @@ struct ReferenceEvaluator::State {
   const std::vector<dvec3>& worldTangentValues() {
     if (worldTangent) return *worldTangent;
     const auto& T = objectTangent();
-    skinMatrices();
+    prepareSkinning();
     std::vector<dvec3> out(n);
     for (size_t v = 0; v < n; ++v) out[v] = glm::normalize(dmat3(skinAt(v)) * T[v]);
     worldTangent = std::move(out);
@@ -324,10 +325,11 @@ struct ReferenceEvaluator::State {
 
 std::vector<glm::vec4> ReferenceEvaluator::State::evaluate(const std::string& sem) {
   requested = sem;
-  std::vector<glm::vec4> out(n);
   auto fill = [&](auto&& f) {
-    for (size_t v = 0; v < n; ++v) out[v] = toVec4(f(v));
-    return std::move(out);
+    std::vector<glm::vec4> out;
+    out.reserve(n);
+    for (size_t v = 0; v < n; ++v) out.push_back(toVec4(f(v)));
+    return out;
   };
 
   if (nonVectorSemantics().count(sem))

@@ -552,6 +552,13 @@ TEST(Procedural, PosesAreDeterministicAndDifferAcrossSeeds) {
   // fixes (the first output for seed 1234 is 822569775), so this value is the same everywhere.
   std::mt19937 raw(1234);
   EXPECT_EQ(raw(), 822569775u);
+  // Golden pose values: floats are top-24-bit fractions of the raw output, exact everywhere.
+  Pose g = makeRandomPose(RigShape{4, 4, 2, false}, 1234);
+  EXPECT_EQ(g.morphWeights[0], 0.117443383f);
+  EXPECT_EQ(g.morphWeights[1], 0.933140099f);
+  EXPECT_NEAR(g.cameraPosition.x, -2.11153841f, 1e-5f);
+  EXPECT_NEAR(g.cameraPosition.y, 3.00929809f, 1e-5f);
+  EXPECT_NEAR(g.cameraPosition.z, -0.939701557f, 1e-5f);
 }
 
 TEST(Procedural, PoseContents) {

@@ -1,0 +1,89 @@
+// Validation: run a generated shader on a Vulkan device (lavapipe by default) over a
+// mesh in given poses and compare every output with the GLM reference of its
+// semantics. Tolerances and their justification: docs/validation.md.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pipeline/generate.h"
+#include "runtime/mesh.h"
+#include "runtime/vk_harness.h"
+
+namespace sg {
+
+struct Tolerance {
+  // A component passes if |gpu - ref| <= abs + rel * max(1, |ref|_max), where |ref|_max is
+  // the largest reference component of that output at that vertex.
+  double abs = 2e-5;
+  double rel = 1e-4;
+};
+
+struct OutputReport {
+  std::string name;                    // "gl_Position", "WorldEyeDir", ...
+  std::vector<std::string> semantics;  // what it carries
+  double maxAbsError = 0;
+  double maxRelError = 0;  // |gpu - ref| / max(1, |ref|_max)
+  size_t worstVertex = 0;
+  int worstComponent = 0;
+  bool pass = true;
+};
+
+struct RunReport {
+  std::string label;  // "chosen plan" or "forced: <rule> for <semantic>"
+  std::vector<std::string> rules;  // plan rules in order
+  int64_t planCost = 0;
+  size_t vertices = 0;
+  std::vector<OutputReport> outputs;
+  std::vector<std::string> validationMessages;
+  rt::RunTimings timings;
+  double referenceMs = 0;
+  double generateMs = 0;
+  bool pass = true;
+};
+
+struct ValidateReport {
+  std::string device;
+  bool validationLayers = false;
+  std::vector<RunReport> runs;
+  bool pass = true;
+};
+
+// What to run the shader on.
+struct ValidationScene {
+  rt::Mesh mesh;
+  std::vector<rt::Pose> poses;
+  rt::RigShape shape;
+};
+
+// A procedural scene matching the rig: "head" (default), "limb", or "dawn" (180k vertices).
+// Throws InputError if the rig asks for something the procedural meshes can't supply.
+ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_t seed, int poses);
+
+struct ValidateOptions {
+  GenerateOptions gen;
+  bool crossCheck = false;  // also force each alternative derivation and check it
+  Tolerance tolerance;
+  std::string device;       // "" = lavapipe
+  bool validationLayers = true;
+};
+
+class Validator {
+ public:
+  explicit Validator(const ValidateOptions& opts);
+  ~Validator();
+  // Generates (capture build), runs every pose, compares. With crossCheck, repeats for
+  // every alternative derivation of each semantic in the plan.
+  ValidateReport run(const ValidationScene& scene);
+  // One generation result on the scene (no cross-check); exposed for tests and benchmarks.
+  RunReport runOne(const GenerateResult& r, const ValidationScene& scene, const std::string& label);
+
+ private:
+  ValidateOptions opts_;
+  std::unique_ptr<rt::Harness> harness_;
+};
+
+std::string formatReport(const ValidateReport& report);
+
+}  // namespace sg
