@@ -123,9 +123,5 @@ void registerGenerate(CLI::App& app, CliState& state) {
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }
 
-void registerCommands(CLI::App& app, CliState& state) {
-  registerGenerate(app, state);
-  registerValidate(app, state);
-}
 
 }  // namespace sg

@@ -28,5 +28,8 @@ struct GenerateArgs {
 void registerCommands(CLI::App& app, CliState& state);
 void registerGenerate(CLI::App& app, CliState& state);
 void registerValidate(CLI::App& app, CliState& state);
+void registerCheck(CLI::App& app, CliState& state);    // cmd_check.cpp
+void registerExplain(CLI::App& app, CliState& state);  // cmd_explain.cpp: explain + graph
+void registerRig(CLI::App& app, CliState& state);      // cmd_rig.cpp: rig import
 
 }  // namespace sg

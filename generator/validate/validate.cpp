@@ -216,6 +216,7 @@ RunReport Validator::runOne(const GenerateResult& r, const ValidationScene& scen
     rep.timings.uploadMs += res.timings.uploadMs;
     rep.timings.runMs += res.timings.runMs;
     rep.timings.readbackMs += res.timings.readbackMs;
+    rt::ReferenceEvaluator reference(mesh, pose, scene.shape);  // shares intermediates across outputs
     for (size_t oi = 0; oi < r.glsl.outputs.size(); ++oi) {
       const EmittedOutput& o = r.glsl.outputs[oi];
       OutputReport& out = rep.outputs[oi];
@@ -226,7 +227,7 @@ RunReport Validator::runOne(const GenerateResult& r, const ValidationScene& scen
         const SemanticDecl* d = r.in.rules.findSemantic(sem);
         int n = d ? componentCount(d->type) : rt::referenceComponents(sem);
         try {
-          refs.emplace_back(rt::referenceValues(sem, mesh, pose, scene.shape), n);
+          refs.emplace_back(reference.values(sem), n);
         } catch (const std::exception& e) {
           throw InputError(SourceLoc{}, fmt::format("cannot validate output '{}': {}", o.name, e.what()));
         }
@@ -304,12 +305,15 @@ ValidateReport Validator::run(const ValidationScene& scene) {
         for (const auto& other : producers)
           if (other != alt) forced.bannedRules.push_back(other);
         GenerateResult r;
+        auto tg = Clock::now();
         try {
           r = generateFrom(in, forced);
         } catch (const InputError&) {
           continue;  // the alternative needs something this rig cannot provide
         }
+        double ms = msSince(tg);
         RunReport rr = runOne(r, scene, fmt::format("forced {} for {}", alt, p.facts[fact].name));
+        rr.generateMs = ms;
         if (!seenPlans.insert(rr.rules).second) continue;
         report.runs.push_back(std::move(rr));
       }

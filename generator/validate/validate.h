@@ -16,8 +16,8 @@ namespace sg {
 struct Tolerance {
   // A component passes if |gpu - ref| <= abs + rel * max(1, |ref|_max), where |ref|_max is
   // the largest reference component of that output at that vertex.
-  double abs = 2e-5;
-  double rel = 1e-4;
+  double abs = 1e-6;
+  double rel = 1e-5;
 };
 
 struct OutputReport {

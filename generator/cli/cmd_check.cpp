@@ -1,0 +1,7 @@
+#include "cli/commands.h"
+
+namespace sg {
+
+void registerCheck(CLI::App&, CliState&) {}
+
+}  // namespace sg

@@ -1,0 +1,7 @@
+#include "cli/commands.h"
+
+namespace sg {
+
+void registerExplain(CLI::App&, CliState&) {}
+
+}  // namespace sg

@@ -1,0 +1,13 @@
+#include "cli/commands.h"
+
+namespace sg {
+
+void registerCommands(CLI::App& app, CliState& state) {
+  registerGenerate(app, state);
+  registerValidate(app, state);
+  registerCheck(app, state);
+  registerExplain(app, state);
+  registerRig(app, state);
+}
+
+}  // namespace sg
