@@ -198,6 +198,10 @@ FactSet factSetOf(const Problem& p, uint32_t mask) {
 }
 
 // Random delete-free instance: `nf` facts, `na` actions with 0-3 preconditions, costs 0-9.
+// Generated forwards: most preconditions are facts already provided or produced by an
+// earlier-generated action, the rest are any fact (cycles, never-produced facts); most
+// goals are some action's product, the rest any fact (possibly provided or unproducible).
+// So most instances are solvable, many have alternatives, and a good share are not.
 Problem randomProblem(std::mt19937& rng, int nf, int na, int ngoals) {
   Problem p;
   for (int f = 0; f < nf; ++f) {
@@ -205,26 +209,31 @@ Problem randomProblem(std::mt19937& rng, int nf, int na, int ngoals) {
     fact.name = "f" + std::to_string(f);
     p.facts.push_back(fact);
   }
-  std::uniform_int_distribution<int> factDist(0, nf - 1), costDist(0, 9), preCount(0, 3), initCount(1, 3);
+  std::uniform_int_distribution<int> factDist(0, nf - 1), costDist(0, 9), preCount(0, 3), initCount(1, 3),
+      percent(0, 99);
   std::vector<int> order(nf);
   for (int i = 0; i < nf; ++i) order[i] = i;
   std::shuffle(order.begin(), order.end(), rng);
   int ni = initCount(rng);
   p.init.assign(order.begin(), order.begin() + ni);
+  std::vector<int> available = p.init;  // may hold duplicates: biases towards popular facts
+  auto pickAvailable = [&] { return available[std::uniform_int_distribution<size_t>(0, available.size() - 1)(rng)]; };
   for (int a = 0; a < na; ++a) {
     Action act;
     act.name = "a" + std::to_string(a);
     act.add = factDist(rng);
     int k = preCount(rng);
     std::set<int> pre;
-    for (int i = 0; i < k; ++i) pre.insert(factDist(rng));
+    for (int i = 0; i < k; ++i) pre.insert(percent(rng) < 80 ? pickAvailable() : factDist(rng));
     act.pre.assign(pre.begin(), pre.end());
     act.cost = costDist(rng);
+    available.push_back(act.add);
     p.actions.push_back(std::move(act));
   }
-  // Goals: mostly facts other than init (occasionally an init fact too).
   std::set<int> goals;
-  for (int i = 0; i < ngoals; ++i) goals.insert(factDist(rng));
+  for (int i = 0; i < ngoals; ++i)
+    goals.insert(percent(rng) < 85 && na > 0 ? p.actions[std::uniform_int_distribution<int>(0, na - 1)(rng)].add
+                                             : factDist(rng));
   p.goals.assign(goals.begin(), goals.end());
   return p;
 }
