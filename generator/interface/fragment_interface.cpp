@@ -46,10 +46,15 @@ SourceLoc findDeclaration(const std::string& source, const std::string& file, co
   return SourceLoc{file, 0, 0};
 }
 
-std::string dotted(const std::string& name) {
-  std::string s = name;
-  std::replace(s.begin(), s.end(), '_', '.');
-  return s;
+// The declared semantic whose name, with '.' written as '_', is the input's name
+// (world_eye_dir -> world.eye_dir; '_' inside a semantic name stays '_').
+const SemanticDecl* semanticNamed(const RuleSet& rules, const std::string& inputName) {
+  for (const auto& d : rules.semantics) {
+    std::string s = d.name;
+    std::replace(s.begin(), s.end(), '.', '_');
+    if (s == inputName) return &d;
+  }
+  return nullptr;
 }
 
 }  // namespace
@@ -139,8 +144,8 @@ std::vector<Varying> bindVaryings(const FragmentInterface& frag, const RuleSet& 
       v.semantics = m->semantics;
       mapLoc = m->loc;
       how = fmt::format("the mapping at {}:{}", m->loc.file, m->loc.line);
-    } else if (rules.findSemantic(dotted(in.name))) {
-      v.semantics = {dotted(in.name)};
+    } else if (const SemanticDecl* d = semanticNamed(rules, in.name)) {
+      v.semantics = {d->name};
       how = "its name";
     } else {
       throw InputError(in.loc, fmt::format("fragment input '{}' does not name a semantic; map it in the rules' "

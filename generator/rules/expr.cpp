@@ -57,20 +57,25 @@ class Parser {
     n->col = static_cast<int>(at);
     return n;
   }
+  // Position of the next token (an operator's column, not the blank before it).
+  size_t next() {
+    skip();
+    return pos_;
+  }
   NodeP parseOr() {
     NodeP l = parseAnd();
-    for (size_t at = pos_; eat("||"); at = pos_) l = bin("||", l, parseAnd(), at);
+    for (size_t at = next(); eat("||"); at = next()) l = bin("||", l, parseAnd(), at);
     return l;
   }
   NodeP parseAnd() {
     NodeP l = parseCmp();
-    for (size_t at = pos_; eat("&&"); at = pos_) l = bin("&&", l, parseCmp(), at);
+    for (size_t at = next(); eat("&&"); at = next()) l = bin("&&", l, parseCmp(), at);
     return l;
   }
   NodeP parseCmp() {
     NodeP l = parseAdd();
     for (;;) {
-      size_t at = pos_;
+      size_t at = next();
       const char* ops[] = {"==", "!=", "<=", ">=", "<", ">"};
       const char* hit = nullptr;
       for (const char* op : ops)
@@ -85,7 +90,7 @@ class Parser {
   NodeP parseAdd() {
     NodeP l = parseMul();
     for (;;) {
-      size_t at = pos_;
+      size_t at = next();
       if (eat("+")) l = bin("+", l, parseMul(), at);
       else if (eat("-")) l = bin("-", l, parseMul(), at);
       else return l;
@@ -94,7 +99,7 @@ class Parser {
   NodeP parseMul() {
     NodeP l = parseUnary();
     for (;;) {
-      size_t at = pos_;
+      size_t at = next();
       if (eat("*")) l = bin("*", l, parseUnary(), at);
       else if (eat("/")) l = bin("/", l, parseUnary(), at);
       else if (eat("%")) l = bin("%", l, parseUnary(), at);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "interface/fragment_interface.h"
@@ -128,9 +129,13 @@ class Builder {
         for (const auto& part : attr.provides) {
           std::string name = attr.perMorphTarget ? indexed(part.semantic, t) : part.semantic;
           int n = part.swizzle.empty() ? componentCount(attr.shaderType) : static_cast<int>(part.swizzle.size());
-          Type have = *vectorType(scalarKind(attr.shaderType), n);
+          std::optional<Type> have = vectorType(scalarKind(attr.shaderType), n);
+          if (!have)  // e.g. "xy" of a uint8x4: there is no uvec2 type
+            throw InputError(attr.loc, fmt::format("attribute '{}' provides '{}' through swizzle '{}': {} components of "
+                                                   "{} have no supported type",
+                                                   attr.name, name, part.swizzle, n, glslName(attr.shaderType)));
           int f = factOrFail(name, attr.loc, fmt::format("attribute '{}' provides", attr.name).c_str());
-          provide(f, Fact::Source::Attribute, static_cast<int>(a), attr.perMorphTarget ? t : -1, part.swizzle, have,
+          provide(f, Fact::Source::Attribute, static_cast<int>(a), attr.perMorphTarget ? t : -1, part.swizzle, *have,
                   attr.loc);
         }
     }
