@@ -132,10 +132,14 @@ Mesh buildMesh(std::string name, int rings, int segments, const MeshOptions& opt
   std::vector<glm::vec4>* occlusion = nullptr;
   std::vector<glm::vec4>* tangent = nullptr;
   std::vector<glm::vec4>* handedness = nullptr;
+  std::vector<glm::vec4>* binormal = nullptr;
+  auto& color = mesh.streams["vertex.color0"];
+  color.resize(n);
   if (opts.occlusion) (occlusion = &mesh.streams["vertex.occlusion"])->resize(n);
   if (opts.tangents) {
     (tangent = &mesh.streams["vertex.tangent"])->resize(n);
     (handedness = &mesh.streams["vertex.handedness"])->resize(n);
+    (binormal = &mesh.streams["vertex.binormal"])->resize(n);
   }
   struct Target {
     std::vector<glm::vec4>*dp = nullptr, *dn = nullptr, *docc = nullptr, *dt = nullptr;
@@ -166,6 +170,7 @@ Mesh buildMesh(std::string name, int rings, int segments, const MeshOptions& opt
       position[k] = v4(sp.position);
       normal[k] = v4(sp.normal);
       tex0[k] = glm::vec4(static_cast<float>(u), static_cast<float>(v), 0.0f, 0.0f);
+      color[k] = glm::vec4(static_cast<float>(u), static_cast<float>(v), static_cast<float>(0.5 * (u + v)), 1.0f);
       tex1[k] = glm::vec4(static_cast<float>(0.25 + 0.5 * v), static_cast<float>(0.75 - 0.5 * u), 0.0f, 0.0f);
       if (occlusion) (*occlusion)[k] = s4(0.55 + 0.35 * std::sin(3.0 * kTwoPi * u) * std::cos(kTwoPi * v));
       if (tangent) {
@@ -173,6 +178,8 @@ Mesh buildMesh(std::string name, int rings, int segments, const MeshOptions& opt
         dvec3 t = glm::normalize(sp.tangent + 0.15 * std::sin(kTwoPi * (3.0 * u + v)) * sp.normal);
         (*tangent)[k] = v4(t);
         (*handedness)[k] = s4(u < 0.5 ? 1.0 : -1.0);  // mirrored UVs on the second half
+        // A stored binormal for rigs without tangent.w (only its sign against N x T matters).
+        (*binormal)[k] = v4((u < 0.5 ? 1.0 : -1.0) * glm::normalize(glm::cross(sp.normal, t)));
       }
       for (int m = 0; m < opts.morphTargets; ++m) {
         const Target& tg = targets[static_cast<size_t>(m)];

@@ -81,7 +81,7 @@ bool hasDigitSuffix(const std::string& s, const std::string& prefix) {
 std::optional<int> streamComponents(const std::string& s) {
   static const std::map<std::string, int> vertexTable = {
       {"vertex.position", 3}, {"vertex.normal", 3},     {"vertex.occlusion", 1},
-      {"vertex.tangent", 3},  {"vertex.handedness", 1},
+      {"vertex.tangent", 3},  {"vertex.handedness", 1}, {"vertex.binormal", 3},
   };
   if (auto it = vertexTable.find(s); it != vertexTable.end()) return it->second;
   if (hasDigitSuffix(s, "vertex.texcoord")) return 2;
@@ -309,6 +309,22 @@ struct ReferenceEvaluator::State {
     return *worldTangent;
   }
 
+  // world.handedness = vertex.handedness; without it, the sign of a stored binormal
+  // against the bind-pose frame: sign(dot(cross(vertex.normal, vertex.tangent), vertex.binormal)).
+  const std::vector<glm::vec4>& handedness() {
+    if (mesh.has("vertex.handedness") || !mesh.has("vertex.binormal")) return stream("vertex.handedness");
+    if (derivedHandedness.empty()) {
+      const auto& N = stream("vertex.normal");
+      const auto& T = stream("vertex.tangent");
+      const auto& B = stream("vertex.binormal");
+      derivedHandedness.resize(n);
+      for (size_t v = 0; v < n; ++v)
+        derivedHandedness[v].x = glm::dot(glm::cross(dvec3(N[v]), dvec3(T[v])), dvec3(B[v])) < 0.0 ? -1.0f : 1.0f;
+    }
+    return derivedHandedness;
+  }
+  std::vector<glm::vec4> derivedHandedness;
+
   // world.binormal = world.handedness · normalize(cross(world.normal, world.tangent))
   dvec3 binormal(size_t v, const std::vector<dvec3>& N, const std::vector<dvec3>& T,
                  const std::vector<glm::vec4>& h) const {
@@ -373,12 +389,11 @@ std::vector<glm::vec4> ReferenceEvaluator::State::evaluate(const std::string& se
     return fill([&](size_t v) { return T[v]; });
   }
   if (sem == "world.handedness") {
-    // world.handedness = vertex.handedness
-    const auto& h = stream("vertex.handedness");
+    const auto& h = handedness();
     return fill([&](size_t v) { return static_cast<double>(h[v].x); });
   }
   if (sem == "world.binormal") {
-    const auto& h = stream("vertex.handedness");
+    const auto& h = handedness();
     const auto& N = worldNormalValues();
     const auto& T = worldTangentValues();
     return fill([&](size_t v) { return binormal(v, N, T, h); });
@@ -386,7 +401,7 @@ std::vector<glm::vec4> ReferenceEvaluator::State::evaluate(const std::string& se
   if (sem == "frame.row_x" || sem == "frame.row_y" || sem == "frame.row_z") {
     // Rows of the tangent→world matrix [T B N]: row_c = (T.c, B.c, N.c).
     const int c = sem.back() - 'x';
-    const auto& h = stream("vertex.handedness");
+    const auto& h = handedness();
     const auto& N = worldNormalValues();
     const auto& T = worldTangentValues();
     return fill([&](size_t v) {

@@ -1,7 +1,75 @@
+// `shadergen rig import MODEL.gltf|.glb [--mesh N] [--primitive P] [-o rig.yaml]`:
+// derive the rig of one mesh primitive of a glTF model (docs/gltf.md).
+#include <fmt/format.h>
+
+#include <iostream>
+
 #include "cli/commands.h"
+#include "cli/output_files.h"
+#include "rig/gltf_import.h"
 
 namespace sg {
+namespace {
 
-void registerRig(CLI::App&, CliState&) {}
+struct RigImportCommand {
+  std::string model;
+  int mesh = -1;
+  int primitive = -1;
+  std::string output;
+  bool quiet = false;
+
+  int run() {
+    GltfRef ref = parseGltfRef(model);
+    GltfImportOptions o;
+    o.mesh = mesh >= 0 ? mesh : ref.mesh;
+    o.primitive = primitive >= 0 ? primitive : ref.primitive;
+    GltfImport imp = importGltf(ref.file, o);
+    std::vector<std::string> header{
+        fmt::format("Imported by shadergen {} rig import from {}, mesh {} '{}', primitive {}.", shadergenVersion(),
+                    ref.file, imp.data.mesh, imp.data.meshName, imp.data.primitive),
+        fmt::format("{} vertices; glTF attributes:", imp.data.vertexCount)};
+    for (const auto& a : imp.attributes)
+      header.push_back(fmt::format("  {:<11} {}{} {}{} -> {}", a.gltfName, a.normalized ? "normalized " : "",
+                                   a.componentType, a.type, a.sparse ? " (sparse)" : "",
+                                   a.rigAttribute.empty() ? std::string("(left out)")
+                                                          : fmt::format("{} ({})", a.rigAttribute, a.format)));
+    if (imp.morphTargets > 0) {
+      header.push_back(fmt::format("{} morph target(s):", imp.morphTargets));
+      for (size_t t = 0; t < imp.targetAttributes.size(); ++t) {
+        std::string list;
+        for (const auto& n : imp.targetAttributes[t]) list += (list.empty() ? "" : ", ") + n;
+        header.push_back(fmt::format("  target {}: {}", t, list));
+      }
+    }
+    for (const auto& n : imp.notes) header.push_back("note: " + n);
+    std::string yaml = rigToYaml(imp.rig, header);
+    // Check the round trip before writing anything.
+    loadRigText(yaml, output.empty() ? "<stdout>" : output);
+    if (!quiet)
+      for (const auto& n : imp.notes) std::cerr << fmt::format("{}: warning: {}\n", ref.file, n);
+    if (output.empty() || output == "-") {
+      std::cout << yaml;
+    } else {
+      writeFilesAtomically({PendingFile{output, yaml}});
+    }
+    return 0;
+  }
+};
+
+}  // namespace
+
+void registerRig(CLI::App& app, CliState& state) {
+  CLI::App* rig = app.add_subcommand("rig", "Rig utilities");
+  rig->require_subcommand(1);
+  auto cmd = std::make_shared<RigImportCommand>();
+  CLI::App* imp = rig->add_subcommand("import", "Derive the rig of a glTF mesh primitive and write it as YAML");
+  imp->add_option("model", cmd->model, "glTF model (.gltf or .glb), optionally MODEL#MESH/PRIMITIVE")->required();
+  imp->add_option("--mesh", cmd->mesh, "Mesh index (default 0)")->check(CLI::NonNegativeNumber);
+  imp->add_option("--primitive", cmd->primitive, "Primitive index within the mesh (default 0)")
+      ->check(CLI::NonNegativeNumber);
+  imp->add_option("-o,--output", cmd->output, "Output rig YAML (default: standard output)");
+  imp->add_flag("-q,--quiet", cmd->quiet, "Do not print warnings about attributes left out");
+  imp->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
+}
 
 }  // namespace sg

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "cli/commands.h"
+#include "validate/gltf_scene.h"
 #include "validate/validate.h"
 
 namespace sg {
@@ -18,6 +19,8 @@ struct ValidateCommand {
   std::string device;
   bool noLayers = false;
   Tolerance tol;
+  std::vector<double> times;  // glTF rigs: animation times
+  std::string animation;
 
   int run() {
     ValidateOptions vo;
@@ -26,12 +29,29 @@ struct ValidateCommand {
     vo.device = device;
     vo.validationLayers = !noLayers;
     vo.tolerance = tol;
-    Rig rig = loadRigFile(vo.gen.rigPath);
-    ValidationScene scene = proceduralScene(rig, mesh, seed, poses);
+    ValidationScene scene;
+    std::string what;
+    if (isGltfPath(vo.gen.rigPath)) {  // a real model: its own mesh, posed by its animation
+      GltfSceneOptions so;
+      so.times = times;
+      so.animation = animation;
+      GltfSceneInfo info;
+      scene = gltfScene(vo.gen.rigPath, so, &info);
+      std::string ts;
+      for (double t : info.times) ts += fmt::format("{}{:g}", ts.empty() ? "" : ", ", t);
+      what = fmt::format("model '{}' ({} vertices), {}, t = {}\n", scene.mesh.name, scene.mesh.vertexCount,
+                         info.animation.empty() ? std::string("no animation (rest pose)")
+                                                : fmt::format("animation '{}' [{:g}, {:g}] s", info.animation,
+                                                              info.start, info.end),
+                         ts);
+    } else {
+      scene = proceduralScene(loadRigFile(vo.gen.rigPath), mesh, seed, poses);
+      what = fmt::format("mesh '{}' ({} vertices), {} pose(s) from seed {}\n", scene.mesh.name,
+                         scene.mesh.vertexCount, scene.poses.size(), seed);
+    }
     Validator v(vo);
     ValidateReport report = v.run(scene);
-    std::cout << fmt::format("mesh '{}' ({} vertices), {} pose(s) from seed {}\n", scene.mesh.name,
-                             scene.mesh.vertexCount, scene.poses.size(), seed);
+    std::cout << what;
     std::cout << formatReport(report);
     return report.pass ? 0 : 1;
   }
@@ -47,6 +67,8 @@ void registerValidate(CLI::App& app, CliState& state) {
       ->check(CLI::IsMember({"head", "limb", "dawn"}));
   sub->add_option("--seed", cmd->seed, "Seed of the random poses");
   sub->add_option("--poses", cmd->poses, "Number of random poses")->check(CLI::Range(1, 100));
+  sub->add_option("--time", cmd->times, "glTF rig (MODEL.glb#m/p): animation time in seconds (repeatable)");
+  sub->add_option("--animation", cmd->animation, "glTF rig: animation name or index (default: the first)");
   sub->add_flag("--cross-check", cmd->crossCheck, "Also force and check every alternative derivation");
   sub->add_option("--device", cmd->device, "Vulkan device name (substring); default lavapipe");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer");

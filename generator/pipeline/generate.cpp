@@ -7,6 +7,7 @@
 #include <set>
 
 #include "emit/templates.h"
+#include "rig/gltf_import.h"
 
 namespace sg {
 
@@ -14,7 +15,7 @@ const char* shadergenVersion() { return SHADERGEN_VERSION; }
 
 LoadedInputs loadInputs(const GenerateOptions& opts) {
   LoadedInputs in;
-  in.rig = loadRigFile(opts.rigPath);
+  in.rig = loadRig(opts.rigPath);  // YAML, or a glTF model "model.glb#mesh/primitive"
   in.rules = loadRules(opts.rulesPaths);
   in.fragment = reflectFragmentFile(opts.fragmentPath);
   in.varyings = bindVaryings(in.fragment, in.rules, opts.overrides);

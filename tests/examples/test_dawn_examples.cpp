@@ -141,3 +141,26 @@ INSTANTIATE_TEST_SUITE_P(Examples, DawnValidation,
 
 }  // namespace
 }  // namespace sg
+
+namespace sg {
+namespace {
+
+TEST(RulesLibrary, StoredBinormalGivesTheHandednessAndValidates) {
+  const std::string data = std::string(SG_SOURCE_DIR) + "/tests/examples/data/";
+  ValidateOptions vo;
+  vo.gen.rigPath = data + "binormal.rig.yaml";
+  vo.gen.fragmentPath = data + "frame_color.frag";
+  vo.gen.rulesPaths = {std::string(SG_SOURCE_DIR) + "/rules/standard.yaml"};
+  vo.gen.templateDir = std::string(SG_SOURCE_DIR) + "/templates";
+  vo.crossCheck = true;
+  GenerateResult r = generate(vo.gen);
+  auto rules = planRules(r);
+  EXPECT_TRUE(has(rules, "world_handedness_from_binormal"));
+  EXPECT_TRUE(has(rules, "clip_from_view_projection"));
+  Validator v(vo);
+  ValidateReport report = v.run(proceduralScene(r.in.rig, "limb", 3, 2));
+  EXPECT_TRUE(report.pass) << formatReport(report);
+}
+
+}  // namespace
+}  // namespace sg

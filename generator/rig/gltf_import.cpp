@@ -1,0 +1,844 @@
+// glTF 2.0 → rig (docs/gltf.md). The only translation unit that sees tinygltf.
+#define TINYGLTF_IMPLEMENTATION
+#define TINYGLTF_NO_STB_IMAGE
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#define TINYGLTF_NO_EXTERNAL_IMAGE
+#include <tiny_gltf.h>
+
+#include "rig/gltf_import.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <set>
+
+namespace sg {
+namespace {
+
+std::string lower(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+[[noreturn]] void fail(const std::string& file, const std::string& msg) { throw InputError(SourceLoc{file, 0, 0}, msg); }
+
+// Textures are not needed (and the test models ship without them): accept every image as is.
+bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+  return true;
+}
+
+const char* componentTypeName(int ct) {
+  switch (ct) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: return "byte";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return "unsigned byte";
+    case TINYGLTF_COMPONENT_TYPE_SHORT: return "short";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return "unsigned short";
+    case TINYGLTF_COMPONENT_TYPE_INT: return "int";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return "unsigned int";
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return "float";
+    case TINYGLTF_COMPONENT_TYPE_DOUBLE: return "double";
+  }
+  return "unknown";
+}
+
+const char* typeName(int t) {
+  switch (t) {
+    case TINYGLTF_TYPE_SCALAR: return "SCALAR";
+    case TINYGLTF_TYPE_VEC2: return "VEC2";
+    case TINYGLTF_TYPE_VEC3: return "VEC3";
+    case TINYGLTF_TYPE_VEC4: return "VEC4";
+    case TINYGLTF_TYPE_MAT2: return "MAT2";
+    case TINYGLTF_TYPE_MAT3: return "MAT3";
+    case TINYGLTF_TYPE_MAT4: return "MAT4";
+  }
+  return "unknown";
+}
+
+// One component as the GPU reads it: integers as their value, normalized integers converted
+// with the Vulkan/glTF rules (unorm c / (2^b − 1), snorm max(c / (2^(b−1) − 1), −1)).
+float readComponent(const unsigned char* p, int ct, bool normalized) {
+  switch (ct) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+      float f;
+      std::memcpy(&f, p, 4);
+      return f;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
+      uint8_t v = *p;
+      return normalized ? static_cast<float>(v) / 255.0f : static_cast<float>(v);
+    }
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+      int8_t v;
+      std::memcpy(&v, p, 1);
+      return normalized ? std::max(static_cast<float>(v) / 127.0f, -1.0f) : static_cast<float>(v);
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? static_cast<float>(v) / 65535.0f : static_cast<float>(v);
+    }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+      int16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? std::max(static_cast<float>(v) / 32767.0f, -1.0f) : static_cast<float>(v);
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return static_cast<float>(v);
+    }
+  }
+  return 0.0f;
+}
+
+uint32_t readIndex(const unsigned char* p, int ct) {
+  switch (ct) {
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return *p;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return v;
+    }
+    default: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+  }
+}
+
+struct AccessorData {
+  int components = 0;
+  size_t count = 0;
+  int componentType = 0;
+  int type = 0;
+  bool normalized = false;
+  bool sparse = false;
+  std::vector<float> values;  // count * components
+};
+
+class Reader {
+ public:
+  Reader(const tinygltf::Model& m, std::string file) : m_(m), file_(std::move(file)) {}
+
+  // Pointer to `bytes` bytes at `offset` of buffer view `bv`, bounds-checked.
+  const unsigned char* at(int bv, size_t offset, size_t bytes, const std::string& what) const {
+    if (bv < 0 || static_cast<size_t>(bv) >= m_.bufferViews.size())
+      fail(file_, fmt::format("{} refers to buffer view {}, which does not exist", what, bv));
+    const auto& view = m_.bufferViews[static_cast<size_t>(bv)];
+    if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= m_.buffers.size())
+      fail(file_, fmt::format("{}: buffer view {} refers to a missing buffer", what, bv));
+    const auto& buf = m_.buffers[static_cast<size_t>(view.buffer)].data;
+    if (offset + bytes > view.byteLength || view.byteOffset + view.byteLength > buf.size())
+      fail(file_, fmt::format("{} reads past the end of buffer view {} (or its buffer is missing or short)", what, bv));
+    return buf.data() + view.byteOffset + offset;
+  }
+
+  AccessorData read(int index, const std::string& what) const {
+    if (index < 0 || static_cast<size_t>(index) >= m_.accessors.size())
+      fail(file_, fmt::format("{} refers to accessor {}, which does not exist", what, index));
+    const tinygltf::Accessor& a = m_.accessors[static_cast<size_t>(index)];
+    AccessorData d;
+    d.components = tinygltf::GetNumComponentsInType(static_cast<uint32_t>(a.type));
+    int csize = tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(a.componentType));
+    if (d.components <= 0 || csize <= 0 || a.componentType == TINYGLTF_COMPONENT_TYPE_DOUBLE)
+      fail(file_, fmt::format("{}: accessor {} has an invalid type or component type", what, index));
+    if ((a.type == TINYGLTF_TYPE_MAT2 || a.type == TINYGLTF_TYPE_MAT3) && csize < 4)
+      fail(file_, fmt::format("{}: accessor {} is a padded 8/16-bit matrix, which is not supported", what, index));
+    d.count = a.count;
+    d.componentType = a.componentType;
+    d.type = a.type;
+    d.normalized = a.normalized;
+    d.values.assign(d.count * static_cast<size_t>(d.components), 0.0f);
+    size_t elem = static_cast<size_t>(csize) * static_cast<size_t>(d.components);
+    std::string accName = fmt::format("{} (accessor {})", what, index);
+    if (a.bufferView >= 0) {
+      at(a.bufferView, 0, 0, accName);  // validates the view index
+      const auto& view = m_.bufferViews[static_cast<size_t>(a.bufferView)];
+      size_t stride = view.byteStride ? view.byteStride : elem;
+      if (d.count > 0) {
+        const unsigned char* base = at(a.bufferView, a.byteOffset, (d.count - 1) * stride + elem, accName);
+        for (size_t i = 0; i < d.count; ++i)
+          for (int c = 0; c < d.components; ++c)
+            d.values[i * static_cast<size_t>(d.components) + static_cast<size_t>(c)] =
+                readComponent(base + i * stride + static_cast<size_t>(c * csize), a.componentType, a.normalized);
+      }
+    }
+    if (a.sparse.isSparse) {
+      d.sparse = true;
+      size_t n = static_cast<size_t>(a.sparse.count);
+      int ict = a.sparse.indices.componentType;
+      int isize = tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(ict));
+      if (ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+          ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+        fail(file_, fmt::format("{}: sparse indices must be unsigned byte, short or int", accName));
+      if (n > 0) {
+        const unsigned char* idx = at(a.sparse.indices.bufferView, static_cast<size_t>(a.sparse.indices.byteOffset),
+                                      n * static_cast<size_t>(isize), accName + " sparse indices");
+        const unsigned char* val = at(a.sparse.values.bufferView, static_cast<size_t>(a.sparse.values.byteOffset),
+                                      n * elem, accName + " sparse values");
+        for (size_t k = 0; k < n; ++k) {
+          uint32_t i = readIndex(idx + k * static_cast<size_t>(isize), ict);
+          if (i >= d.count)
+            fail(file_, fmt::format("{}: sparse index {} is out of range (count {})", accName, i, d.count));
+          for (int c = 0; c < d.components; ++c)
+            d.values[i * static_cast<size_t>(d.components) + static_cast<size_t>(c)] =
+                readComponent(val + k * elem + static_cast<size_t>(c * csize), a.componentType, a.normalized);
+        }
+      }
+    }
+    for (float v : d.values)
+      if (!std::isfinite(v)) fail(file_, fmt::format("{} holds a non-finite value", accName));
+    return d;
+  }
+
+ private:
+  const tinygltf::Model& m_;
+  std::string file_;
+};
+
+std::string kibText(int bones) {
+  int bytes = bones * 64;
+  if (bytes % 1024 == 0) return fmt::format("{} KiB", bytes / 1024);
+  return fmt::format("{} bytes", bytes);
+}
+
+RigAttribute makeAttribute(const std::string& name, VertexFormat f, std::vector<ProvidedPart> provides,
+                           const std::string& file, bool perTarget = false) {
+  RigAttribute a;
+  a.name = name;
+  a.format = f;
+  int n = formatComponents(f);
+  a.shaderType = *vectorType(formatIsInteger(f) ? ScalarKind::UInt : ScalarKind::Float, n);
+  a.perMorphTarget = perTarget;
+  a.provides = std::move(provides);
+  a.loc = SourceLoc{file, 0, 0};
+  return a;
+}
+
+RigUniform makeUniform(const std::string& name, const std::string& semantic, Type t, const std::string& array,
+                       int size, const std::string& file) {
+  RigUniform u;
+  u.name = name;
+  u.semantic = semantic;
+  u.type = t;
+  u.arraySizeParam = array;
+  u.arraySize = size;
+  u.loc = SourceLoc{file, 0, 0};
+  return u;
+}
+
+// Stores accessor data (n components each) as a per-vertex stream, components [from, from+n).
+std::vector<std::array<float, 4>> toStream(const AccessorData& d, int from, int n) {
+  std::vector<std::array<float, 4>> s(d.count, std::array<float, 4>{0, 0, 0, 0});
+  for (size_t i = 0; i < d.count; ++i)
+    for (int c = 0; c < n; ++c)
+      s[i][static_cast<size_t>(c)] = d.values[i * static_cast<size_t>(d.components) + static_cast<size_t>(from + c)];
+  return s;
+}
+
+// Parses "N/P" after '#'.
+bool parseSelection(const std::string& s, int& mesh, int& prim) {
+  auto slash = s.find('/');
+  if (slash == std::string::npos || slash == 0 || slash + 1 == s.size()) return false;
+  auto num = [](const std::string& t, int& out) {
+    if (t.empty() || t.size() > 6) return false;
+    for (char c : t)
+      if (!std::isdigit(static_cast<unsigned char>(c))) return false;
+    out = std::stoi(t);
+    return true;
+  };
+  return num(s.substr(0, slash), mesh) && num(s.substr(slash + 1), prim);
+}
+
+GltfImport importModel(const tinygltf::Model& model, const std::string& file, const GltfImportOptions& opts) {
+  GltfImport imp;
+  GltfModelData& data = imp.data;
+  data.file = file;
+  data.stem = std::filesystem::path(file).stem().string();
+  Reader reader(model, file);
+
+  if (opts.mesh < 0 || static_cast<size_t>(opts.mesh) >= model.meshes.size())
+    fail(file, fmt::format("the model has {} mesh(es); there is no mesh {}", model.meshes.size(), opts.mesh));
+  const tinygltf::Mesh& mesh = model.meshes[static_cast<size_t>(opts.mesh)];
+  data.mesh = opts.mesh;
+  data.meshName = mesh.name.empty() ? std::to_string(opts.mesh) : mesh.name;
+  const std::string meshDesc = fmt::format("mesh '{}'", data.meshName);
+  if (opts.primitive < 0 || static_cast<size_t>(opts.primitive) >= mesh.primitives.size())
+    fail(file, fmt::format("{} has {} primitive(s); there is no primitive {}", meshDesc, mesh.primitives.size(),
+                           opts.primitive));
+  const tinygltf::Primitive& prim = mesh.primitives[static_cast<size_t>(opts.primitive)];
+  data.primitive = opts.primitive;
+  data.mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+  const std::string where = fmt::format("{} primitive {}", meshDesc, opts.primitive);
+
+  // --- nodes, scene, skins, animations (plain data) ---
+  for (const auto& n : model.nodes) {
+    GltfNode g;
+    g.name = n.name;
+    g.children = n.children;
+    g.mesh = n.mesh;
+    g.skin = n.skin;
+    if (n.matrix.size() == 16) {
+      g.hasMatrix = true;
+      std::copy(n.matrix.begin(), n.matrix.end(), g.matrix.begin());
+    }
+    if (n.translation.size() == 3) std::copy(n.translation.begin(), n.translation.end(), g.translation.begin());
+    if (n.rotation.size() == 4) std::copy(n.rotation.begin(), n.rotation.end(), g.rotation.begin());
+    if (n.scale.size() == 3) std::copy(n.scale.begin(), n.scale.end(), g.scale.begin());
+    g.weights = n.weights;
+    for (int c : g.children)
+      if (c < 0 || static_cast<size_t>(c) >= model.nodes.size())
+        fail(file, fmt::format("node '{}' has a child {} that does not exist", n.name, c));
+    data.nodes.push_back(std::move(g));
+  }
+  {
+    // Parents (and a cycle check: glTF node graphs are forests).
+    std::vector<int> parent(model.nodes.size(), -1);
+    for (size_t i = 0; i < model.nodes.size(); ++i)
+      for (int c : model.nodes[i].children) {
+        if (parent[static_cast<size_t>(c)] >= 0)
+          fail(file, fmt::format("node {} has two parents; glTF node hierarchies are trees", c));
+        parent[static_cast<size_t>(c)] = static_cast<int>(i);
+      }
+    for (size_t i = 0; i < parent.size(); ++i) {
+      size_t steps = 0;
+      for (int p = parent[i]; p >= 0; p = parent[static_cast<size_t>(p)])
+        if (++steps > parent.size()) fail(file, fmt::format("node {} is part of a cycle in the node hierarchy", i));
+    }
+    int sceneIndex = model.defaultScene >= 0 ? model.defaultScene : (model.scenes.empty() ? -1 : 0);
+    if (sceneIndex >= 0 && static_cast<size_t>(sceneIndex) < model.scenes.size()) {
+      data.sceneRoots = model.scenes[static_cast<size_t>(sceneIndex)].nodes;
+    } else {
+      for (size_t i = 0; i < parent.size(); ++i)
+        if (parent[i] < 0) data.sceneRoots.push_back(static_cast<int>(i));
+    }
+    for (int r : data.sceneRoots)
+      if (r < 0 || static_cast<size_t>(r) >= model.nodes.size())
+        fail(file, fmt::format("the scene refers to node {}, which does not exist", r));
+    // The node that instantiates the mesh: first in the scene (depth first), else any.
+    std::function<int(int)> find = [&](int n) -> int {
+      if (data.nodes[static_cast<size_t>(n)].mesh == opts.mesh) return n;
+      for (int c : data.nodes[static_cast<size_t>(n)].children)
+        if (int f = find(c); f >= 0) return f;
+      return -1;
+    };
+    for (int r : data.sceneRoots)
+      if (data.meshNode < 0) data.meshNode = find(r);
+    if (data.meshNode < 0)
+      for (size_t i = 0; i < data.nodes.size(); ++i)
+        if (data.nodes[i].mesh == opts.mesh) {
+          data.meshNode = static_cast<int>(i);
+          break;
+        }
+    if (data.meshNode < 0) imp.notes.push_back(fmt::format("no node instantiates {}; it is posed at the origin", meshDesc));
+  }
+  for (size_t si = 0; si < model.skins.size(); ++si) {
+    const auto& s = model.skins[si];
+    GltfSkin g;
+    g.name = s.name;
+    g.joints = s.joints;
+    for (int j : g.joints)
+      if (j < 0 || static_cast<size_t>(j) >= model.nodes.size())
+        fail(file, fmt::format("skin {} has joint node {}, which does not exist", si, j));
+    if (s.inverseBindMatrices >= 0) {
+      AccessorData ibm = reader.read(s.inverseBindMatrices, fmt::format("skin {} inverseBindMatrices", si));
+      if (ibm.type != TINYGLTF_TYPE_MAT4 || ibm.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT ||
+          ibm.count < g.joints.size())
+        fail(file, fmt::format("skin {}: inverseBindMatrices must be {} float MAT4", si, g.joints.size()));
+      for (size_t j = 0; j < g.joints.size(); ++j) {
+        std::array<float, 16> m{};
+        std::copy(ibm.values.begin() + static_cast<long>(j * 16), ibm.values.begin() + static_cast<long>(j * 16 + 16),
+                  m.begin());
+        g.inverseBind.push_back(m);
+      }
+    } else {
+      std::array<float, 16> id{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+      g.inverseBind.assign(g.joints.size(), id);
+    }
+    data.skins.push_back(std::move(g));
+  }
+  for (size_t ai = 0; ai < model.animations.size(); ++ai) {
+    const auto& a = model.animations[ai];
+    GltfAnimation g;
+    g.name = a.name.empty() ? std::to_string(ai) : a.name;
+    bool first = true;
+    for (size_t ci = 0; ci < a.channels.size(); ++ci) {
+      const auto& c = a.channels[ci];
+      std::string what = fmt::format("animation '{}' channel {}", g.name, ci);
+      if (c.target_node < 0) continue;  // e.g. KHR_animation_pointer targets: not posed here
+      if (static_cast<size_t>(c.target_node) >= model.nodes.size())
+        fail(file, fmt::format("{} targets node {}, which does not exist", what, c.target_node));
+      GltfChannel ch;
+      ch.node = c.target_node;
+      if (c.target_path == "translation") ch.path = GltfPath::Translation;
+      else if (c.target_path == "rotation") ch.path = GltfPath::Rotation;
+      else if (c.target_path == "scale") ch.path = GltfPath::Scale;
+      else if (c.target_path == "weights") ch.path = GltfPath::Weights;
+      else continue;
+      if (c.sampler < 0 || static_cast<size_t>(c.sampler) >= a.samplers.size())
+        fail(file, fmt::format("{} uses sampler {}, which does not exist", what, c.sampler));
+      const auto& smp = a.samplers[static_cast<size_t>(c.sampler)];
+      if (smp.interpolation == "STEP") ch.interpolation = GltfInterpolation::Step;
+      else if (smp.interpolation == "CUBICSPLINE") ch.interpolation = GltfInterpolation::CubicSpline;
+      else if (smp.interpolation.empty() || smp.interpolation == "LINEAR") ch.interpolation = GltfInterpolation::Linear;
+      else fail(file, fmt::format("{}: unknown interpolation '{}'", what, smp.interpolation));
+      AccessorData in = reader.read(smp.input, what + " input");
+      AccessorData out = reader.read(smp.output, what + " output");
+      if (in.components != 1 || in.count == 0) fail(file, fmt::format("{}: the input must be non-empty SCALAR times", what));
+      ch.times = in.values;
+      for (size_t k = 1; k < ch.times.size(); ++k)
+        if (!(ch.times[k] > ch.times[k - 1])) fail(file, fmt::format("{}: keyframe times must increase", what));
+      size_t perKey = ch.interpolation == GltfInterpolation::CubicSpline ? 3 : 1;
+      size_t total = out.values.size();
+      if (ch.path == GltfPath::Weights) {
+        if (total % (ch.times.size() * perKey) != 0)
+          fail(file, fmt::format("{}: {} output values do not divide into {} keyframes", what, total, ch.times.size()));
+        ch.components = static_cast<int>(total / (ch.times.size() * perKey));
+      } else {
+        ch.components = ch.path == GltfPath::Rotation ? 4 : 3;
+        if (out.components != ch.components || out.count != ch.times.size() * perKey)
+          fail(file, fmt::format("{}: expected {} {} output elements, found {} {}", what, ch.times.size() * perKey,
+                                 ch.components == 4 ? "VEC4" : "VEC3", out.count, typeName(out.type)));
+      }
+      ch.values = std::move(out.values);
+      g.start = first ? ch.times.front() : std::min(g.start, ch.times.front());
+      g.end = first ? ch.times.back() : std::max(g.end, ch.times.back());
+      first = false;
+      g.channels.push_back(std::move(ch));
+    }
+    data.animations.push_back(std::move(g));
+  }
+
+  // --- the primitive's attributes ---
+  auto accessorOf = [&](const std::string& name) -> const tinygltf::Accessor* {
+    auto it = prim.attributes.find(name);
+    if (it == prim.attributes.end()) return nullptr;
+    if (it->second < 0 || static_cast<size_t>(it->second) >= model.accessors.size())
+      fail(file, fmt::format("{}: attribute {} refers to accessor {}, which does not exist", where, name, it->second));
+    return &model.accessors[static_cast<size_t>(it->second)];
+  };
+  const tinygltf::Accessor* posAcc = accessorOf("POSITION");
+  if (!posAcc) fail(file, fmt::format("{} has no POSITION attribute", where));
+  data.vertexCount = posAcc->count;
+
+  Rig& rig = imp.rig;
+  rig.file = file;
+  rig.name = fmt::format("{}/{}/{}", data.stem, data.meshName, opts.primitive);
+  rig.params = {{"bones", 0}, {"influences", 0}, {"morph_targets", 0}};
+
+  auto info = [&](const std::string& name, const tinygltf::Accessor& a) {
+    GltfAttributeInfo i;
+    i.gltfName = name;
+    i.componentType = componentTypeName(a.componentType);
+    i.type = typeName(a.type);
+    i.normalized = a.normalized;
+    i.sparse = a.sparse.isSparse;
+    i.count = a.count;
+    return i;
+  };
+  auto formatText = [](const GltfAttributeInfo& i) {
+    return fmt::format("{}{} {}", i.normalized ? "normalized " : "", i.componentType, i.type);
+  };
+  std::map<std::string, size_t> infoIndex;
+  for (const auto& [name, idx] : prim.attributes) {
+    const tinygltf::Accessor* a = accessorOf(name);
+    infoIndex[name] = imp.attributes.size();
+    imp.attributes.push_back(info(name, *a));
+    if (a->count != data.vertexCount)
+      fail(file, fmt::format("{}: attribute {} has {} elements but POSITION has {}", where, name, a->count,
+                             data.vertexCount));
+  }
+  auto readAttr = [&](const std::string& name) {
+    return reader.read(prim.attributes.at(name), fmt::format("{} attribute {}", where, name));
+  };
+  auto isFloat = [](const tinygltf::Accessor* a, int type) {
+    return a->componentType == TINYGLTF_COMPONENT_TYPE_FLOAT && a->type == type;
+  };
+  auto carried = [&](const std::string& name, const std::string& rigName, VertexFormat f) {
+    auto& i = imp.attributes[infoIndex.at(name)];
+    i.rigAttribute = rigName;
+    i.format = formatName(f);
+    if (i.sparse)
+      imp.notes.push_back(fmt::format("{} is a sparse accessor: the application must expand it to a dense {} stream",
+                                      name, formatName(f)));
+  };
+  auto skip = [&](const std::string& name, const std::string& why) {
+    imp.notes.push_back(fmt::format("{} ({}) is not carried by the rig: {}", name,
+                                    formatText(imp.attributes[infoIndex.at(name)]), why));
+  };
+
+  // POSITION
+  if (!isFloat(posAcc, TINYGLTF_TYPE_VEC3))
+    fail(file, fmt::format("{}: POSITION is {}; only float VEC3 positions are supported (KHR_mesh_quantization is not)",
+                           where, formatText(imp.attributes[infoIndex.at("POSITION")])));
+  rig.attributes.push_back(makeAttribute("position", VertexFormat::Float32x3, {{"vertex.position", ""}}, file));
+  carried("POSITION", "position", VertexFormat::Float32x3);
+  data.streams["vertex.position"] = toStream(readAttr("POSITION"), 0, 3);
+
+  bool hasNormal = false, hasTangent = false;
+  if (const auto* a = accessorOf("NORMAL")) {
+    if (isFloat(a, TINYGLTF_TYPE_VEC3)) {
+      hasNormal = true;
+      rig.attributes.push_back(makeAttribute("normal", VertexFormat::Float32x3, {{"vertex.normal", ""}}, file));
+      carried("NORMAL", "normal", VertexFormat::Float32x3);
+      data.streams["vertex.normal"] = toStream(readAttr("NORMAL"), 0, 3);
+    } else {
+      skip("NORMAL", "only float VEC3 normals are supported");
+    }
+  }
+  if (const auto* a = accessorOf("TANGENT")) {
+    if (isFloat(a, TINYGLTF_TYPE_VEC4)) {
+      hasTangent = true;
+      rig.attributes.push_back(makeAttribute("tangent", VertexFormat::Float32x4,
+                                             {{"vertex.tangent", "xyz"}, {"vertex.handedness", "w"}}, file));
+      carried("TANGENT", "tangent", VertexFormat::Float32x4);
+      AccessorData d = readAttr("TANGENT");
+      data.streams["vertex.tangent"] = toStream(d, 0, 3);
+      data.streams["vertex.handedness"] = toStream(d, 3, 1);
+    } else {
+      skip("TANGENT", "only float VEC4 tangents are supported");
+    }
+  }
+  for (int t = 0; t < 2; ++t) {
+    std::string name = fmt::format("TEXCOORD_{}", t);
+    if (const auto* a = accessorOf(name)) {
+      if (isFloat(a, TINYGLTF_TYPE_VEC2)) {
+        std::string rn = fmt::format("texcoord{}", t);
+        rig.attributes.push_back(
+            makeAttribute(rn, VertexFormat::Float32x2, {{fmt::format("vertex.texcoord{}", t), ""}}, file));
+        carried(name, rn, VertexFormat::Float32x2);
+        data.streams[fmt::format("vertex.texcoord{}", t)] = toStream(readAttr(name), 0, 2);
+      } else {
+        skip(name, "the rig formats have no normalized 2-component format (expand to float32x2)");
+      }
+    }
+  }
+  if (const auto* a = accessorOf("COLOR_0")) {
+    std::optional<VertexFormat> f;
+    if (a->type == TINYGLTF_TYPE_VEC4) {
+      if (a->componentType == TINYGLTF_COMPONENT_TYPE_FLOAT) f = VertexFormat::Float32x4;
+      else if (a->componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && a->normalized) f = VertexFormat::Unorm8x4;
+      else if (a->componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT && a->normalized) f = VertexFormat::Unorm16x4;
+    }
+    if (f) {
+      rig.attributes.push_back(makeAttribute("color0", *f, {{"vertex.color0", ""}}, file));
+      carried("COLOR_0", "color0", *f);
+      data.streams["vertex.color0"] = toStream(readAttr("COLOR_0"), 0, 4);
+    } else {
+      skip("COLOR_0", "vertex.color0 is a vec4 (RGB colours must be widened to RGBA by the application)");
+    }
+  }
+
+  // Skinning: JOINTS_n / WEIGHTS_n sets.
+  int sets = 0;
+  for (const auto& [name, idx] : prim.attributes) {
+    for (const char* prefix : {"JOINTS_", "WEIGHTS_"}) {
+      if (name.rfind(prefix, 0) != 0) continue;
+      int s = std::atoi(name.c_str() + std::strlen(prefix));
+      if (s >= kMaxInfluenceSets) {
+        int infl = 0;
+        while (prim.attributes.count(fmt::format("JOINTS_{}", infl / 4))) infl += 4;
+        fail(file, fmt::format("{} has {} ({} influences per vertex); the rules serve at most {} "
+                               "(JOINTS_0..JOINTS_{})",
+                               where, name, std::max(infl, 4 * (s + 1)), 4 * kMaxInfluenceSets,
+                               kMaxInfluenceSets - 1));
+      }
+    }
+  }
+  while (sets < kMaxInfluenceSets && prim.attributes.count(fmt::format("JOINTS_{}", sets))) ++sets;
+  for (int s = 0; s < kMaxInfluenceSets; ++s) {
+    bool j = prim.attributes.count(fmt::format("JOINTS_{}", s)) != 0;
+    bool w = prim.attributes.count(fmt::format("WEIGHTS_{}", s)) != 0;
+    if (j != w)
+      fail(file, fmt::format("{} has {}_{} without {}_{}", where, j ? "JOINTS" : "WEIGHTS", s, j ? "WEIGHTS" : "JOINTS", s));
+    if (j && s >= sets) fail(file, fmt::format("{} has JOINTS_{} without JOINTS_{}", where, s, s - 1));
+  }
+  int skinIndex = data.meshNode >= 0 ? data.nodes[static_cast<size_t>(data.meshNode)].skin : -1;
+  if (skinIndex >= static_cast<int>(data.skins.size()))
+    fail(file, fmt::format("the node of {} uses skin {}, which does not exist", meshDesc, skinIndex));
+  if (sets > 0 && skinIndex < 0) {
+    imp.notes.push_back(fmt::format("{} has JOINTS_0/WEIGHTS_0 but no node gives it a skin: imported unskinned", where));
+    sets = 0;
+  }
+  if (sets == 0 && skinIndex >= 0) {
+    imp.notes.push_back(fmt::format("{} is instantiated with a skin but has no JOINTS_0/WEIGHTS_0: imported unskinned", where));
+    skinIndex = -1;
+  }
+  if (sets > 0) {
+    const GltfSkin& skin = data.skins[static_cast<size_t>(skinIndex)];
+    int joints = static_cast<int>(skin.joints.size());
+    if (joints == 0) fail(file, fmt::format("the skin of {} has no joints", meshDesc));
+    if (joints > opts.maxBones)
+      fail(file, fmt::format("{}: {} uses {} joints; the bone palette holds at most {} ({} uniform block)",
+                             std::filesystem::path(file).filename().string(), meshDesc, joints, opts.maxBones,
+                             kibText(opts.maxBones)));
+    data.skin = skinIndex;
+    imp.joints = joints;
+    imp.influences = 4 * sets;
+    rig.params["bones"] = joints;
+    rig.params["influences"] = imp.influences;
+    for (int s = 0; s < sets; ++s) {
+      std::string jn = fmt::format("JOINTS_{}", s), wn = fmt::format("WEIGHTS_{}", s);
+      const auto* ja = accessorOf(jn);
+      const auto* wa = accessorOf(wn);
+      VertexFormat jf{}, wf{};
+      if (ja->type == TINYGLTF_TYPE_VEC4 && !ja->normalized && ja->componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE)
+        jf = VertexFormat::Uint8x4;
+      else if (ja->type == TINYGLTF_TYPE_VEC4 && !ja->normalized &&
+               ja->componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT)
+        jf = VertexFormat::Uint16x4;
+      else
+        fail(file, fmt::format("{}: {} is {}; glTF joints are unsigned byte or unsigned short VEC4", where, jn,
+                               formatText(imp.attributes[infoIndex.at(jn)])));
+      if (wa->type == TINYGLTF_TYPE_VEC4 && wa->componentType == TINYGLTF_COMPONENT_TYPE_FLOAT)
+        wf = VertexFormat::Float32x4;
+      else if (wa->type == TINYGLTF_TYPE_VEC4 && wa->normalized && wa->componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE)
+        wf = VertexFormat::Unorm8x4;
+      else if (wa->type == TINYGLTF_TYPE_VEC4 && wa->normalized &&
+               wa->componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT)
+        wf = VertexFormat::Unorm16x4;
+      else
+        fail(file, fmt::format("{}: {} is {}; glTF weights are float or normalized unsigned byte/short VEC4", where,
+                               wn, formatText(imp.attributes[infoIndex.at(wn)])));
+      std::string jr = fmt::format("joints{}", s), wr = fmt::format("weights{}", s);
+      rig.attributes.push_back(makeAttribute(jr, jf, {{fmt::format("skin.joints[{}]", s), ""}}, file));
+      rig.attributes.push_back(makeAttribute(wr, wf, {{fmt::format("skin.weights[{}]", s), ""}}, file));
+      carried(jn, jr, jf);
+      carried(wn, wr, wf);
+      AccessorData jd = readAttr(jn);
+      for (size_t v = 0; v < jd.count; ++v)
+        for (int c = 0; c < 4; ++c) {
+          float j = jd.values[v * 4 + static_cast<size_t>(c)];
+          if (j >= static_cast<float>(joints))
+            fail(file, fmt::format("{}: {} of vertex {} is joint {}, but the skin has {} joints", where, jn, v,
+                                   static_cast<long>(j), joints));
+        }
+      data.streams[fmt::format("skin.joints[{}]", s)] = toStream(jd, 0, 4);
+      data.streams[fmt::format("skin.weights[{}]", s)] = toStream(readAttr(wn), 0, 4);
+    }
+  }
+
+  // Every other attribute is reported as left out.
+  for (const auto& [name, idx] : prim.attributes) {
+    const auto& i = imp.attributes[infoIndex.at(name)];
+    if (!i.rigAttribute.empty()) continue;
+    if (name == "NORMAL" || name == "TANGENT" || name == "TEXCOORD_0" || name == "TEXCOORD_1" || name == "COLOR_0")
+      continue;  // already reported
+    if (name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0) continue;  // unskinned (reported)
+    skip(name, "the vocabulary has no semantic for it");
+  }
+
+  // Morph targets.
+  int targets = static_cast<int>(prim.targets.size());
+  imp.morphTargets = targets;
+  std::set<std::string> moved;
+  for (int t = 0; t < targets; ++t) {
+    std::vector<std::string> names;
+    for (const auto& [name, idx] : prim.targets[static_cast<size_t>(t)]) names.push_back(name);
+    imp.targetAttributes.push_back(names);
+    for (const auto& n : names) moved.insert(n);
+  }
+  struct MorphKind {
+    const char* gltf;
+    const char* rigName;  // "position" in rig.morphedAttributes
+    const char* semantic;
+    bool baseCarried;
+  };
+  std::vector<std::string> morphed;
+  for (const MorphKind& k : {MorphKind{"POSITION", "position", "morph.position", true},
+                             MorphKind{"NORMAL", "normal", "morph.normal", hasNormal},
+                             MorphKind{"TANGENT", "tangent", "morph.tangent", hasTangent}}) {
+    if (!moved.count(k.gltf)) continue;
+    if (!k.baseCarried) {
+      imp.notes.push_back(fmt::format("morph target {} deltas are left out: the rig does not carry {}", k.gltf, k.gltf));
+      continue;
+    }
+    morphed.push_back(k.rigName);
+    for (int t = 0; t < targets; ++t) {
+      const auto& tm = prim.targets[static_cast<size_t>(t)];
+      std::string key = fmt::format("{}[{}]", k.semantic, t);
+      auto it = tm.find(k.gltf);
+      if (it == tm.end()) {
+        data.streams[key].assign(data.vertexCount, std::array<float, 4>{0, 0, 0, 0});
+        continue;
+      }
+      std::string what = fmt::format("{} morph target {} {}", where, t, k.gltf);
+      if (it->second < 0 || static_cast<size_t>(it->second) >= model.accessors.size())
+        fail(file, fmt::format("{} refers to accessor {}, which does not exist", what, it->second));
+      const auto& a = model.accessors[static_cast<size_t>(it->second)];
+      if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || a.type != TINYGLTF_TYPE_VEC3)
+        fail(file, fmt::format("{} is {}{} {}; only float VEC3 deltas are supported", what,
+                               a.normalized ? "normalized " : "", componentTypeName(a.componentType), typeName(a.type)));
+      if (a.count != data.vertexCount)
+        fail(file, fmt::format("{} has {} elements but POSITION has {}", what, a.count, data.vertexCount));
+      AccessorData d = reader.read(it->second, what);
+      if (d.sparse)
+        imp.notes.push_back(fmt::format("morph target {} {} is a sparse accessor: the application must expand it to "
+                                        "a dense float32x3 stream",
+                                        t, k.gltf));
+      data.streams[key] = toStream(d, 0, 3);
+    }
+    rig.attributes.push_back(makeAttribute(fmt::format("{}_morph", k.rigName), VertexFormat::Float32x3,
+                                           {{k.semantic, ""}}, file, true));
+  }
+  for (const auto& n : moved)
+    if (n != "POSITION" && n != "NORMAL" && n != "TANGENT")
+      imp.notes.push_back(fmt::format("morph target {} deltas are left out: the vocabulary morphs position, normal "
+                                      "and tangent only",
+                                      n));
+  int rigTargets = morphed.empty() ? 0 : targets;
+  if (targets > 0 && rigTargets == 0)
+    imp.notes.push_back(fmt::format("{} has {} morph target(s) but none moves an attribute the rig carries: imported "
+                                    "without morphing",
+                                    where, targets));
+  rig.params["morph_targets"] = rigTargets;
+  rig.morphedAttributes = morphed;
+  data.meshWeights.assign(static_cast<size_t>(targets), 0.0);
+  for (size_t i = 0; i < mesh.weights.size() && i < data.meshWeights.size(); ++i) data.meshWeights[i] = mesh.weights[i];
+
+  // Uniforms.
+  if (sets > 0) rig.uniforms.push_back(makeUniform("bones", "skin.bones", Type::Mat4, "bones", imp.joints, file));
+  if (rigTargets > 0)
+    rig.uniforms.push_back(makeUniform("morph_weights", "morph.weights", Type::Float, "morph_targets", rigTargets, file));
+  rig.uniforms.push_back(makeUniform("camera_position", "camera.position", Type::Vec3, "", 0, file));
+  rig.uniforms.push_back(makeUniform("view", "camera.view", Type::Mat4, "", 0, file));
+  rig.uniforms.push_back(makeUniform("projection", "camera.projection", Type::Mat4, "", 0, file));
+  if (sets == 0) rig.uniforms.push_back(makeUniform("model", "model.matrix", Type::Mat4, "", 0, file));
+  checkRig(rig);
+  return imp;
+}
+
+GltfImport loadAndImport(const std::string& file, const GltfImportOptions& opts, const std::string* text,
+                         const std::string& baseDir) {
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(skipImage, nullptr);
+  tinygltf::Model model;
+  std::string err, warn;
+  bool ok;
+  if (text) {
+    ok = loader.LoadASCIIFromString(&model, &err, &warn, text->data(), static_cast<unsigned int>(text->size()), baseDir);
+  } else {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec)) fail(file, "cannot open the glTF model (no such file)");
+    if (lower(std::filesystem::path(file).extension().string()) == ".glb")
+      ok = loader.LoadBinaryFromFile(&model, &err, &warn, file);
+    else
+      ok = loader.LoadASCIIFromFile(&model, &err, &warn, file);
+  }
+  if (!ok) {
+    while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();
+    fail(file, "cannot load the glTF model: " + (err.empty() ? std::string("unknown error") : err));
+  }
+  return importModel(model, file, opts);
+}
+
+std::string yamlQuote(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    unsigned char u = static_cast<unsigned char>(c);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (u < 0x20) {
+      out += fmt::format("\\x{:02x}", u);
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+bool isGltfPath(const std::string& path) {
+  std::string p = path;
+  auto hash = p.rfind('#');
+  if (hash != std::string::npos) p = p.substr(0, hash);
+  std::string ext = lower(std::filesystem::path(p).extension().string());
+  return ext == ".gltf" || ext == ".glb";
+}
+
+GltfRef parseGltfRef(const std::string& path) {
+  GltfRef r;
+  auto hash = path.rfind('#');
+  std::string base = hash == std::string::npos ? path : path.substr(0, hash);
+  std::string ext = lower(std::filesystem::path(base).extension().string());
+  if (hash != std::string::npos && (ext == ".gltf" || ext == ".glb")) {
+    r.file = base;
+    if (!parseSelection(path.substr(hash + 1), r.mesh, r.primitive))
+      fail(base, fmt::format("'{}' does not select a primitive: expected MODEL{}#MESH/PRIMITIVE, e.g. '{}#0/0'",
+                             path.substr(hash), ext, base));
+  } else {
+    r.file = path;
+  }
+  return r;
+}
+
+GltfImport importGltf(const std::string& file, const GltfImportOptions& opts) {
+  return loadAndImport(file, opts, nullptr, "");
+}
+
+GltfImport importGltfText(const std::string& json, const std::string& fileName, const GltfImportOptions& opts,
+                          const std::string& baseDir) {
+  return loadAndImport(fileName, opts, &json, baseDir);
+}
+
+Rig loadRig(const std::string& path) {
+  if (!isGltfPath(path)) return loadRigFile(path);
+  GltfRef ref = parseGltfRef(path);
+  GltfImportOptions o;
+  o.mesh = ref.mesh;
+  o.primitive = ref.primitive;
+  return importGltf(ref.file, o).rig;
+}
+
+std::string rigToYaml(const Rig& rig, const std::vector<std::string>& header) {
+  std::string s;
+  for (std::string h : header) {
+    std::replace(h.begin(), h.end(), '\n', ' ');
+    std::replace(h.begin(), h.end(), '\r', ' ');
+    s += h.empty() ? "#\n" : "# " + h + "\n";
+  }
+  s += "rig: " + yamlQuote(rig.name) + "\n";
+  s += "deformers:\n";
+  std::vector<std::string> order{"bones", "influences", "morph_targets"};
+  for (const auto& [k, v] : rig.params)
+    if (std::find(order.begin(), order.end(), k) == order.end()) order.push_back(k);
+  for (const auto& k : order) s += fmt::format("  {}: {}\n", k, rig.param(k));
+  if (!rig.morphedAttributes.empty()) {
+    std::string list;
+    for (const auto& m : rig.morphedAttributes) list += (list.empty() ? "" : ", ") + m;
+    s += "  morphs: [" + list + "]\n";
+  }
+  s += "attributes:\n";
+  for (const auto& a : rig.attributes) {
+    std::string prov;
+    if (a.provides.size() == 1 && a.provides[0].swizzle.empty()) {
+      prov = yamlQuote(a.provides[0].semantic);
+    } else {
+      for (const auto& p : a.provides)
+        prov += (prov.empty() ? "{ " : ", ") + yamlQuote(p.semantic) + ": " +
+                (p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(formatComponents(a.format)))
+                                   : p.swizzle);
+      prov += " }";
+    }
+    s += fmt::format("  {}: {{ format: {}{}, provides: {} }}\n", a.name, formatName(a.format),
+                     a.perMorphTarget ? ", per_target: true" : "", prov);
+  }
+  if (!rig.uniforms.empty()) {
+    s += "uniforms:\n";
+    for (const auto& u : rig.uniforms)
+      s += fmt::format("  {}: {{ type: {}{}, semantic: {} }}\n", u.name, glslName(u.type),
+                       u.arraySizeParam.empty() ? "" : ", array: " + u.arraySizeParam, yamlQuote(u.semantic));
+  }
+  return s;
+}
+
+}  // namespace sg

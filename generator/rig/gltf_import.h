@@ -1,0 +1,143 @@
+// Rigs from real glTF 2.0 models (docs/gltf.md): derive the rig of one mesh primitive
+// (attributes and formats, skin size, influences, morph targets) and decode everything the
+// validator needs to pose it (vertex data with sparse accessors applied and normalized
+// formats dequantized, node hierarchy, skins, animations). The decoded model is plain data:
+// nothing here exposes tinygltf, which stays private to gltf_import.cpp.
+#pragma once
+#include <array>
+#include <cstddef>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "rig/rig.h"
+
+namespace sg {
+
+// The bone palette is one uniform array of mat4: 256 × 64 B = 16 KiB, Vulkan's guaranteed
+// maxUniformBufferRange (16384). Skins with more joints are rejected with a diagnostic.
+constexpr int kMaxBonePalette = 256;
+// Influences per vertex the rules serve: two JOINTS_n/WEIGHTS_n sets of 4.
+constexpr int kMaxInfluenceSets = 2;
+
+// "model.glb", "model.gltf", "model.glb#1/0" (mesh 1, primitive 0).
+struct GltfRef {
+  std::string file;
+  int mesh = 0;
+  int primitive = 0;
+};
+// True if the path names a glTF model (extension .gltf/.glb, case-insensitive, optionally
+// followed by "#mesh/primitive").
+bool isGltfPath(const std::string& path);
+// Splits the optional "#m/p" suffix. Throws InputError on a malformed suffix.
+GltfRef parseGltfRef(const std::string& path);
+
+struct GltfImportOptions {
+  int mesh = 0;
+  int primitive = 0;
+  int maxBones = kMaxBonePalette;  // tests lower it to exercise the diagnostic
+};
+
+// One attribute of the primitive as the file stores it, and what the rig made of it.
+struct GltfAttributeInfo {
+  std::string gltfName;       // "JOINTS_0"
+  std::string componentType;  // "float", "unsigned byte", "unsigned short", ...
+  std::string type;           // "VEC4"
+  bool normalized = false;
+  bool sparse = false;
+  size_t count = 0;
+  std::string rigAttribute;  // "" when the rig does not carry it (see GltfImport::notes)
+  std::string format;        // rig vertex format ("uint16x4"), "" when skipped
+};
+
+// A node of the hierarchy (local transform as stored).
+struct GltfNode {
+  std::string name;
+  std::vector<int> children;
+  int mesh = -1;
+  int skin = -1;
+  bool hasMatrix = false;
+  std::array<double, 16> matrix{};  // column-major, when hasMatrix
+  std::array<double, 3> translation{0, 0, 0};
+  std::array<double, 4> rotation{0, 0, 0, 1};  // quaternion x, y, z, w
+  std::array<double, 3> scale{1, 1, 1};
+  std::vector<double> weights;  // node-level default morph weights (overrides the mesh's)
+};
+
+struct GltfSkin {
+  std::string name;
+  std::vector<int> joints;                      // node indices
+  std::vector<std::array<float, 16>> inverseBind;  // one per joint (identity if absent), column-major
+};
+
+enum class GltfInterpolation { Linear, Step, CubicSpline };
+enum class GltfPath { Translation, Rotation, Scale, Weights };
+
+struct GltfChannel {
+  int node = -1;
+  GltfPath path = GltfPath::Translation;
+  GltfInterpolation interpolation = GltfInterpolation::Linear;
+  std::vector<float> times;   // keyframe inputs (seconds, increasing)
+  std::vector<float> values;  // outputs, `components` floats per element; CUBICSPLINE: 3 elements
+                              // (in-tangent, value, out-tangent) per keyframe
+  int components = 0;         // 3 (T/S), 4 (R), morph target count (weights)
+};
+
+struct GltfAnimation {
+  std::string name;
+  std::vector<GltfChannel> channels;
+  float start = 0, end = 0;  // time range over all channels
+};
+
+// Everything decoded from the file for one primitive.
+struct GltfModelData {
+  std::string file;  // as given (without "#m/p")
+  std::string stem;  // "Fox"
+  int mesh = 0, primitive = 0;
+  std::string meshName;  // name, or the index as text when unnamed
+  int mode = 4;          // primitive mode (any mode is fine: shaders run per vertex)
+  size_t vertexCount = 0;
+  // Per-vertex values by semantic (docs/semantics.md), with sparse accessors applied and
+  // normalized integers dequantized as the GPU reads them: "vertex.position", "vertex.normal",
+  // "vertex.tangent" (xyz), "vertex.handedness" (.x = TANGENT.w), "vertex.texcoord0/1",
+  // "vertex.color0", "skin.joints[s]" (integers as floats), "skin.weights[s]",
+  // "morph.position[i]", "morph.normal[i]", "morph.tangent[i]" (zeros for targets that do
+  // not move that attribute). Only attributes the rig carries are present.
+  std::map<std::string, std::vector<std::array<float, 4>>> streams;
+  std::vector<GltfNode> nodes;
+  std::vector<int> sceneRoots;  // default scene (or scene 0, or every parentless node)
+  std::vector<GltfSkin> skins;
+  std::vector<GltfAnimation> animations;
+  std::vector<double> meshWeights;  // default morph weights of the mesh (padded with 0)
+  int meshNode = -1;  // the node instantiating the mesh (-1: none; identity transform)
+  int skin = -1;      // the skin it uses (-1: unskinned)
+};
+
+struct GltfImport {
+  Rig rig;
+  GltfModelData data;
+  std::vector<GltfAttributeInfo> attributes;  // in the file's order
+  int joints = 0;                             // joint count of the skin (0 = unskinned)
+  int influences = 0;
+  int morphTargets = 0;
+  // Per target: the glTF attributes it moves ("POSITION", "NORMAL", "TANGENT", ...).
+  std::vector<std::vector<std::string>> targetAttributes;
+  std::vector<std::string> notes;  // warnings: attributes the rig leaves out, sparse data, ...
+};
+
+// Loads the model and derives the rig of one primitive. Throws InputError naming the model,
+// the mesh and the limit for anything the rules cannot serve (too many joints, JOINTS_2+,
+// quantized positions, ...), and for malformed files.
+GltfImport importGltf(const std::string& file, const GltfImportOptions& opts = {});
+// Same, from glTF JSON text (buffers as data URIs; external files relative to baseDir).
+GltfImport importGltfText(const std::string& json, const std::string& fileName, const GltfImportOptions& opts = {},
+                          const std::string& baseDir = "");
+
+// Any rig path: "rig.yaml" (loadRigFile) or "model.glb[#m/p]" (importGltf).
+Rig loadRig(const std::string& path);
+
+// The rig as YAML that loadRigText reads back to the same rig. `header` lines become
+// comments at the top.
+std::string rigToYaml(const Rig& rig, const std::vector<std::string>& header = {});
+
+}  // namespace sg
