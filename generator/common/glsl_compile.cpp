@@ -53,6 +53,8 @@ std::vector<Diagnostic> parseGlslangLog(const std::string& log, const GlslUnit& 
     d.loc.file = (src >= 1 && src <= unit.sourceFiles.size()) ? unit.sourceFiles[src - 1] : unit.fileName;
     d.loc.line = std::stoi(m[3]);
     d.message = m[4];
+    while (!d.message.empty() && d.message.back() == ' ') d.message.pop_back();
+    if (d.message == "compilation terminated") continue;  // follows the real error
     out.push_back(std::move(d));
   }
   return out;
