@@ -1,7 +1,87 @@
+// `shadergen explain`: the chosen plan as a tree with each choice's cheapest alternative;
+// `shadergen graph`: the plan as Graphviz DOT (and SVG through `dot`). analysis/explain.h,
+// analysis/graph.h.
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <iostream>
+
+#include "analysis/explain.h"
+#include "analysis/graph.h"
 #include "cli/commands.h"
+#include "cli/output_files.h"
 
 namespace sg {
+namespace {
 
-void registerExplain(CLI::App&, CliState&) {}
+// Loads the inputs with --ban applied; nullopt plan = unreachable request.
+std::pair<LoadedInputs, std::optional<Plan>> loadAndSearch(const GenerateOptions& o) {
+  LoadedInputs in = loadInputs(o);
+  if (!o.bannedRules.empty()) in.problem = withoutRules(in.problem, o.bannedRules);
+  std::optional<Plan> plan = searchPlan(in.problem, o.heuristic);
+  return {std::move(in), std::move(plan)};
+}
+
+struct ExplainCommand {
+  GenerateArgs args;
+  bool noAlternatives = false;
+
+  int run() {
+    GenerateOptions o = args.resolve();
+    auto [in, plan] = loadAndSearch(o);
+    if (!plan) {
+      std::cout << fmt::format("the request cannot be met for rig '{}' and fragment shader '{}':\n", in.rig.name,
+                               std::filesystem::path(in.fragment.file).filename().string());
+      std::cout << formatUnreachable(in.problem, analyzeUnreachable(in.problem, in.rules, in.varyings));
+      return 1;
+    }
+    ExplainOptions eo;
+    eo.heuristic = o.heuristic;
+    eo.alternatives = !noAlternatives;
+    std::cout << formatExplanation(in, explainPlan(in, *plan, eo));
+    return 0;
+  }
+};
+
+struct GraphCommand {
+  GenerateArgs args;
+  std::string output;
+  std::string svg;
+
+  int run() {
+    GenerateOptions o = args.resolve();
+    if (!svg.empty() && findOnPath("dot").empty())
+      throw std::runtime_error("cannot write " + svg + ": Graphviz 'dot' is not on PATH (install graphviz)");
+    auto [in, plan] = loadAndSearch(o);
+    if (!plan) {
+      std::string why = formatUnreachable(in.problem, analyzeUnreachable(in.problem, in.rules, in.varyings));
+      if (!why.empty() && why.back() == '\n') why.pop_back();
+      throw InputError(SourceLoc{in.fragment.file, 0, 0},
+                       fmt::format("the request cannot be met for rig '{}':\n{}", in.rig.name, why));
+    }
+    std::string dot = planToDot(in, *plan);
+    if (output.empty() || output == "-") std::cout << dot;
+    else writeFilesAtomically({{output, dot}});
+    if (!svg.empty()) renderSvg(dot, svg);
+    return 0;
+  }
+};
+
+}  // namespace
+
+void registerExplain(CLI::App& app, CliState& state) {
+  auto ex = std::make_shared<ExplainCommand>();
+  CLI::App* sub = app.add_subcommand("explain", "Show the chosen plan, its costs, and each choice's best alternative");
+  ex->args.add(*sub);
+  sub->add_flag("--no-alternatives", ex->noAlternatives, "Do not re-search for each choice's alternative");
+  sub->callback([ex, &state] { state.run = [ex] { return ex->run(); }; });
+
+  auto gr = std::make_shared<GraphCommand>();
+  CLI::App* g = app.add_subcommand("graph", "Write the chosen plan as a Graphviz DOT graph (and SVG)");
+  gr->args.add(*g);
+  g->add_option("-o", gr->output, "DOT output path (default: standard output)");
+  g->add_option("--svg", gr->svg, "Also render SVG with Graphviz 'dot' (must be on PATH)");
+  g->callback([gr, &state] { state.run = [gr] { return gr->run(); }; });
+}
 
 }  // namespace sg

@@ -57,16 +57,25 @@ struct GenerateCommand {
   bool depfile = false;
   std::string depfilePath;
   bool quiet = false;
+  bool capture = false;
 
   int run() {
     GenerateOptions o = args.resolve();
     o.optimize = optimize;
+    o.capture = capture;
     std::set<std::string> kinds(emit.begin(), emit.end());
-    std::string stem = output;
-    auto ext = std::filesystem::path(output).extension().string();
+    if (kinds.empty()) throw CLI::ValidationError("--emit", "nothing to emit");
+    // With one --emit kind, -o names that file exactly (like glslc -o). Otherwise -o is a
+    // stem: known suffixes are stripped and each kind gets its own (.vert .spv .spv.h .json).
     bool single = kinds.size() == 1 && !output.empty();
-    if (output.empty()) stem = std::filesystem::path(o.fragmentPath).stem().string();
-    else if (ext == ".spv" || ext == ".vert" || ext == ".json" || ext == ".h") stem = output.substr(0, output.size() - ext.size());
+    std::string stem = output.empty() ? std::filesystem::path(o.fragmentPath).stem().string() : output;
+    for (const char* suffix : {".spv.h", ".vert", ".spv", ".json", ".h"}) {
+      std::string sfx(suffix);
+      if (stem.size() > sfx.size() && stem.compare(stem.size() - sfx.size(), sfx.size(), sfx) == 0) {
+        stem.resize(stem.size() - sfx.size());
+        break;
+      }
+    }
     auto pathFor = [&](const std::string& kind) {
       if (single) return output;
       if (kind == "glsl") return stem + ".vert";
@@ -74,7 +83,7 @@ struct GenerateCommand {
       if (kind == "header") return stem + ".spv.h";
       return stem + ".json";
     };
-    o.outputName = pathFor("glsl");
+    o.outputName = single && kinds.count("glsl") ? output : stem + ".vert";
 
     GenerateResult r = generate(o);
 
@@ -85,15 +94,20 @@ struct GenerateCommand {
       files.push_back({pathFor("spv"), bytes});
     }
     if (kinds.count("header")) {
+      // Symbol from the output stem: "out/face.spv.h" -> face_spv (+ face_spv_size).
       std::string sym = std::filesystem::path(stem).filename().string();
       for (auto& c : sym)
         if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+      if (sym.empty() || std::isdigit(static_cast<unsigned char>(sym[0]))) sym = "sg_" + sym;
       files.push_back({pathFor("header"), spirvHeader(r.spirv.words, sym + "_spv")});
     }
     if (kinds.count("reflection")) files.push_back({pathFor("reflection"), reflectionJson(r.in.rig, r.glsl, r.spirv)});
     if (depfile || !depfilePath.empty()) {
+      // Every output is a target of the depfile (first = the first output, as Ninja wants).
+      std::vector<std::string> targets;
+      for (const auto& f : files) targets.push_back(f.path);
       std::string dpath = depfilePath.empty() ? files.front().path + ".d" : depfilePath;
-      files.push_back({dpath, makeDepfile(files.front().path, r.inputsRead)});
+      files.push_back({dpath, makeDepfile(targets, r.inputsRead)});
     }
     writeFilesAtomically(files);
     if (!quiet) {
@@ -117,9 +131,15 @@ void registerGenerate(CLI::App& app, CliState& state) {
       ->delimiter(',')
       ->check(CLI::IsMember({"glsl", "spv", "header", "reflection"}));
   sub->add_flag("-O", cmd->optimize, "Optimise the SPIR-V (spirv-opt -O)");
-  sub->add_flag("--MD", cmd->depfile, "Write a depfile (<first output>.d) listing every input read");
-  sub->add_option("--MF", cmd->depfilePath, "Depfile path (implies -MD)");
+  sub->add_flag("--MD", cmd->depfile,
+                "-MD: write a Make/Ninja depfile (<first output>.d) listing every input read "
+                "(rig, fragment shader, rules files and their includes, templates)");
+  sub->add_option("--MF", cmd->depfilePath, "-MF FILE: depfile path (implies -MD)");
   sub->add_flag("-q,--quiet", cmd->quiet, "Do not print the plan");
+  sub->add_flag("--capture", cmd->capture,
+                "Transform-feedback build: add xfb_buffer/xfb_offset/xfb_stride to gl_Position and every "
+                "output so sg::rt::Harness can read them back (testing/validation, not for rendering)")
+      ->group("Advanced");
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }
 

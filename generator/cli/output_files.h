@@ -11,12 +11,15 @@ struct PendingFile {
   std::string contents;
 };
 
-// Writes every file to "<path>.tmp.<pid>" first, then renames them all. If any write
-// fails, removes the temporaries and leaves existing outputs untouched. Throws
-// std::runtime_error naming the file.
+// Writes every file to "<path>.tmp.<pid>" first, then renames them all into place. If any
+// write or rename fails, existing outputs are left (or put back) as they were, new ones are
+// removed, and no temporary is left behind. Throws std::runtime_error naming the file.
 void writeFilesAtomically(const std::vector<PendingFile>& files);
 
-// "target: dep1 dep2 ..." with spaces escaped (Make/Ninja syntax).
-std::string makeDepfile(const std::string& target, const std::vector<std::string>& deps);
+// "target1 target2: dep1 dep2 ..." with spaces, '#' and '$' escaped (Make/Ninja syntax).
+std::string makeDepfile(const std::vector<std::string>& targets, const std::vector<std::string>& deps);
+inline std::string makeDepfile(const std::string& target, const std::vector<std::string>& deps) {
+  return makeDepfile(std::vector<std::string>{target}, deps);
+}
 
 }  // namespace sg

@@ -6,6 +6,9 @@
 #include <functional>
 #include <set>
 
+#include "analysis/cost.h"
+#include "analysis/explain.h"
+#include "analysis/probe.h"
 #include "emit/templates.h"
 #include "rig/gltf_import.h"
 
@@ -19,44 +22,14 @@ LoadedInputs loadInputs(const GenerateOptions& opts) {
   in.rules = loadRules(opts.rulesPaths);
   in.fragment = reflectFragmentFile(opts.fragmentPath);
   in.varyings = bindVaryings(in.fragment, in.rules, opts.overrides);
+  resolveAutoCosts(in.rules, in.rig);  // `cost: auto`: measured for this rig
   in.problem = buildProblem(in.rig, in.rules, in.varyings);
   return in;
 }
 
 std::string explainUnreachable(const Problem& p, const RuleSet& rules) {
-  std::vector<bool> reach = reachableFacts(p);
-  std::vector<bool> producible(p.facts.size(), false);
-  for (const auto& a : p.actions) producible[a.add] = true;
-  std::string out;
-  for (int g : p.goals) {
-    if (reach[g]) continue;
-    // Leaves: unreachable facts no instantiated rule produces (missing rig inputs).
-    std::set<std::string> missing;
-    std::vector<bool> seen(p.facts.size(), false);
-    std::function<void(int)> walk = [&](int f) {
-      if (seen[f] || reach[f]) return;
-      seen[f] = true;
-      if (!producible[f]) {
-        missing.insert(p.facts[f].name);
-        return;
-      }
-      for (const auto& a : p.actions)
-        if (a.add == f)
-          for (int q : a.pre) walk(q);
-    };
-    walk(g);
-    std::string list;
-    for (const auto& m : missing) list += (list.empty() ? "" : ", ") + m;
-    out += fmt::format("cannot produce '{}': it needs {} which the rig does not provide and no applicable rule "
-                       "produces",
-                       p.facts[g].name, list.empty() ? "values" : list);
-    std::string skipped;
-    for (const auto& [r, why] : p.skippedRules)
-      if (missing.count(rules.rules[r].produces) || rules.rules[r].produces == p.facts[g].name)
-        skipped += fmt::format("; rule '{}' does not apply ({})", rules.rules[r].name, why);
-    out += skipped + "\n";
-  }
-  return out;
+  // Minimal sets of missing rig inputs per unreachable goal (analysis/explain.h).
+  return formatUnreachable(p, analyzeUnreachable(p, rules, {}));
 }
 
 GenerateResult generate(const GenerateOptions& opts) { return generateFrom(loadInputs(opts), opts); }
@@ -68,7 +41,7 @@ GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts) {
   if (!h) throw InputError(SourceLoc{}, fmt::format("unknown heuristic '{}' (blind, hmax, lmcut)", opts.heuristic));
   std::optional<Plan> plan = astarSearch(in.problem, *h, &res.stats);
   if (!plan) {
-    std::string why = explainUnreachable(in.problem, in.rules);
+    std::string why = formatUnreachable(in.problem, analyzeUnreachable(in.problem, in.rules, in.varyings));
     // Point at the first fragment input whose request cannot be met.
     SourceLoc at{in.fragment.file, 0, 0};
     std::vector<bool> reach = reachableFacts(in.problem);
@@ -88,7 +61,15 @@ GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts) {
   eo.heuristic = opts.heuristic;
   eo.version = shadergenVersion();
   res.glsl = emitGlsl(in.rig, in.problem, res.plan, in.varyings, templates, in.fragment.file, eo);
-  res.spirv = compileVertexShader(res.glsl, opts.outputName, opts.targetEnv);
+  try {
+    res.spirv = compileVertexShader(res.glsl, opts.outputName, opts.targetEnv);
+  } catch (const InputError& e) {
+    // glslang reports lines only: point the columns at the snippet text in the rules file.
+    std::vector<SourceLoc> snippetLines;
+    for (int a : res.plan.actions)
+      for (const auto& l : in.problem.actions[a].code) snippetLines.push_back(l.loc);
+    throw refineSnippetError(e, snippetLines);
+  }
   if (std::string err = validateSpirv(res.spirv.words, opts.targetEnv); !err.empty())
     throw InputError(SourceLoc{opts.outputName, 0, 0}, "generated SPIR-V fails validation: " + err);
   checkLink(res.glsl, in.fragment.source, in.fragment.file, opts.targetEnv);

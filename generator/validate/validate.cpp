@@ -167,10 +167,16 @@ ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_
   mo.influences = static_cast<int>(rig.param("influences"));
   mo.bones = std::max<int>(1, static_cast<int>(rig.param("bones")));
   ValidationScene s;
-  if (mesh == "head") s.mesh = rt::makeHead(40, 48, mo);
-  else if (mesh == "limb") s.mesh = rt::makeLimb(32, 24, mo);
-  else if (mesh == "dawn") s.mesh = rt::makeHead(299, 599, mo);
-  else throw InputError(SourceLoc{}, fmt::format("unknown mesh '{}' (head, limb, dawn)", mesh));
+  if (mesh == "head") {
+    s.mesh = rt::makeHead(40, 48, mo);
+  } else if (mesh == "limb") {
+    s.mesh = rt::makeLimb(32, 24, mo);
+  } else if (mesh == "dawn") {
+    s.mesh = rt::makeHead(299, 599, mo);
+    s.mesh.name = "dawn";  // makeHead names it "head"
+  } else {
+    throw InputError(SourceLoc{}, fmt::format("unknown mesh '{}' (head, limb, dawn)", mesh));
+  }
   s.shape = rt::rigShapeFor(mo);
   for (const auto& u : rig.uniforms)
     if (u.semantic == "model.matrix") s.shape.hasModelMatrix = true;
@@ -208,7 +214,8 @@ RunReport Validator::runOne(const GenerateResult& r, const ValidationScene& scen
     out.semantics = o.semantics;
     rep.outputs.push_back(out);
   }
-  size_t before = harness_->validationMessages().size();
+  // Messages since the last run, so those of the harness setup (instance, device) count too.
+  size_t before = reportedMessages_;
   for (const rt::Pose& pose : scene.poses) {
     req.uniformData = buildUniforms(rig, r.glsl, r.spirv, pose);
     rt::RunResult res = harness_->run(req);
@@ -271,6 +278,7 @@ RunReport Validator::runOne(const GenerateResult& r, const ValidationScene& scen
   }
   const auto& msgs = harness_->validationMessages();
   rep.validationMessages.assign(msgs.begin() + static_cast<long>(before), msgs.end());
+  reportedMessages_ = msgs.size();
   rep.pass = rep.validationMessages.empty();
   for (const auto& o : rep.outputs) rep.pass = rep.pass && o.pass;
   return rep;

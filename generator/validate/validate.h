@@ -82,6 +82,7 @@ class Validator {
  private:
   ValidateOptions opts_;
   std::unique_ptr<rt::Harness> harness_;
+  size_t reportedMessages_ = 0;  // layer messages already attributed to a run (setup's go to the first)
 };
 
 std::string formatReport(const ValidateReport& report);

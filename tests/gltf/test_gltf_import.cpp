@@ -18,6 +18,7 @@ namespace sg {
 namespace {
 
 using test::GltfBuilder;
+using test::tinySkinnedModel;
 using test::modelPath;
 
 const GltfAttributeInfo* attr(const GltfImport& imp, const std::string& name) {
@@ -253,57 +254,6 @@ TEST(GltfImport, FoxWorldNormalRequestNamesVertexNormal) {
   EXPECT_NO_THROW(generate(g));
 }
 
-// A tiny skinned triangle: joints as unsigned bytes, normalized weights (ubyte) and
-// colours (ushort), a sparse morph target without a buffer view, sparse UVs over a base
-// buffer view, and a CUBICSPLINE + STEP animation.
-std::string tinySkinnedModel(int extraJointSets = 0) {
-  GltfBuilder b;
-  int pos = b.accessor(b.view(std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}), 5126, 3, "VEC3",
-                       R"("min":[0,0,0],"max":[1,1,0])");
-  int joints = b.accessor(b.view(std::vector<uint8_t>{0, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 0}), 5121, 3, "VEC4");
-  int weights = b.accessor(b.view(std::vector<uint8_t>{255, 0, 0, 0, 128, 127, 0, 0, 51, 204, 0, 0}), 5121, 3,
-                           "VEC4", R"("normalized":true)");
-  int color = b.accessor(b.view(std::vector<uint16_t>{65535, 0, 32768, 65535, 1, 2, 3, 4, 0, 65535, 0, 65535}), 5123,
-                         3, "VEC4", R"("normalized":true)");
-  int sparseIdx = b.view(std::vector<uint16_t>{1, 0});  // one index (padded)
-  int sparseVal = b.view(std::vector<float>{0, 0.5f, 0});
-  int morph = b.accessor(-1, 5126, 3, "VEC3",
-                         fmt::format(R"("sparse":{{"count":1,"indices":{{"bufferView":{},"componentType":5123}},)"
-                                     R"("values":{{"bufferView":{}}}}})",
-                                     sparseIdx, sparseVal));
-  int uvBase = b.view(std::vector<float>{0, 0, 1, 0, 0, 1});
-  int uvIdx = b.view(std::vector<uint8_t>{2, 0, 0, 0});
-  int uvVal = b.view(std::vector<float>{0.25f, 0.75f});
-  int uv = b.accessor(uvBase, 5126, 3, "VEC2",
-                      fmt::format(R"("sparse":{{"count":1,"indices":{{"bufferView":{},"componentType":5121}},)"
-                                  R"("values":{{"bufferView":{}}}}})",
-                                  uvIdx, uvVal));
-  int ibm = b.accessor(b.view(std::vector<float>{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1,  //
-                                                 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -1, 0, 0, 1}),
-                       5126, 2, "MAT4");
-  int times = b.accessor(b.view(std::vector<float>{0, 2}), 5126, 2, "SCALAR", R"("min":[0],"max":[2])");
-  // CUBICSPLINE translation of joint 1 (node 1): in-tangent, value, out-tangent per key.
-  int cubic = b.accessor(b.view(std::vector<float>{0, 0, 0, 0, 0, 0, 1, 0, 0,  //
-                                                   0, 0, 0, 0, 2, 0, 0, 0, 0}),
-                         5126, 6, "VEC3");
-  // STEP rotation of joint 2: identity, then 90° about Z.
-  float h = std::sqrt(0.5f);
-  int step = b.accessor(b.view(std::vector<float>{0, 0, 0, 1, 0, 0, h, h}), 5126, 2, "VEC4");
-  std::string attrs = fmt::format(R"("POSITION":{},"JOINTS_0":{},"WEIGHTS_0":{},"COLOR_0":{},"TEXCOORD_0":{})", pos,
-                                  joints, weights, color, uv);
-  for (int s = 1; s <= extraJointSets; ++s) attrs += fmt::format(R"(,"JOINTS_{}":{},"WEIGHTS_{}":{})", s, joints, s, weights);
-  return b.json(fmt::format(
-      R"("meshes":[{{"name":"tri","primitives":[{{"attributes":{{{}}},"targets":[{{"POSITION":{}}}]}}],"weights":[0.25]}}],)"
-      R"("skins":[{{"joints":[1,2],"inverseBindMatrices":{}}}],)"
-      R"("nodes":[{{"name":"skinned","mesh":0,"skin":0,"translation":[5,5,5]}},{{"name":"root","children":[2]}},)"
-      R"({{"name":"tip","translation":[1,0,0]}}],)"
-      R"("scenes":[{{"nodes":[0,1]}}],"scene":0,)"
-      R"("animations":[{{"name":"wave","samplers":[{{"input":{},"output":{},"interpolation":"CUBICSPLINE"}},)"
-      R"({{"input":{},"output":{},"interpolation":"STEP"}}],)"
-      R"("channels":[{{"sampler":0,"target":{{"node":1,"path":"translation"}}}},{{"sampler":1,"target":{{"node":2,"path":"rotation"}}}}]}}])",
-      attrs, morph, ibm, times, cubic, times, step));
-}
-
 TEST(GltfImport, NormalizedFormatsAreDequantizedAsTheGpuReadsThem) {
   GltfImport imp = importGltfText(tinySkinnedModel(), "tiny.gltf");
   EXPECT_EQ(imp.rig.name, "tiny/tri/0");
@@ -512,19 +462,31 @@ TEST(GltfAnimation, SkinPaletteFollowsTheHierarchy) {
   EXPECT_EQ(scene.poses[2].morphWeights, (std::vector<float>{0.25f}));
 }
 
-TEST(GltfAnimation, SimpleSkinBindPoseIsIdentity) {
+TEST(GltfAnimation, SimpleSkinPaletteIsJointGlobalTimesInverseBind) {
   GltfImport imp = importAt("SimpleSkin/SimpleSkin.gltf");
-  // Without the animation the joints sit in the bind pose: global · IBM = identity.
+  // Node 1 (joint 0) at (0,1,0), node 2 (joint 1) its child at the same place; both inverse
+  // bind matrices of this copy are translate(-0.5,-1,0): without the animation both palette
+  // entries are translate(-0.5,0,0).
   std::vector<glm::dmat4> G = gltfNodeGlobals(imp.data, -1, 0.0);
   const GltfSkin& skin = imp.data.skins[0];
+  glm::dmat4 expect = glm::translate(glm::dmat4(1.0), glm::dvec3(-0.5, 0, 0));
   for (size_t j = 0; j < skin.joints.size(); ++j) {
     glm::dmat4 ibm;
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r) ibm[c][r] = skin.inverseBind[j][static_cast<size_t>(c * 4 + r)];
     glm::dmat4 B = G[static_cast<size_t>(skin.joints[j])] * ibm;
     for (int c = 0; c < 4; ++c)
-      for (int r = 0; r < 4; ++r) EXPECT_NEAR(B[c][r], c == r ? 1.0 : 0.0, 1e-6);
+      for (int r = 0; r < 4; ++r) EXPECT_NEAR(B[c][r], expect[c][r], 1e-6);
   }
+  // The scene's palette is the same product (in float) at the start of the animation, whose
+  // first key is the identity rotation.
+  GltfSceneOptions so;
+  so.times = {0.0};
+  ValidationScene scene = gltfScene(imp, so);
+  ASSERT_EQ(scene.poses[0].bones.size(), 2u);
+  for (const auto& B : scene.poses[0].bones)
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) EXPECT_NEAR(B[c][r], expect[c][r], 1e-6);
 }
 
 TEST(GltfAnimation, MorphWeightsChannelDrivesTheWeights) {

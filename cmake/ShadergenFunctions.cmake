@@ -1,0 +1,146 @@
+# shadergen_add_vertex_shader(): generate a vertex shader at build time and attach it to
+# a target. Loaded by find_package(shadergen) (installed package) and by the top-level
+# CMakeLists.txt of shadergen itself (add_subdirectory of the source tree). See docs/cmake.md.
+#
+#   shadergen_add_vertex_shader(<target>
+#     RIG <file> FRAGMENT <file> RULES <file>...
+#     [OUTPUT_NAME <name>]      # default: the fragment shader's name without extension
+#     [OPTIMIZE]                # -O (spirv-opt)
+#     [EMBED]                   # also <name>.spv.h (uint32_t <name>_spv[]), #include-able
+#     [TARGET_ENV <env>]        # vulkan1.0 (default) .. vulkan1.3
+#     [CAPTURE]                 # transform-feedback build (to read outputs back with sg::rt::Harness)
+#     [MAP <Name=sem[,sem...]>...]  # --map overrides of fragment inputs
+#     [TEMPLATES <dir>]         # --templates (default: the ones shipped with shadergen)
+#     [DEPENDS <file>...])      # extra dependencies of the generator run
+#
+# Runs `shadergen generate` in a custom command whose DEPFILE lists every file the
+# generator read (rig, fragment shader, every rules file including included ones, the
+# template), so editing any of them regenerates this shader and nothing else.
+#
+# Outputs go to ${CMAKE_CURRENT_BINARY_DIR}/shadergen/<target>/<name>.{vert,spv,json}
+# (+ .spv.h with EMBED) and are added to the target's sources. The target gets:
+#   - compile definitions SHADERGEN_<NAME>_SPV="<abs path of .spv>" and
+#     SHADERGEN_<NAME>_REFLECTION="<abs path of .json>" (NAME: OUTPUT_NAME upper-cased,
+#     non-alphanumerics replaced by '_'),
+#   - with EMBED, that directory as a PRIVATE include directory, so `#include "<name>.spv.h"`
+#     works.
+# The same paths are set in the caller's scope as SHADERGEN_<NAME>_{GLSL,SPV,REFLECTION,HEADER}.
+
+if(CMAKE_VERSION VERSION_LESS 3.20)
+  message(FATAL_ERROR "shadergen_add_vertex_shader() needs CMake 3.20 or newer (DEPFILE support for all generators)")
+endif()
+
+# Functions record the policy settings in effect where they are defined. CMP0116 NEW makes
+# the Ninja generator rewrite depfile paths the way Ninja expects, whatever the policy
+# version of the project that calls the function.
+cmake_policy(PUSH)
+cmake_policy(VERSION 3.20)
+
+function(shadergen_add_vertex_shader target)
+  set(options OPTIMIZE EMBED CAPTURE)
+  set(one RIG FRAGMENT OUTPUT_NAME TARGET_ENV TEMPLATES)
+  set(multi RULES MAP DEPENDS)
+  cmake_parse_arguments(PARSE_ARGV 1 SG "${options}" "${one}" "${multi}")
+
+  if(SG_UNPARSED_ARGUMENTS)
+    message(FATAL_ERROR "shadergen_add_vertex_shader(${target}): unknown arguments: ${SG_UNPARSED_ARGUMENTS}")
+  endif()
+  if(NOT TARGET ${target})
+    message(FATAL_ERROR "shadergen_add_vertex_shader: '${target}' is not a target")
+  endif()
+  foreach(req RIG FRAGMENT RULES)
+    if(NOT SG_${req})
+      message(FATAL_ERROR "shadergen_add_vertex_shader(${target}): ${req} is required")
+    endif()
+  endforeach()
+  if(SG_TARGET_ENV AND NOT SG_TARGET_ENV MATCHES "^vulkan(1\\.[0-3])?$")
+    message(FATAL_ERROR "shadergen_add_vertex_shader(${target}): TARGET_ENV must be vulkan1.0, vulkan1.1, vulkan1.2 or vulkan1.3, not '${SG_TARGET_ENV}'")
+  endif()
+
+  # The generator: the imported shadergen::shadergen of an installed package, or the
+  # in-tree target when shadergen's source tree was added with add_subdirectory().
+  if(NOT TARGET shadergen::shadergen)
+    message(FATAL_ERROR "shadergen_add_vertex_shader: no shadergen::shadergen target (use find_package(shadergen) or add_subdirectory(<shadergen source>))")
+  endif()
+  get_target_property(_sg_exe shadergen::shadergen ALIASED_TARGET)
+  if(NOT _sg_exe)
+    set(_sg_exe shadergen::shadergen)
+  endif()
+
+  # Absolute input paths: the depfile then names the same files the DEPENDS do.
+  get_filename_component(_rig "${SG_RIG}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+  get_filename_component(_frag "${SG_FRAGMENT}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+  set(_rules "")
+  set(_rule_args "")
+  foreach(r IN LISTS SG_RULES)
+    get_filename_component(_r "${r}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+    list(APPEND _rules "${_r}")
+    list(APPEND _rule_args -r "${_r}")
+  endforeach()
+  set(_extra "")
+  foreach(d IN LISTS SG_DEPENDS)
+    get_filename_component(_d "${d}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+    list(APPEND _extra "${_d}")
+  endforeach()
+
+  set(_name "${SG_OUTPUT_NAME}")
+  if(NOT _name)
+    get_filename_component(_name "${_frag}" NAME_WE)
+  endif()
+  string(MAKE_C_IDENTIFIER "${_name}" _ident)
+  string(TOUPPER "${_ident}" _NAME)
+
+  set(_dir "${CMAKE_CURRENT_BINARY_DIR}/shadergen/${target}")
+  set(_stem "${_dir}/${_name}")
+  set(_depfile "${_stem}.d")
+  # Same order as the generator writes them (its depfile names the first one first).
+  set(_outputs "${_stem}.vert" "${_stem}.spv")
+  set(_emit glsl,spv,reflection)
+  if(SG_EMBED)
+    list(APPEND _outputs "${_stem}.spv.h")
+    set(_emit glsl,spv,header,reflection)
+  endif()
+  list(APPEND _outputs "${_stem}.json")
+
+  set(_args generate --rig "${_rig}" -f "${_frag}" ${_rule_args} -o "${_stem}" --emit ${_emit} -MF "${_depfile}" -q)
+  if(SG_OPTIMIZE)
+    list(APPEND _args -O)
+  endif()
+  if(SG_TARGET_ENV)
+    list(APPEND _args "--target-env=${SG_TARGET_ENV}")
+  endif()
+  if(SG_CAPTURE)
+    list(APPEND _args --capture)
+  endif()
+  foreach(m IN LISTS SG_MAP)
+    list(APPEND _args --map "${m}")
+  endforeach()
+  if(SG_TEMPLATES)
+    get_filename_component(_tpl "${SG_TEMPLATES}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+    list(APPEND _args --templates "${_tpl}")
+  endif()
+
+  add_custom_command(
+    OUTPUT ${_outputs}
+    COMMAND ${_sg_exe} ${_args}
+    DEPENDS "${_rig}" "${_frag}" ${_rules} ${_extra} ${_sg_exe}
+    DEPFILE "${_depfile}"
+    WORKING_DIRECTORY "${CMAKE_CURRENT_BINARY_DIR}"
+    COMMENT "shadergen: generating vertex shader ${_name} for ${target}"
+    VERBATIM)
+
+  target_sources(${target} PRIVATE ${_outputs})
+  set_source_files_properties(${_outputs} PROPERTIES GENERATED TRUE)
+  target_compile_definitions(${target} PRIVATE
+    "SHADERGEN_${_NAME}_SPV=\"${_stem}.spv\""
+    "SHADERGEN_${_NAME}_REFLECTION=\"${_stem}.json\"")
+  if(SG_EMBED)
+    target_include_directories(${target} PRIVATE "${_dir}")
+    set(SHADERGEN_${_NAME}_HEADER "${_stem}.spv.h" PARENT_SCOPE)
+  endif()
+  set(SHADERGEN_${_NAME}_GLSL "${_stem}.vert" PARENT_SCOPE)
+  set(SHADERGEN_${_NAME}_SPV "${_stem}.spv" PARENT_SCOPE)
+  set(SHADERGEN_${_NAME}_REFLECTION "${_stem}.json" PARENT_SCOPE)
+endfunction()
+
+cmake_policy(POP)

@@ -1,0 +1,304 @@
+#include "analysis/probe.h"
+
+#include <fmt/format.h>
+
+#include <fstream>
+
+#include "rig/rig.h"
+#include "rules/snippet.h"
+
+namespace sg {
+namespace {
+
+std::string indexed(const std::string& name, int64_t i) { return fmt::format("{}[{}]", name, i); }
+
+// GLSL identifier for a semantic instance: "morph.position[3]" -> "morph_position_3".
+std::string mangle(const std::string& fact) {
+  std::string s;
+  for (char c : fact) {
+    if (c == '.' || c == '[') s += '_';
+    else if (c != ']') s += c;
+  }
+  return s;
+}
+
+bool isIntegerType(Type t) { return scalarKind(t) != ScalarKind::Float; }
+
+// Semantics no rule produces: what some rig would have to provide.
+std::set<std::string> leafSemantics(const RuleSet& rules) {
+  std::set<std::string> produced;
+  for (const auto& r : rules.rules) produced.insert(r.produces);
+  std::set<std::string> leaves;
+  for (const auto& d : rules.semantics)
+    if (!produced.count(d.name)) leaves.insert(d.name);
+  return leaves;
+}
+
+void evalShapes(ProbeRig& pr, const RuleSet& rules, bool strictArrays) {
+  ExprEnv env;
+  env.lookup = [&pr](const std::string& n, int64_t& v) {
+    auto it = pr.params.find(n);
+    if (it == pr.params.end()) return false;
+    v = it->second;
+    return true;
+  };
+  env.has = [](const std::string&) { return false; };  // as at instantiation: counts come first
+  for (const auto& d : rules.semantics) {
+    if (!d.count.empty()) {
+      int64_t n = d.count.eval(env);
+      if (n < 0 || n > 256) throw InputError(d.loc, fmt::format("semantic '{}' has count {} (allowed 0..256)", d.name, n));
+      pr.families[d.name] = n;
+    }
+    if (!d.arrayParam.empty()) {
+      auto it = pr.params.find(d.arrayParam);
+      if (it == pr.params.end()) {
+        if (strictArrays)
+          throw InputError(d.loc, fmt::format("semantic '{}' is sized by '{}', which rig '{}' does not define", d.name,
+                                              d.arrayParam, pr.name));
+        pr.arrays[d.name] = 4;
+      } else {
+        pr.arrays[d.name] = std::max<int64_t>(1, it->second);
+      }
+    }
+  }
+}
+
+ProbeRig makeDefault(const RuleSet& rules, const std::string& name, std::map<std::string, int64_t> params,
+                     bool provideLeaves) {
+  ProbeRig pr;
+  pr.name = name;
+  pr.params = std::move(params);
+  pr.isDefault = true;
+  evalShapes(pr, rules, false);
+  if (provideLeaves)
+    for (const auto& s : leafSemantics(rules)) {
+      auto f = pr.families.find(s);
+      if (f == pr.families.end()) pr.provided.insert(s);
+      else
+        for (int64_t i = 0; i < f->second; ++i) pr.provided.insert(indexed(s, i));
+    }
+  return pr;
+}
+
+}  // namespace
+
+ProbeRig probeRigFromRig(const Rig& rig, const RuleSet& rules) {
+  ProbeRig pr;
+  pr.name = rig.name;
+  pr.params = rig.params;
+  evalShapes(pr, rules, true);
+  for (const auto& a : rig.attributes) {
+    int targets = a.perMorphTarget ? rig.morphTargets() : 1;
+    for (int t = 0; t < targets; ++t)
+      for (const auto& part : a.provides) {
+        std::string fact = a.perMorphTarget ? indexed(part.semantic, t) : part.semantic;
+        pr.provided.insert(fact);
+        std::string input = a.perMorphTarget ? fmt::format("a_{}{}", a.name, t) : "a_" + a.name;
+        pr.streams[fact] = ProbeRig::Stream{input, a.shaderType, part.swizzle};
+      }
+  }
+  for (const auto& u : rig.uniforms) pr.provided.insert(u.semantic);
+  return pr;
+}
+
+std::vector<ProbeRig> defaultProbeRigs(const RuleSet& rules) {
+  std::vector<ProbeRig> out;
+  out.push_back(makeDefault(rules, "default rig (morph_targets=2, influences=4, bones=4)",
+                            {{"morph_targets", 2}, {"influences", 4}, {"bones", 4}}, true));
+  out.push_back(makeDefault(rules, "default rigid rig (morph_targets=0, influences=1, bones=4)",
+                            {{"morph_targets", 0}, {"influences", 1}, {"bones", 4}}, true));
+  out.push_back(makeDefault(rules, "default unskinned rig (morph_targets=0, influences=0, bones=0)",
+                            {{"morph_targets", 0}, {"influences", 0}, {"bones", 0}}, true));
+  out.push_back(makeDefault(rules, "default bare rig (no parameters, provides nothing)",
+                            {{"morph_targets", 0}, {"influences", 0}, {"bones", 0}}, false));
+  return out;
+}
+
+ExprEnv probeEnv(const ProbeRig& rig) {
+  ExprEnv env;
+  const ProbeRig* pr = &rig;
+  env.lookup = [pr](const std::string& n, int64_t& v) {
+    auto it = pr->params.find(n);
+    if (it == pr->params.end()) return false;
+    v = it->second;
+    return true;
+  };
+  env.has = [pr](const std::string& s) { return pr->provided.count(s) || pr->provided.count(indexed(s, 0)); };
+  return env;
+}
+
+SnippetProbe buildSnippetProbe(const RuleSet& rules, int r, const ProbeRig& rig) {
+  const Rule& rule = rules.rules[static_cast<size_t>(r)];
+  const SemanticDecl* product = rules.findSemantic(rule.produces);
+  if (!product)
+    throw InputError(rule.producesLoc, fmt::format("rule '{}' produces unknown semantic '{}'", rule.name, rule.produces));
+  if (!product->count.empty())
+    throw InputError(rule.producesLoc, fmt::format("rule '{}' produces '{}', which is an indexed family; rules "
+                                                   "produce single semantics",
+                                                   rule.name, rule.produces));
+  ExprEnv env = probeEnv(rig);
+
+  // The needed semantic instances, in a stable order.
+  std::map<std::string, const SemanticDecl*> needs;
+  for (const auto& ref : rule.needs) {
+    const SemanticDecl* d = rules.findSemantic(ref.name);
+    if (!d) throw InputError(ref.loc, fmt::format("needs unknown semantic '{}' (not declared in the rules)", ref.name));
+    bool family = !d->count.empty();
+    int64_t n = family ? rig.families.at(d->name) : 0;
+    if (ref.index.empty()) {
+      if (family)
+        throw InputError(ref.loc, fmt::format("'{}' is an indexed family: write '{}[*]' or '{}[i]'", ref.name,
+                                              ref.name, ref.name));
+      needs[ref.name] = d;
+    } else if (!family) {
+      throw InputError(ref.loc, fmt::format("'{}' is not an indexed family", ref.name));
+    } else if (ref.index == "*") {
+      for (int64_t i = 0; i < n; ++i) needs[indexed(ref.name, i)] = d;
+    } else {
+      SourceLoc at = ref.loc;
+      if (at.col > 0) at.col += static_cast<int>(ref.name.size()) + 1;
+      int64_t i = Expr::parse(ref.index, at).eval(env);
+      if (i < 0 || i >= n)
+        throw InputError(ref.loc, fmt::format("needs '{}[{}]': index {} is out of range ({} has {} instances for {})",
+                                              ref.name, i, i, ref.name, n, rig.name));
+      needs[indexed(ref.name, i)] = d;
+    }
+  }
+  if (needs.count(rule.produces))
+    throw InputError(rule.producesLoc, fmt::format("rule '{}' needs its own product '{}'", rule.name, rule.produces));
+
+  const std::string outName = "t_" + mangle(rule.produces);
+  SnippetContext ctx;
+  ctx.rigEnv = env;
+  ctx.outText = outName;
+  ctx.semantic = [&](const std::string& name, int64_t idx, const SourceLoc& at, std::string& text) {
+    const SemanticDecl* d = rules.findSemantic(name);
+    if (!d) {
+      if (idx >= 0) return false;
+      throw InputError(at, fmt::format("rule '{}' uses unknown semantic '{}'", rule.name, name));
+    }
+    bool family = !d->count.empty();
+    if (family && idx < 0) throw InputError(at, fmt::format("'{}' is an indexed family: write ${{{}[i]}}", name, name));
+    std::string full = family ? indexed(name, idx) : name;
+    if (full == rule.produces) {
+      text = outName;
+      return true;
+    }
+    if (!needs.count(full))
+      throw InputError(at, fmt::format("rule '{}' uses '{}' but does not list it in 'needs'", rule.name, full));
+    if (auto st = rig.streams.find(full); st != rig.streams.end())
+      text = st->second.swizzle.empty() ? st->second.input : st->second.input + "." + st->second.swizzle;
+    else
+      text = "p_" + mangle(full);
+    return true;
+  };
+  std::vector<ExpandedLine> lines = expandSnippet(rule.glsl, ctx);
+
+  SnippetProbe probe;
+  probe.unit.stage = Stage::Vertex;
+  probe.unit.fileName = fmt::format("<probe of rule '{}'>", rule.name);
+  std::string ruleFile = rule.loc.file;
+  probe.unit.sourceFiles = {ruleFile};
+  std::string& s = probe.unit.text;
+  s += "#version 450\n";
+  s += fmt::format("// Probe of rule '{}' instantiated for {}.\n", rule.name, rig.name);
+  std::map<std::string, Type> inputs;  // vertex inputs read (attribute streams)
+  std::string members;                  // uniform block members
+  for (const auto& [fact, d] : needs) {
+    if (auto st = rig.streams.find(fact); st != rig.streams.end()) {
+      inputs.emplace(st->second.input, st->second.type);
+      continue;
+    }
+    std::string array;
+    if (auto it = rig.arrays.find(d->name); it != rig.arrays.end()) array = fmt::format("[{}]", it->second);
+    members += fmt::format("  {} p_{}{};\n", glslName(d->type), mangle(fact), array);
+  }
+  int location = 0;
+  for (const auto& [name, type] : inputs) {
+    s += fmt::format("layout(location = {}) in {} {};\n", location, glslName(type), name);
+    location += isMatrix(type) ? 4 : 1;
+  }
+  if (!members.empty()) s += "layout(set = 0, binding = 0, std140) uniform ProbeInputs {\n" + members + "};\n";
+  s += fmt::format("layout(location = 0) {}out {} sg_probe_out;\n", isIntegerType(product->type) ? "flat " : "",
+                   glslName(product->type));
+  s += "void main() {\n";
+  s += fmt::format("  {} {};\n", glslName(product->type), outName);
+  int line = 1 + static_cast<int>(std::count(s.begin(), s.end(), '\n'));  // line number of the next line
+  int expect = -1;
+  for (const auto& l : lines) {
+    if (l.loc.line != expect) {
+      s += fmt::format("#line {} 1\n", l.loc.line);
+      ++line;
+    }
+    s += "  " + l.text + "\n";
+    ++line;
+    probe.snippetLines.push_back(l.loc);
+    expect = l.loc.line + 1;
+  }
+  s += fmt::format("#line {} 0\n", line + 1);
+  s += fmt::format("  sg_probe_out = {};\n", outName);
+  s += "}\n";
+  return probe;
+}
+
+CompileResult compileSnippetProbe(const SnippetProbe& probe, const Rule& rule) {
+  CompileResult r = compileGlsl(probe.unit, TargetEnv::Vulkan1_0);
+  for (auto& d : r.diagnostics)
+    if (d.loc.file == probe.unit.fileName) {
+      d.message = fmt::format("snippet of rule '{}' does not fit its declaration (product '{}'): {}", rule.name,
+                              rule.produces, d.message);
+      d.loc = rule.loc;
+    }
+  refineSnippetColumns(r.diagnostics, probe.snippetLines);
+  return r;
+}
+
+void refineSnippetColumns(std::vector<Diagnostic>& diags, const std::vector<SourceLoc>& snippetLines) {
+  std::map<std::string, std::vector<std::string>> fileLines;
+  auto rawLine = [&](const std::string& file, int line) -> std::string {
+    auto it = fileLines.find(file);
+    if (it == fileLines.end()) {
+      std::vector<std::string> ls;
+      std::ifstream in(file, std::ios::binary);
+      std::string l;
+      while (std::getline(in, l)) {
+        if (!l.empty() && l.back() == '\r') l.pop_back();
+        ls.push_back(l);
+      }
+      it = fileLines.emplace(file, std::move(ls)).first;
+    }
+    return line >= 1 && line <= static_cast<int>(it->second.size()) ? it->second[static_cast<size_t>(line - 1)] : "";
+  };
+  for (auto& d : diags) {
+    if (d.loc.line <= 0 || d.loc.col > 0) continue;
+    const SourceLoc* start = nullptr;
+    for (const auto& s : snippetLines)
+      if (s.file == d.loc.file && s.line == d.loc.line) {
+        start = &s;
+        break;
+      }
+    if (!start) continue;
+    d.loc.col = std::max(1, start->col);
+    // glslang quotes the offending token first: "'nrmalize' : no matching overloaded function found".
+    size_t q1 = d.message.find('\'');
+    size_t q2 = q1 == std::string::npos ? std::string::npos : d.message.find('\'', q1 + 1);
+    if (q2 == std::string::npos || q2 == q1 + 1) continue;
+    std::string token = d.message.substr(q1 + 1, q2 - q1 - 1);
+    if (token.find_first_not_of(' ') == std::string::npos) continue;
+    std::string raw = rawLine(d.loc.file, d.loc.line);
+    size_t from = static_cast<size_t>(std::max(0, start->col - 1));
+    size_t at = raw.find(token, std::min(from, raw.size()));
+    if (at != std::string::npos) d.loc.col = static_cast<int>(at) + 1;
+  }
+}
+
+InputError refineSnippetError(const InputError& e, const std::vector<SourceLoc>& snippetLines) {
+  std::vector<Diagnostic> all{e.diagnostic()};
+  all.insert(all.end(), e.related.begin(), e.related.end());
+  refineSnippetColumns(all, snippetLines);
+  InputError out(all.front());
+  out.related.assign(all.begin() + 1, all.end());
+  return out;
+}
+
+}  // namespace sg

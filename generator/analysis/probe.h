@@ -1,0 +1,73 @@
+// Compiling one rule's snippet on its own: a tiny vertex shader that declares every
+// semantic the rule needs as a uniform of its type and the product as a local, with
+// the snippet instantiated against a rig. `check` uses it to find snippets that do
+// not compile; `cost: auto` measures the compiled result (analysis/cost.h).
+#pragma once
+#include <cstdint>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "common/diagnostics.h"
+#include "common/glsl_compile.h"
+#include "rules/rules.h"
+
+namespace sg {
+
+struct Rig;
+
+// What a snippet is instantiated against: rig parameters, which semantic instances
+// the rig provides (for has()), and the instance count of each indexed family.
+struct ProbeRig {
+  std::string name;  // "dawn-face", or a description of a default rig
+  std::map<std::string, int64_t> params;
+  std::set<std::string> provided;           // "vertex.position", "morph.position[3]", ...
+  std::map<std::string, int64_t> families;  // "morph.position" -> 5
+  std::map<std::string, int64_t> arrays;    // uniform arrays: "skin.bones" -> 98
+  // Semantics a real rig stores in (part of) a vertex attribute: the probe declares the
+  // attribute as a vertex input and reads the swizzle, as the emitted shader does (so
+  // vec4(normal, occlusion) from one float4 attribute costs nothing). Others are uniforms.
+  struct Stream {
+    std::string input;  // GLSL input name, "a_normal" / "a_coord_morph3"
+    Type type = Type::Vec4;
+    std::string swizzle;  // "" = whole attribute
+  };
+  std::map<std::string, Stream> streams;
+  bool isDefault = false;
+};
+
+// The rig as a probe rig (families and arrays evaluated against its parameters).
+// Throws InputError when a count expression cannot be evaluated.
+ProbeRig probeRigFromRig(const Rig& rig, const RuleSet& rules);
+
+// Rigs used when no rig is given: morph_targets=2, influences=4, bones=4 with every
+// semantic no rule produces provided; then rigid (influences=1) and unskinned
+// (influences=0) variants without morph targets, the last one providing only vertex
+// streams. A rule is probed with the first whose `when` holds.
+std::vector<ProbeRig> defaultProbeRigs(const RuleSet& rules);
+
+// Expression environment of a probe rig (rig parameters and has()).
+ExprEnv probeEnv(const ProbeRig& rig);
+
+struct SnippetProbe {
+  GlslUnit unit;  // the probe vertex shader; sourceFiles[0] is the rule's file
+  std::vector<SourceLoc> snippetLines;  // where each emitted snippet line sits in the rules file
+};
+
+// Builds the probe shader for rules.rules[rule]. Throws InputError (located in the rules
+// file) for template errors, unknown semantics and semantics used but not in `needs`.
+SnippetProbe buildSnippetProbe(const RuleSet& rules, int rule, const ProbeRig& rig);
+
+// Compiles the probe with glslang; diagnostics point at the rule's YAML lines (columns
+// refined with refineSnippetColumns; errors in the probe scaffolding at the rule's name).
+CompileResult compileSnippetProbe(const SnippetProbe& probe, const Rule& rule);
+
+// glslang reports lines only. For diagnostics on a snippet line (file and line in
+// `snippetLines`), sets the column to the token the message quotes when it appears on
+// that YAML line, else to the first character of the snippet text.
+void refineSnippetColumns(std::vector<Diagnostic>& diags, const std::vector<SourceLoc>& snippetLines);
+// The same error (primary and related diagnostics) with refineSnippetColumns applied.
+InputError refineSnippetError(const InputError& e, const std::vector<SourceLoc>& snippetLines);
+
+}  // namespace sg

@@ -1,0 +1,261 @@
+#!/usr/bin/env bash
+# CLI conventions of `shadergen generate` (glslc style): exit codes, -o, --emit, --target-env,
+# -MD/-MF depfiles, atomic outputs, byte-identical reruns, the C++ header, --version/--help.
+#
+#   cli_test.sh <case> <shadergen> <source dir> <c++ compiler> <version> [ninja]
+set -uo pipefail
+case_name=$1 SG=$2 SRC=$3 CXX=$4 VERSION=$5 NINJA=${6:-}
+E=$SRC/examples/dawn
+T=$(mktemp -d "${TMPDIR:-/tmp}/sg-cli-XXXXXX")
+trap 'chmod -R u+w "$T" 2>/dev/null; rm -rf "$T"' EXIT
+cd "$T"
+
+fails=0
+fail() { echo "FAIL: $*" >&2; fails=$((fails + 1)); }
+ok() { echo "ok: $*"; }
+# expect <code> <description> -- command...
+expect() {
+  local want=$1 what=$2
+  shift 3
+  "$@" >"$T/last.out" 2>"$T/last.err"
+  local got=$?
+  if [ "$got" -eq "$want" ]; then ok "$what (exit $got)"; else
+    fail "$what: exit $got, expected $want"; sed 's/^/  | /' "$T/last.err" >&2
+  fi
+}
+DAWN=(--rig "$E/face.rig.yaml" -f "$E/face.frag" -r "$E/rules.yaml")
+no_temps() {  # no *.tmp.* / *.bak.* left anywhere under $1
+  local left
+  left=$(find "$1" -name '*.tmp.*' -o -name '*.bak.*')
+  [ -z "$left" ] && ok "no temporaries left in $(basename "$1")" || fail "temporaries left: $left"
+}
+
+case "$case_name" in
+
+version_help)
+  expect 0 "--version" -- "$SG" --version
+  grep -qx "shadergen $VERSION" last.out && ok "--version prints 'shadergen $VERSION'" || fail "--version printed: $(cat last.out)"
+  expect 0 "--help" -- "$SG" --help
+  grep -q "generate" last.out || fail "--help does not list generate"
+  expect 0 "generate --help" -- "$SG" generate --help
+  for opt in "-o" "--emit" "--target-env" "-O" "-MD" "-MF" "--capture" "--rig" "--fragment" "--rules"; do
+    grep -q -- "$opt" last.out && ok "generate --help mentions $opt" || fail "generate --help lacks $opt"
+  done
+  ;;
+
+exit_codes)
+  expect 0 "valid inputs" -- "$SG" generate "${DAWN[@]}" -o ok/face -q
+  expect 2 "no subcommand" -- "$SG"
+  expect 2 "unknown option" -- "$SG" generate "${DAWN[@]}" -o x -q --frobnicate
+  expect 2 "unknown subcommand" -- "$SG" frobnicate
+  expect 2 "missing --rig" -- "$SG" generate -f "$E/face.frag" -r "$E/rules.yaml" -o x
+  expect 2 "missing --fragment" -- "$SG" generate --rig "$E/face.rig.yaml" -r "$E/rules.yaml" -o x
+  expect 2 "missing --rules" -- "$SG" generate --rig "$E/face.rig.yaml" -f "$E/face.frag" -o x
+  expect 2 "bad --target-env" -- "$SG" generate "${DAWN[@]}" -o x --target-env=vulkan9
+  expect 2 "bad --emit" -- "$SG" generate "${DAWN[@]}" -o x --emit glsl,elf
+  expect 2 "-MF without a path" -- "$SG" generate "${DAWN[@]}" -o x -MF
+  printf 'rig: broken\ndeformers: [1, 2\n' >bad.rig.yaml
+  expect 1 "malformed rig (YAML)" -- "$SG" generate --rig bad.rig.yaml -f "$E/face.frag" -r "$E/rules.yaml" -o x -q
+  grep -Eq '^bad\.rig\.yaml:[0-9]+:[0-9]+: error: ' last.err && ok "diagnostic is file:line:col: error:" ||
+    fail "diagnostic format: $(head -1 last.err)"
+  sed 's/format: float32x3/format: float99/' "$E/face.rig.yaml" >badfmt.rig.yaml
+  expect 1 "rig with an unknown vertex format" -- "$SG" generate --rig badfmt.rig.yaml -f "$E/face.frag" -r "$E/rules.yaml" -o x -q
+  expect 1 "missing rig file" -- "$SG" generate --rig nope.rig.yaml -f "$E/face.frag" -r "$E/rules.yaml" -o x -q
+  printf 'include: [does-not-exist.yaml]\n' >bad.rules.yaml
+  expect 1 "rules including a missing file" -- "$SG" generate --rig "$E/face.rig.yaml" -f "$E/face.frag" -r bad.rules.yaml -o x -q
+  printf '#version 450\nlayout(location = 0) in vec3 Foo\nvoid main() {}\n' >bad.frag
+  expect 1 "fragment shader that does not compile" -- "$SG" generate --rig "$E/face.rig.yaml" -f bad.frag -r "$E/rules.yaml" -o x -q
+  [ ! -e x ] && [ ! -e x.vert ] && [ ! -e x.spv ] && ok "failed runs wrote nothing" || fail "a failed run wrote outputs"
+  no_temps "$T"
+  ;;
+
+outputs)
+  # -o names the file exactly when one kind is emitted (like glslc -o).
+  expect 0 "--emit spv -o dir/my.spv" -- "$SG" generate "${DAWN[@]}" --emit spv -o one/my.spv -q
+  [ "$(ls one)" = "my.spv" ] && ok "exactly one/my.spv written" || fail "one/ holds: $(ls one)"
+  [ "$(od -An -tx4 -N4 one/my.spv | tr -d ' ')" = "07230203" ] && ok "SPIR-V magic" || fail "one/my.spv is not SPIR-V"
+  expect 0 "--emit glsl -o shader.glsl" -- "$SG" generate "${DAWN[@]}" --emit glsl -o g/shader.glsl -q
+  [ "$(ls g)" = "shader.glsl" ] && grep -q '^#version 450' g/shader.glsl && ok "exactly g/shader.glsl written" || fail "g/ holds: $(ls g)"
+  # Several kinds: -o is a stem (a known suffix is stripped).
+  expect 0 "--emit all -o all/face" -- "$SG" generate "${DAWN[@]}" --emit glsl,spv,header,reflection -o all/face -q
+  [ "$(ls all | tr '\n' ' ')" = "face.json face.spv face.spv.h face.vert " ] && ok "stem outputs" || fail "all/ holds: $(ls all)"
+  expect 0 "--emit glsl,spv -o st/face.spv" -- "$SG" generate "${DAWN[@]}" --emit glsl,spv -o st/face.spv -q
+  [ "$(ls st | tr '\n' ' ')" = "face.spv face.vert " ] && ok "suffix stripped from the stem" || fail "st/ holds: $(ls st)"
+  python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["inputs"] and d["outputs"] and d["uniform_block"]["members"]' all/face.json &&
+    ok "reflection is JSON with inputs/outputs/uniforms" || fail "all/face.json is not the expected JSON"
+  # Default: the fragment shader's stem in the current directory, glsl + spv.
+  mkdir def && (cd def && "$SG" generate "${DAWN[@]}" -q) && [ "$(ls def | tr '\n' ' ')" = "face.spv face.vert " ] &&
+    ok "default outputs face.vert face.spv" || fail "default outputs: $(ls def)"
+  # --target-env, '=' and space syntax; the SPIR-V version word follows it.
+  for env in vulkan1.0:00010000 vulkan1.1:00010300 vulkan1.2:00010500 vulkan1.3:00010600; do
+    name=${env%%:*} want=${env##*:}
+    expect 0 "--target-env=$name" -- "$SG" generate "${DAWN[@]}" --emit spv -o "env/$name.spv" --target-env="$name" -q
+    got=$(od -An -tx4 -j4 -N4 "env/$name.spv" | tr -d ' ')
+    [ "$got" = "$want" ] && ok "$name -> SPIR-V version word $got" || fail "$name -> SPIR-V version word $got, expected $want"
+  done
+  expect 0 "--target-env vulkan1.2 (space)" -- "$SG" generate "${DAWN[@]}" --emit spv -o env/space.spv --target-env vulkan1.2 -q
+  cmp -s env/space.spv env/vulkan1.2.spv && ok "'=' and space syntax agree" || fail "--target-env syntaxes differ"
+  # -O: optimised SPIR-V still valid and different from the unoptimised one.
+  expect 0 "-O" -- "$SG" generate "${DAWN[@]}" --emit spv -o opt/face.spv -O -q
+  if command -v spirv-val >/dev/null; then
+    spirv-val opt/face.spv && ok "-O output passes spirv-val" || fail "-O output fails spirv-val"
+  fi
+  cmp -s opt/face.spv one/my.spv && fail "-O changed nothing" || ok "-O changes the SPIR-V"
+  # --capture: transform-feedback qualifiers only when asked.
+  expect 0 "--capture" -- "$SG" generate "${DAWN[@]}" --emit glsl -o cap/face.vert --capture -q
+  grep -q 'xfb_offset' cap/face.vert && ok "--capture adds xfb qualifiers" || fail "--capture output lacks xfb_offset"
+  grep -q 'xfb_' g/shader.glsl && fail "xfb qualifiers without --capture" || ok "no xfb qualifiers without --capture"
+  no_temps "$T"
+  ;;
+
+depfile)
+  expect 0 "-MD" -- "$SG" generate "${DAWN[@]}" --emit glsl,spv -o d/face -MD -q
+  [ -f d/face.vert.d ] && ok "-MD writes <first output>.d" || fail "no d/face.vert.d: $(ls d)"
+  expect 0 "-MF" -- "$SG" generate "${DAWN[@]}" --emit spv -o f/face.spv -MF f/deps.d -q
+  [ -f f/deps.d ] && [ ! -e f/face.spv.d ] && ok "-MF names the depfile" || fail "-MF: $(ls f)"
+  head -1 f/deps.d | grep -q '^f/face\.spv: \\$' && ok "-MF target is the output" || fail "-MF target line: $(head -1 f/deps.d)"
+  head -1 d/face.vert.d | grep -q '^d/face\.vert d/face\.spv: \\$' && ok "every output is a target, the first first" ||
+    fail "target line: $(head -1 d/face.vert.d)"
+  # Every input read: rig, fragment, the rules file and everything it includes, the template.
+  want=("$E/face.rig.yaml" "$E/face.frag" "$E/rules.yaml" "$SRC/templates/vertex.glsl")
+  for r in standard vocabulary morph skinning frames view projection; do want+=("$SRC/rules/$r.yaml"); done
+  deps=$(tail -n +2 d/face.vert.d | sed 's/^ *//; s/ *\\$//')
+  for w in "${want[@]}"; do
+    w=$(realpath -ms "$w")
+    grep -qxF "$w" <<<"$deps" && ok "depfile lists ${w#$SRC/}" || fail "depfile lacks $w"
+  done
+  [ "$(wc -l <<<"$deps")" -eq "${#want[@]}" ] && ok "depfile lists nothing else" || fail "depfile: $deps"
+  # Relative inputs stay relative (to the working directory, like a compiler's depfile).
+  mkdir rel && cp "$E/face.rig.yaml" "$E/face.frag" rel/ && printf 'include: [%s]\nvaryings:\n' "$SRC/rules/standard.yaml" >rel/r.yaml
+  sed -n '/^varyings:/,$p' "$E/rules.yaml" | tail -n +2 >>rel/r.yaml
+  (cd rel && "$SG" generate --rig face.rig.yaml -f face.frag -r r.yaml --emit spv -o out.spv -MD -q) && grep -q '^  face.rig.yaml \\$' rel/out.spv.d &&
+    ok "relative input paths as given" || fail "relative depfile: $(cat rel/out.spv.d)"
+  # Ninja reads it (paths with spaces too): build, no-op, touch an included rules file.
+  if [ -n "$NINJA" ]; then
+    mkdir -p "nj/in put" && cp "$E/face.rig.yaml" "$E/face.frag" "nj/in put/"
+    cp -r "$SRC/rules" "nj/in put/rules" && cp -r "$SRC/templates" "nj/in put/templates"
+    printf 'include: [rules/standard.yaml]\nvaryings:\n' >"nj/in put/face rules.yaml"
+    sed -n '/^varyings:/,$p' "$E/rules.yaml" | tail -n +2 >>"nj/in put/face rules.yaml"
+    cat >nj/build.ninja <<EOF
+rule sg
+  command = "$SG" generate --rig "in put/face.rig.yaml" -f "in put/face.frag" -r "in put/face rules.yaml" --templates "in put/templates" --emit spv,reflection -o out/face -MF out/face.d -q
+  depfile = out/face.d
+  deps = gcc
+build out/face.spv out/face.json: sg
+EOF
+    (cd nj && "$NINJA" >../nj1.log 2>&1) && ok "ninja builds with the depfile" || fail "ninja build: $(cat nj1.log)"
+    (cd nj && "$NINJA" -t deps out/face.spv) >nj-deps.log 2>&1
+    grep -q 'in put/rules/skinning.yaml' nj-deps.log && grep -q 'in put/templates/vertex.glsl' nj-deps.log &&
+      ok "ninja recorded included rules and the template (paths with spaces)" || fail "ninja deps: $(cat nj-deps.log)"
+    (cd nj && "$NINJA") | grep -q 'no work to do' && ok "ninja: no-op rebuild" || fail "ninja rebuilt without a change"
+    sleep 0.01; touch "nj/in put/rules/skinning.yaml"
+    (cd nj && "$NINJA" -d explain 2>&1) | grep -q 'skinning.yaml' && ok "touching an included rules file rebuilds" ||
+      fail "included rules file not a dependency"
+    sleep 0.01; touch "nj/in put/templates/vertex.glsl"
+    (cd nj && "$NINJA") | grep -q 'no work to do' && fail "touching the template did not rebuild" || ok "touching the template rebuilds"
+    (cd nj && "$NINJA") | grep -q 'no work to do' && ok "ninja: no-op again" || fail "ninja rebuilt without a change"
+  fi
+  no_temps "$T"
+  ;;
+
+atomic)
+  "$SG" generate "${DAWN[@]}" --emit glsl,spv,header,reflection -o out/face -MD -q || fail "first run"
+  cp -r out saved
+  # A bad rig: the run fails before writing; old outputs stay byte-identical.
+  printf 'rig: [oops\n' >bad.rig.yaml
+  expect 1 "bad rig over existing outputs" -- "$SG" generate --rig bad.rig.yaml -f "$E/face.frag" -r "$E/rules.yaml" \
+    --emit glsl,spv,header,reflection -o out/face -MD -q
+  diff -r saved out >/dev/null && ok "old outputs unchanged after an input error" || fail "outputs changed: $(diff -rq saved out)"
+  no_temps "$T/out"
+  # A write that fails half-way (the reflection's path is a directory): outputs renamed before
+  # the failure are put back, so every old output is unchanged and nothing new appears.
+  rm -rf blocked && mkdir blocked && printf 'old glsl\n' >blocked/face.vert && printf 'old spv\n' >blocked/face.spv
+  mkdir blocked/face.json
+  cp -r blocked blocked.saved
+  expect 1 "output path is a directory" -- "$SG" generate "${DAWN[@]}" --emit glsl,spv,header,reflection -o blocked/face -MD -q
+  grep -q "blocked/face.json" last.err && ok "error names the file" || fail "error: $(cat last.err)"
+  diff -r blocked.saved blocked >/dev/null && ok "all-or-nothing: old outputs restored, no new ones" ||
+    fail "partial write: $(diff -rq blocked.saved blocked)"
+  no_temps "$T/blocked"
+  # A read-only output directory (meaningless as root, who may write anyway).
+  if [ "$(id -u)" -ne 0 ]; then
+    chmod a-w out
+    expect 1 "read-only output directory" -- "$SG" generate "${DAWN[@]}" --emit glsl,spv,header,reflection -o out/face -MD -q
+    chmod u+w out
+    diff -r saved out >/dev/null && ok "old outputs unchanged" || fail "outputs changed"
+    no_temps "$T/out"
+  else
+    echo "skip: read-only directory case (running as root)"
+  fi
+  # A successful rerun replaces them and cleans up.
+  expect 0 "rerun" -- "$SG" generate "${DAWN[@]}" --emit glsl,spv,header,reflection -o out/face -MD -q
+  no_temps "$T/out"
+  ;;
+
+deterministic)
+  for d in a b; do  # same inputs, two output directories
+    "$SG" generate "${DAWN[@]}" --emit glsl,spv,header,reflection -o "$d/out/face" -MD -q &&
+      "$SG" generate "${DAWN[@]}" --emit spv -o "$d/opt/face.spv" -O -MD -q --target-env=vulkan1.2 &&
+      "$SG" generate "${DAWN[@]}" --emit glsl,spv -o "$d/cap/face" --capture -MD -q || fail "run into $d"
+  done
+  n=0
+  while IFS= read -r f; do
+    n=$((n + 1))
+    if [[ $f == *.d ]]; then  # the target line names the output path; the rest must match
+      cmp -s <(tail -n +2 "a/$f") <(tail -n +2 "b/$f") && ok "identical (modulo target): $f" || fail "differs: $f"
+    else
+      cmp -s "a/$f" "b/$f" && ok "identical: $f" || fail "differs: $f"
+    fi
+  done < <(cd a && find . -type f | sort)
+  [ "$n" -eq 10 ] && ok "compared $n files" || fail "compared $n files, expected 10"
+  # Different output directories must not leak into the shader outputs either.
+  "$SG" generate "${DAWN[@]}" --emit glsl,spv,header,reflection -o elsewhere/deep/face -q
+  for f in face.vert face.spv face.spv.h face.json; do
+    cmp -s "a/out/$f" "elsewhere/deep/$f" && ok "same $f from another output dir" || fail "$f depends on the output dir"
+  done
+  ;;
+
+header)
+  "$SG" generate "${DAWN[@]}" --emit spv,header -o gen/face -q || fail "generate"
+  "$SG" generate "${DAWN[@]}" --emit header -o gen/2nd-shader.spv.h -q || fail "generate 2nd-shader"
+  grep -q 'face_spv\[\]' gen/face.spv.h && ok "symbol face_spv from the stem" || fail "no face_spv in header"
+  grep -q 'sg_2nd_shader_spv\[\]' gen/2nd-shader.spv.h && ok "symbol sg_2nd_shader_spv (sanitised)" || fail "2nd-shader symbol: $(grep -o '[a-z_0-9]*\[\]' gen/2nd-shader.spv.h)"
+  bytes=$(stat -c %s gen/face.spv)
+  cat >use.cpp <<'EOF'
+#include "face.spv.h"
+#include "face.spv.h"  // include guard
+#include "2nd-shader.spv.h"
+#include <cstdio>
+#include <cstring>
+#include <vector>
+size_t other_tu_size();
+int main() {
+  static_assert(sizeof(face_spv[0]) == 4, "32-bit words");
+  if (face_spv[0] != 0x07230203u || face_spv_size != sizeof(face_spv) || face_spv_size % 4) return 1;
+  if (face_spv_size != other_tu_size()) return 2;
+  if (std::memcmp(face_spv, sg_2nd_shader_spv, face_spv_size) != 0) return 3;
+  std::vector<uint32_t> words(face_spv, face_spv + face_spv_size / 4);
+  std::printf("%zu\n", words.size() * 4);
+  return 0;
+}
+EOF
+  printf '#include "face.spv.h"\nsize_t other_tu_size() { return face_spv_size; }\n' >other.cpp
+  if "$CXX" -std=c++17 -Wall -Wextra -Werror -pedantic -Igen use.cpp other.cpp -o use 2>cxx.log; then
+    ok "header compiles in two C++ TUs (-Wall -Wextra -Werror -pedantic)"
+    out=$(./use) && [ "$out" = "$bytes" ] && ok "face_spv_size == size of face.spv ($bytes bytes)" || fail "run: exit $? output '$out' (want $bytes)"
+  else
+    fail "header does not compile: $(cat cxx.log)"
+  fi
+  ;;
+
+*)
+  echo "unknown case $case_name" >&2
+  exit 2
+  ;;
+esac
+
+if [ "$fails" -ne 0 ]; then
+  echo "$fails check(s) failed" >&2
+  exit 1
+fi
+echo "all checks passed"
