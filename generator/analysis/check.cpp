@@ -7,6 +7,7 @@
 #include <map>
 #include <regex>
 #include <set>
+#include <sstream>
 
 #include "analysis/cost.h"
 #include "analysis/probe.h"
@@ -31,9 +32,13 @@ struct RuleKeys {
   SourceLoc cost, when, glsl;
 };
 
-SourceLoc valueLoc(const YAML::Node& n, const std::string& file) {
+SourceLoc valueLoc(const YAML::Node& n, const std::string& file, const std::vector<std::string>& lines) {
   SourceLoc l = locOf(n, file);
-  if (n.IsDefined() && n.Tag() == "!" && l.col > 0) l.col += 1;  // quoted scalars start after the quote
+  // Quoted scalars start after the quote (block scalars '|' stay on the indicator).
+  if (l.line >= 1 && l.line <= static_cast<int>(lines.size()) && l.col >= 1) {
+    const std::string& raw = lines[static_cast<size_t>(l.line - 1)];
+    if (static_cast<size_t>(l.col) <= raw.size() && (raw[l.col - 1] == '"' || raw[l.col - 1] == '\'')) l.col += 1;
+  }
   return l;
 }
 
@@ -41,8 +46,12 @@ std::map<std::string, RuleKeys> locateRuleKeys(const RuleSet& rules) {
   std::map<std::string, RuleKeys> out;
   for (const auto& file : rules.files) {
     YAML::Node root;
+    std::vector<std::string> lines;
     try {
-      root = parseYaml(readInputFile(file), file);
+      std::string text = readInputFile(file);
+      root = parseYaml(text, file);
+      std::istringstream in(text);
+      for (std::string l; std::getline(in, l);) lines.push_back(l);
     } catch (const std::exception&) {
       continue;
     }
@@ -50,9 +59,9 @@ std::map<std::string, RuleKeys> locateRuleKeys(const RuleSet& rules) {
     for (const auto& r : root["rules"]) {
       if (!r.IsMap() || !r["name"] || !r["name"].IsScalar()) continue;
       RuleKeys k;
-      k.cost = valueLoc(r["cost"], file);
-      k.when = valueLoc(r["when"], file);
-      k.glsl = valueLoc(r["glsl"], file);
+      k.cost = valueLoc(r["cost"], file, lines);
+      k.when = valueLoc(r["when"], file, lines);
+      k.glsl = valueLoc(r["glsl"], file, lines);
       out.emplace(r["name"].Scalar(), k);
     }
   }
@@ -444,7 +453,7 @@ class Checker {
       if (!c.ok) {
         for (auto d : c.diagnostics) {
           if (d.loc.file.empty() || d.loc.line == 0) d.loc = rule.loc;
-          d.message = fmt::format("{} [snippet of rule '{}' compiled alone for {}]", d.message, rule.name, chosen->name);
+          d.message = fmt::format("{} (snippet of '{}' compiled alone for {})", d.message, rule.name, chosen->name);
           report_.findings.push_back(d);
         }
         report_.costs.push_back(row);

@@ -363,8 +363,12 @@ AutoCost measureRuleCost(const RuleSet& rules, int r, const ProbeRig& rig) {
   }
   CompileResult c = compileSnippetProbe(probe, rule);
   if (!c.ok) {
-    for (const auto& d : c.diagnostics)  // glslang's trailing "compilation terminated" adds nothing
-      if (d.severity == Severity::Error && d.message.find("compilation terminated") == std::string::npos)
+    // glslang's trailing "compilation terminated" adds nothing, nor do errors that cascade
+    // from the first one on the same line.
+    std::set<std::pair<std::string, int>> lines;
+    for (const auto& d : c.diagnostics)
+      if (d.severity == Severity::Error && d.message.find("compilation terminated") == std::string::npos &&
+          (d.loc.line == 0 || lines.insert({d.loc.file, d.loc.line}).second))
         res.diagnostics.push_back(d);
     if (res.diagnostics.empty())
       res.diagnostics.push_back(Diagnostic{Severity::Error, rule.loc,

@@ -275,7 +275,7 @@ std::string formatUnreachable(const Problem& p, const std::vector<UnreachableGoa
       out += ": no rule derives it from anything a rig could provide\n";
     } else {
       for (size_t i = 0; i < g.missingInputs.size(); ++i)
-        out += fmt::format("{}{}", i == 0 ? ": possible if the rig provided " : "; or ",
+        out += fmt::format("{}{{{}}}", i == 0 ? ": possible if the rig also provided " : " or ",
                            compactFactList(g.missingInputs[i]));
       out += "\n";
     }

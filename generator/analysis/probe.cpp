@@ -195,6 +195,7 @@ SnippetProbe buildSnippetProbe(const RuleSet& rules, int r, const ProbeRig& rig)
   std::vector<ExpandedLine> lines = expandSnippet(rule.glsl, ctx);
 
   SnippetProbe probe;
+  probe.productType = std::string(glslName(product->type));
   probe.unit.stage = Stage::Vertex;
   probe.unit.fileName = fmt::format("<probe of rule '{}'>", rule.name);
   std::string ruleFile = rule.loc.file;
@@ -235,6 +236,8 @@ SnippetProbe buildSnippetProbe(const RuleSet& rules, int r, const ProbeRig& rig)
     probe.snippetLines.push_back(l.loc);
     expect = l.loc.line + 1;
   }
+  probe.end = rule.glsl.empty() ? rule.loc : rule.glsl.back().loc;
+  if (!rule.glsl.empty() && probe.end.col > 0) probe.end.col += static_cast<int>(rule.glsl.back().text.size());
   s += fmt::format("#line {} 0\n", line + 1);
   s += fmt::format("  sg_probe_out = {};\n", outName);
   s += "}\n";
@@ -243,11 +246,18 @@ SnippetProbe buildSnippetProbe(const RuleSet& rules, int r, const ProbeRig& rig)
 
 CompileResult compileSnippetProbe(const SnippetProbe& probe, const Rule& rule) {
   CompileResult r = compileGlsl(probe.unit, TargetEnv::Vulkan1_0);
+  for (auto& d : r.diagnostics) {
+    // glslang's "'' :  syntax error..." names no token.
+    if (d.message.rfind("'' :", 0) == 0) d.message = d.message.substr(d.message.find_first_not_of(" ", 4));
+  }
   for (auto& d : r.diagnostics)
     if (d.loc.file == probe.unit.fileName) {
-      d.message = fmt::format("snippet of rule '{}' does not fit its declaration (product '{}'): {}", rule.name,
-                              rule.produces, d.message);
-      d.loc = rule.loc;
+      bool syntax = d.message.find("syntax error") != std::string::npos;
+      d.message = syntax ? fmt::format("at the end of the snippet of rule '{}': {} (a missing ';' or bracket?)",
+                                       rule.name, d.message)
+                         : fmt::format("the snippet of rule '{}' does not fit its product '{}' ({}): {}", rule.name,
+                                       rule.produces, probe.productType, d.message);
+      d.loc = probe.end.line ? probe.end : rule.loc;
     }
   refineSnippetColumns(r.diagnostics, probe.snippetLines);
   return r;
@@ -284,6 +294,7 @@ void refineSnippetColumns(std::vector<Diagnostic>& diags, const std::vector<Sour
     size_t q2 = q1 == std::string::npos ? std::string::npos : d.message.find('\'', q1 + 1);
     if (q2 == std::string::npos || q2 == q1 + 1) continue;
     std::string token = d.message.substr(q1 + 1, q2 - q1 - 1);
+    if (token == "assign") token = "=";  // glslang names the assignment operator
     if (token.find_first_not_of(' ') == std::string::npos) continue;
     std::string raw = rawLine(d.loc.file, d.loc.line);
     size_t from = static_cast<size_t>(std::max(0, start->col - 1));

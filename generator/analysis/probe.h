@@ -53,6 +53,8 @@ ExprEnv probeEnv(const ProbeRig& rig);
 struct SnippetProbe {
   GlslUnit unit;  // the probe vertex shader; sourceFiles[0] is the rule's file
   std::vector<SourceLoc> snippetLines;  // where each emitted snippet line sits in the rules file
+  std::string productType;  // GLSL type of the product
+  SourceLoc end;  // just past the last snippet line's text (where a missing ';' is reported)
 };
 
 // Builds the probe shader for rules.rules[rule]. Throws InputError (located in the rules
@@ -60,7 +62,8 @@ struct SnippetProbe {
 SnippetProbe buildSnippetProbe(const RuleSet& rules, int rule, const ProbeRig& rig);
 
 // Compiles the probe with glslang; diagnostics point at the rule's YAML lines (columns
-// refined with refineSnippetColumns; errors in the probe scaffolding at the rule's name).
+// refined with refineSnippetColumns). Errors glslang reports after the snippet (a missing
+// ';' or bracket shows up at the next token) point just past the snippet's last line.
 CompileResult compileSnippetProbe(const SnippetProbe& probe, const Rule& rule);
 
 // glslang reports lines only. For diagnostics on a snippet line (file and line in

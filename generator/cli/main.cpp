@@ -31,7 +31,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    // Usage errors: "shadergen: error: ..." like glslc, exit status 2.
+    std::cerr << "shadergen: error: " << e.what() << "\nRun 'shadergen --help' or 'shadergen <command> --help' for usage.\n";
     return 2;
   }
   try {

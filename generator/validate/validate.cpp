@@ -45,18 +45,19 @@ float quantize(VertexFormat f, float v) {
   }
 }
 
-void putComponent(std::vector<uint8_t>& out, VertexFormat f, float v) {
+// Writes v in format f at `dst`; returns the bytes written.
+size_t putComponent(uint8_t* dst, VertexFormat f, float v) {
   auto put = [&](auto x) {
-    const auto* p = reinterpret_cast<const uint8_t*>(&x);
-    out.insert(out.end(), p, p + sizeof(x));
+    std::memcpy(dst, &x, sizeof(x));
+    return sizeof(x);
   };
   switch (f) {
-    case VertexFormat::Unorm8x4: put(static_cast<uint8_t>(std::lround(v * 255.0f))); break;
-    case VertexFormat::Uint8x4: put(static_cast<uint8_t>(v)); break;
-    case VertexFormat::Unorm16x4: put(static_cast<uint16_t>(std::lround(v * 65535.0f))); break;
-    case VertexFormat::Uint16x4: put(static_cast<uint16_t>(v)); break;
-    case VertexFormat::Uint32x4: put(static_cast<uint32_t>(v)); break;
-    default: put(v); break;
+    case VertexFormat::Unorm8x4: return put(static_cast<uint8_t>(std::lround(v * 255.0f)));
+    case VertexFormat::Uint8x4: return put(static_cast<uint8_t>(v));
+    case VertexFormat::Unorm16x4: return put(static_cast<uint16_t>(std::lround(v * 65535.0f)));
+    case VertexFormat::Uint16x4: return put(static_cast<uint16_t>(v));
+    case VertexFormat::Uint32x4: return put(static_cast<uint32_t>(v));
+    default: return put(v);
   }
 }
 
@@ -88,12 +89,13 @@ rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
 
 rt::VertexStream buildStream(const Rig& rig, const EmittedInput& in, const rt::Mesh& mesh) {
   const RigAttribute& a = rig.attributes[in.attribute];
-  int n = formatComponents(a.format);
+  const int n = formatComponents(a.format);
   rt::VertexStream s;
   s.location = static_cast<uint32_t>(in.location);
   s.format = vkFormat(a.format);
   s.stride = static_cast<uint32_t>(formatBytes(a.format));
-  std::vector<std::vector<float>> comps(mesh.vertexCount, std::vector<float>(static_cast<size_t>(n), 0.0f));
+  // Gather the parts into one flat array of n components per vertex, then encode.
+  std::vector<float> comps(mesh.vertexCount * static_cast<size_t>(n), 0.0f);
   for (const auto& p : a.provides) {
     std::string sem = partSemantic(a, p, in.target);
     if (!mesh.has(sem))
@@ -101,11 +103,12 @@ rt::VertexStream buildStream(const Rig& rig, const EmittedInput& in, const rt::M
     const auto& src = mesh.at(sem);
     std::string swz = p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(n)) : p.swizzle;
     for (size_t v = 0; v < mesh.vertexCount; ++v)
-      for (size_t k = 0; k < swz.size(); ++k) comps[v][static_cast<size_t>(swizzleIndex(swz[k]))] = src[v][static_cast<int>(k)];
+      for (size_t k = 0; k < swz.size(); ++k)
+        comps[v * static_cast<size_t>(n) + static_cast<size_t>(swizzleIndex(swz[k]))] = src[v][static_cast<int>(k)];
   }
-  s.data.reserve(mesh.vertexCount * s.stride);
-  for (const auto& c : comps)
-    for (float x : c) putComponent(s.data, a.format, x);
+  s.data.resize(mesh.vertexCount * s.stride);
+  uint8_t* dst = s.data.data();
+  for (float x : comps) dst += putComponent(dst, a.format, x);
   return s;
 }
 
@@ -194,12 +197,16 @@ Validator::Validator(const ValidateOptions& opts) : opts_(opts) {
 Validator::~Validator() = default;
 
 RunReport Validator::runOne(const GenerateResult& r, const ValidationScene& scene, const std::string& label) {
+  return runQuantized(r, quantizedMesh(r.in.rig, scene.mesh), scene, label);
+}
+
+RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh, const ValidationScene& scene,
+                                  const std::string& label) {
   RunReport rep;
   rep.label = label;
   rep.planCost = r.plan.cost;
   for (int a : r.plan.actions) rep.rules.push_back(r.in.problem.actions[a].name);
   const Rig& rig = r.in.rig;
-  rt::Mesh mesh = quantizedMesh(rig, scene.mesh);
   rep.vertices = mesh.vertexCount;
 
   rt::RunRequest req;
@@ -294,7 +301,9 @@ ValidateReport Validator::run(const ValidationScene& scene) {
   auto t0 = Clock::now();
   GenerateResult chosen = generateFrom(in, gen);
   double genMs = msSince(t0);
-  report.runs.push_back(runOne(chosen, scene, "chosen plan"));
+  // Every run shares the rig's attribute formats: quantize the mesh once.
+  const rt::Mesh mesh = quantizedMesh(chosen.in.rig, scene.mesh);
+  report.runs.push_back(runQuantized(chosen, mesh, scene, "chosen plan"));
   report.runs.back().generateMs = genMs;
 
   if (opts_.crossCheck) {
@@ -320,7 +329,7 @@ ValidateReport Validator::run(const ValidationScene& scene) {
           continue;  // the alternative needs something this rig cannot provide
         }
         double ms = msSince(tg);
-        RunReport rr = runOne(r, scene, fmt::format("forced {} for {}", alt, p.facts[fact].name));
+        RunReport rr = runQuantized(r, mesh, scene, fmt::format("forced {} for {}", alt, p.facts[fact].name));
         rr.generateMs = ms;
         if (!seenPlans.insert(rr.rules).second) continue;
         report.runs.push_back(std::move(rr));

@@ -80,6 +80,10 @@ class Validator {
   RunReport runOne(const GenerateResult& r, const ValidationScene& scene, const std::string& label);
 
  private:
+  // runOne on a mesh already quantized to the rig's attribute formats.
+  RunReport runQuantized(const GenerateResult& r, const rt::Mesh& mesh, const ValidationScene& scene,
+                         const std::string& label);
+
   ValidateOptions opts_;
   std::unique_ptr<rt::Harness> harness_;
   size_t reportedMessages_ = 0;  // layer messages already attributed to a run (setup's go to the first)

@@ -59,8 +59,9 @@ void expectBroken(const sg::ValidateReport& rep, const std::string& rule, const 
   EXPECT_EQ(failingOutputs(run), expected);
   EXPECT_TRUE(run.validationMessages.empty());
   // A broken rule is off by far more than the tolerance, not by rounding.
-  for (const auto& o : run.outputs)
+  for (const auto& o : run.outputs) {
     if (!o.pass) EXPECT_GT(o.maxRelError, 1e-3) << o.name;
+  }
 }
 
 TEST(BreakRules, UnbrokenCopyPasses) {

@@ -138,7 +138,7 @@ INSTANTIATE_TEST_SUITE_P(
                 {"skin_matrix_model", "clip_from_eye"}, {"ndotv_eye_space"}},
         RigCase{"unskinned_identity", "unskinned_identity.rig.yaml", "basic.frag", "limb",
                 {"skin_matrix_identity", "clip_from_view_projection"}, {}}),
-    [](const ::testing::TestParamInfo<RigCase>& info) { return std::string(info.param.name); });
+    [](const ::testing::TestParamInfo<RigCase>& p) { return std::string(p.param.name); });
 
 // The quantization path matters: with unorm8 weights, the reference fed the raw float weights
 // is off by far more than the tolerance, so the unorm8 rig above only passes because the
