@@ -2,7 +2,7 @@
 // through shadergen::runtime, and checks gl_Position of every vertex against the same
 // formula computed here on the CPU (docs/semantics.md: clip.position).
 //
-//   face: SPIR-V embedded with EMBED      -> #include "face.spv.h" (face_spv[], face_spv_size)
+//   face: SPIR-V embedded with EMBED      -> #include "face.spv.h" (face_shader.cpp)
 //   prop: SPIR-V loaded from its .spv file -> SHADERGEN_PROP_SPV (compile definition)
 // Both read their vertex-input / uniform / output layout from the generated reflection
 // JSON (SHADERGEN_<NAME>_REFLECTION), because the generator decides which rig attributes
@@ -23,11 +23,12 @@
 #include <string>
 #include <vector>
 
-#include "face.spv.h"  // generated: static const uint32_t face_spv[]; face_spv_size (bytes)
 #include "runtime/procedural.h"
 #include "runtime/vk_harness.h"
 
 using json = nlohmann::json;
+
+std::vector<uint32_t> faceShaderWords();  // face_shader.cpp: the embedded face.spv.h
 
 namespace {
 
@@ -206,8 +207,7 @@ int main() {
     facePose.bones[0] = glm::rotate(glm::mat4(1.0f), glm::radians(30.0f), glm::vec3(1, 0, 0));
     facePose.bones[1] = glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, -0.1f, 0.05f));
     facePose.morphWeights = {0.5f, 0.25f, 0.0f, 0.0f, 1.0f};
-    std::vector<uint32_t> faceWords(face_spv, face_spv + face_spv_size / sizeof(uint32_t));
-    bool ok = check(harness, "face", faceWords, readJson(SHADERGEN_FACE_REFLECTION), head, facePose);
+    bool ok = check(harness, "face", faceShaderWords(), readJson(SHADERGEN_FACE_REFLECTION), head, facePose);
 
     // The prop: unskinned, placed by its model matrix.
     sg::rt::MeshOptions propOpts;

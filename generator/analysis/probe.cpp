@@ -305,7 +305,8 @@ void refineSnippetColumns(std::vector<Diagnostic>& diags, const std::vector<Sour
 
 InputError refineSnippetError(const InputError& e, const std::vector<SourceLoc>& snippetLines) {
   std::vector<Diagnostic> all{e.diagnostic()};
-  all.insert(all.end(), e.related.begin(), e.related.end());
+  for (const auto& d : e.related)  // glslang's closing "compilation terminated" adds nothing
+    if (d.message.find("compilation terminated") == std::string::npos) all.push_back(d);
   refineSnippetColumns(all, snippetLines);
   InputError out(all.front());
   out.related.assign(all.begin() + 1, all.end());

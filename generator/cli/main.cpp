@@ -37,6 +37,9 @@ int main(int argc, char** argv) {
   }
   try {
     return state.run();
+  } catch (const CLI::ParseError& e) {  // option values checked after parsing (--map, --emit)
+    std::cerr << "shadergen: error: " << e.what() << "\n";
+    return 2;
   } catch (const sg::InputError& e) {
     std::cerr << sg::renderDiagnostic(e.diagnostic()) << "\n";
     size_t shown = 0;

@@ -15,9 +15,22 @@ namespace sg::testing {
 
 inline std::string sourceDir() { return SG_SOURCE_DIR; }
 
-// A fresh directory per test (removed at the start, kept afterwards for inspection).
+inline std::filesystem::path scratchRoot() {
+  return std::filesystem::temp_directory_path() / ("sg_analysis_" + std::to_string(::getpid()));
+}
+
+// Removes this process's scratch files when the test program exits.
+struct ScratchCleanup {
+  ~ScratchCleanup() {
+    std::error_code ec;
+    std::filesystem::remove_all(scratchRoot(), ec);
+  }
+};
+inline ScratchCleanup scratchCleanup;
+
+// A fresh directory per test (removed when the test program exits).
 inline std::filesystem::path scratchDir(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / ("sg_analysis_" + std::to_string(::getpid())) / name;
+  auto dir = scratchRoot() / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

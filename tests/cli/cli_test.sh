@@ -54,6 +54,8 @@ exit_codes)
   expect 2 "bad --target-env" -- "$SG" generate "${DAWN[@]}" -o x --target-env=vulkan9
   expect 2 "bad --emit" -- "$SG" generate "${DAWN[@]}" -o x --emit glsl,elf
   expect 2 "-MF without a path" -- "$SG" generate "${DAWN[@]}" -o x -MF
+  expect 2 "malformed --map" -- "$SG" generate "${DAWN[@]}" -o x --map bogus -q
+  grep -q '^shadergen: error: ' last.err && ok "usage errors start with 'shadergen: error:'" || fail "usage error: $(head -1 last.err)"
   printf 'rig: broken\ndeformers: [1, 2\n' >bad.rig.yaml
   expect 1 "malformed rig (YAML)" -- "$SG" generate --rig bad.rig.yaml -f "$E/face.frag" -r "$E/rules.yaml" -o x -q
   grep -Eq '^bad\.rig\.yaml:[0-9]+:[0-9]+: error: ' last.err && ok "diagnostic is file:line:col: error:" ||
