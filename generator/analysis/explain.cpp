@@ -11,15 +11,6 @@
 namespace sg {
 namespace {
 
-std::pair<std::string, int64_t> splitIndexed(const std::string& s) {
-  auto lb = s.find('[');
-  if (lb == std::string::npos || s.back() != ']') return {s, -1};
-  try {
-    return {s.substr(0, lb), std::stoll(s.substr(lb + 1, s.size() - lb - 2))};
-  } catch (const std::exception&) {
-    return {s, -1};
-  }
-}
 
 std::string sourceOf(const LoadedInputs& in, int f) {
   const Fact& fact = in.problem.facts[f];

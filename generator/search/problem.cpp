@@ -17,6 +17,16 @@ namespace sg {
 
 std::string factRef(int fact) { return std::string(1, kFactRefBegin) + std::to_string(fact) + kFactRefEnd; }
 
+std::pair<std::string, int64_t> splitIndexed(const std::string& s) {
+  auto lb = s.find('[');
+  if (lb == std::string::npos || s.back() != ']') return {s, -1};
+  try {
+    return {s.substr(0, lb), std::stoll(s.substr(lb + 1, s.size() - lb - 2))};
+  } catch (const std::exception&) {
+    return {s, -1};
+  }
+}
+
 int Problem::findFact(const std::string& name) const {
   for (size_t i = 0; i < facts.size(); ++i)
     if (facts[i].name == name) return static_cast<int>(i);
@@ -27,16 +37,6 @@ namespace {
 
 std::string indexed(const std::string& name, int64_t i) { return fmt::format("{}[{}]", name, i); }
 
-// Splits "skin.joints[1]" into ("skin.joints", 1); plain names give index -1.
-std::pair<std::string, int64_t> splitIndexed(const std::string& s) {
-  auto lb = s.find('[');
-  if (lb == std::string::npos || s.back() != ']') return {s, -1};
-  try {
-    return {s.substr(0, lb), std::stoll(s.substr(lb + 1, s.size() - lb - 2))};
-  } catch (const std::exception&) {
-    return {s, -1};
-  }
-}
 
 class Builder {
  public:

@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/diagnostics.h"
@@ -35,6 +36,9 @@ struct CodeLine {
 constexpr char kFactRefBegin = '\x01';
 constexpr char kFactRefEnd = '\x02';
 std::string factRef(int fact);
+
+// Splits "skin.joints[1]" into ("skin.joints", 1); plain names give index -1.
+std::pair<std::string, int64_t> splitIndexed(const std::string& name);
 
 struct Action {
   std::string name;  // rule name
