@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "common/diagnostics.h"
+#include "core_test_util.h"
 #include "common/glsl_compile.h"
 #include "common/types.h"
 #include "emit/glsl_emitter.h"
@@ -53,21 +54,8 @@ int lineOf(const std::string& text, const std::string& needle) {
   return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
 }
 
-void writeText(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
-
-// A fresh directory per test (tests run as separate processes, possibly in parallel).
-std::filesystem::path freshDir(const std::string& tag) {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  std::string name = std::string("sg_emit_") + (info ? info->test_suite_name() : "x") + "_" +
-                     (info ? info->name() : "x") + "_" + tag + "_" + std::to_string(::getpid());
-  auto dir = std::filesystem::temp_directory_path() / name;
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
+using sgtest::freshDir;
+using sgtest::writeText;
 
 sg::GenerateOptions dawnOptions() {
   sg::GenerateOptions o;

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "common/diagnostics.h"
+#include "core_test_util.h"
 #include "common/types.h"
 #include "interface/fragment_interface.h"
 #include "rig/rig.h"
@@ -71,21 +72,6 @@ std::string readText(const std::string& path) {
   return ss.str();
 }
 
-void writeText(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
-
-// A fresh directory per test (tests run as separate processes, possibly in parallel).
-std::filesystem::path freshDir(const std::string& tag) {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  std::string name = std::string("sg_core_") + (info ? info->test_suite_name() : "x") + "_" +
-                     (info ? info->name() : "x") + "_" + tag + "_" + std::to_string(::getpid());
-  auto dir = std::filesystem::temp_directory_path() / name;
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
 
 }  // namespace sgtest
 
