@@ -5,9 +5,27 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 
+#include "common/diagnostics.h"
+
 namespace sgtest {
+
+// Runs `f` and returns the diagnostic of the InputError it throws; records a test failure
+// (and returns an empty diagnostic) if it throws nothing or something else.
+inline sg::Diagnostic errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const sg::InputError& e) {
+    return e.diagnostic();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected sg::InputError, got another exception: " << e.what();
+    return {};
+  }
+  ADD_FAILURE() << "expected sg::InputError, nothing was thrown";
+  return {};
+}
 
 inline void writeText(const std::filesystem::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);

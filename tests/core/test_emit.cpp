@@ -32,18 +32,7 @@ const std::string kDawnFrag = kSrc + "/examples/dawn/face.frag";
 const std::string kDawnRules = kSrc + "/examples/dawn/rules.yaml";
 const std::string kStandardRules = kSrc + "/rules/standard.yaml";
 
-sg::Diagnostic errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const sg::InputError& e) {
-    return e.diagnostic();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected sg::InputError, got another exception: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "expected sg::InputError, nothing was thrown";
-  return {};
-}
+using sgtest::errorOf;
 
 int lineOf(const std::string& text, const std::string& needle) {
   size_t at = text.find(needle);

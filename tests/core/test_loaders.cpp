@@ -25,20 +25,6 @@
 
 namespace sgtest {
 
-// Runs `f` and returns the diagnostic of the InputError it throws; records a test failure
-// (and returns an empty diagnostic) if it throws nothing or something else.
-sg::Diagnostic errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const sg::InputError& e) {
-    return e.diagnostic();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected sg::InputError, got another exception: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "expected sg::InputError, nothing was thrown";
-  return {};
-}
 
 struct Pos {
   int line = 0;
