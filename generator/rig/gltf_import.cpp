@@ -865,8 +865,9 @@ bool insideRoot(BufferFiles& ctx, const std::string& path) {
 }
 
 bool bufferFileExists(const std::string& path, void* user) {
+  auto& ctx = *static_cast<BufferFiles*>(user);
   std::error_code ec;
-  return std::filesystem::exists(path, ec) && insideRoot(*static_cast<BufferFiles*>(user), path);
+  return (ctx.root.empty() || std::filesystem::exists(path, ec)) && insideRoot(ctx, path);
 }
 std::string keepPath(const std::string& path, void*) { return path; }
 bool readBufferFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
