@@ -91,6 +91,7 @@ std::optional<Plan> integerProgramSearch(const Problem& p, SearchStats* stats, c
       if (!isInit[q]) succ[q].push_back(p.actions[a].add);
     }
   }
+  if (cols == 0) return finish(Plan{});  // every goal provided (GLPK rejects empty programs)
   std::vector<int> comp = components(nf, succ);
   std::vector<int> compSize(nf + 1, 0);
   for (int f = 0; f < nf; ++f) ++compSize[comp[f]];
