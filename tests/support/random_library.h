@@ -91,7 +91,10 @@ inline sg::Problem randomLibrary(const LibraryShape& shape) {
   for (int f = inputs; f < static_cast<int>(p.facts.size()); ++f)
     if (layerOf[f] * 2 > layers) upper.push_back(f);
   std::shuffle(upper.begin(), upper.end(), rng);
-  int goals = std::min<int>(uniform(shape.minGoals, shape.maxGoals), static_cast<int>(upper.size()));
+  // Tiny libraries have few upper semantics: then the lower ones are requested too.
+  for (int f = static_cast<int>(p.facts.size()) - 1; f >= inputs; --f)
+    if (layerOf[f] * 2 <= layers) upper.push_back(f);
+  int goals = std::min<int>(uniform(shape.minGoals, shape.maxGoals), computed);
   p.goals.assign(upper.begin(), upper.begin() + goals);
   std::sort(p.goals.begin(), p.goals.end());
   return p;
