@@ -14,6 +14,7 @@ packages=(
   libglm-dev libyaml-cpp-dev libfmt-dev libcli11-dev
   libtinygltf-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev graphviz
+  libembree-dev
 )
 missing=()
 for p in "${packages[@]}"; do
