@@ -36,6 +36,8 @@ struct GltfImportOptions {
   int mesh = 0;
   int primitive = 0;
   int maxBones = kMaxBonePalette;  // tests lower it to exercise the diagnostic
+  // Dawn's layout: _OCCLUSION in normal.w (float32x4), target deltas in the normal deltas' w.
+  bool packOcclusionInNormal = false;
 };
 
 // One attribute of the primitive as the file stores it, and what the rig made of it.
