@@ -20,6 +20,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev graphviz
   clang-14 libclang-rt-14-dev
   libglpk-dev
+  libembree-dev
 )
 missing=()
 for p in "${packages[@]}"; do
