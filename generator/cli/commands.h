@@ -35,5 +35,6 @@ void registerValidate(CLI::App& app, CliState& state);
 void registerCheck(CLI::App& app, CliState& state);    // cmd_check.cpp
 void registerExplain(CLI::App& app, CliState& state);  // cmd_explain.cpp: explain + graph
 void registerRig(CLI::App& app, CliState& state);      // cmd_rig.cpp: rig import
+void registerBake(CLI::App& app, CliState& state);     // cmd_bake.cpp: bake occlusion
 
 }  // namespace sg

@@ -40,9 +40,14 @@ GenerateResult generate(const GenerateOptions& opts) { return generateFrom(loadI
 GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts) {
   GenerateResult res;
   if (!opts.bannedRules.empty()) in.problem = withoutRules(in.problem, opts.bannedRules);
-  auto h = makeHeuristic(opts.heuristic, in.problem);
-  if (!h) throw InputError(SourceLoc{}, fmt::format("unknown heuristic '{}' (blind, hmax, lmcut)", opts.heuristic));
-  std::optional<Plan> plan = astarSearch(in.problem, *h, &res.stats);
+  if (!makeHeuristic(opts.heuristic, in.problem))
+    throw InputError(SourceLoc{}, fmt::format("unknown heuristic '{}' (blind, hmax, lmcut)", opts.heuristic));
+  std::optional<Plan> plan;
+  try {
+    plan = findPlan(in.problem, SearchOptions{opts.searchEngine, opts.heuristic, opts.searchLimits}, &res.stats);
+  } catch (const std::invalid_argument& e) {  // unknown engine, or regression on a cyclic rule graph
+    throw InputError(SourceLoc{}, e.what());
+  }
   if (!plan) {
     std::string why = formatUnreachable(in.problem, analyzeUnreachable(in.problem, in.rules, in.varyings));
     // Point at the first fragment input whose request cannot be met.

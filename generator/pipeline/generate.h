@@ -12,6 +12,7 @@
 #include "rig/rig.h"
 #include "rules/rules.h"
 #include "search/astar.h"
+#include "search/search.h"
 #include "search/plan.h"
 #include "search/problem.h"
 
@@ -26,6 +27,8 @@ struct GenerateOptions {
   std::vector<VaryingOverride> overrides;
   std::vector<std::string> bannedRules;  // force alternatives (cross-check, explain)
   std::string heuristic = "lmcut";
+  std::string searchEngine = "auto";  // auto, regression, forward, ip (search/search.h)
+  SearchLimits searchLimits;
   std::string templateDir;  // "" = defaultTemplateDir()
   TargetEnv targetEnv = TargetEnv::Vulkan1_0;
   bool optimize = false;
