@@ -26,7 +26,7 @@ void GenerateArgs::add(CLI::App& cmd) {
       ->check(CLI::IsMember({"auto", "regression", "forward", "ip"}));
   cmd.add_option("--search-time-limit", opts.searchLimits.maxSeconds,
                  "Give up (error) when one search runs longer than this many seconds (0 = no limit)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finiteNumber(false));
   cmd.add_option("--max-expansions", opts.searchLimits.maxExpansions,
                  "Give up (error) after this many A* expansions")
       ->check(CLI::PositiveNumber);
