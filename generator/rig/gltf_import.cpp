@@ -618,7 +618,11 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   for (const auto& [name, idx] : prim.attributes) {
     for (const char* prefix : {"JOINTS_", "WEIGHTS_"}) {
       if (name.rfind(prefix, 0) != 0) continue;
-      int s = std::atoi(name.c_str() + std::strlen(prefix));
+      // The set number, saturated (atoi overflows on "JOINTS_99999999999", and 4·(s+1) below
+      // must not); a name without digits ("JOINTS_x") counts as set 0, like atoi did.
+      int s = 0;
+      for (const char* p = name.c_str() + std::strlen(prefix); *p >= '0' && *p <= '9'; ++p)
+        s = std::min(s * 10 + (*p - '0'), 1000000);
       if (s >= kMaxInfluenceSets) {
         int infl = 0;
         while (prim.attributes.count(fmt::format("JOINTS_{}", infl / 4))) infl += 4;
