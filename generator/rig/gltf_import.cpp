@@ -854,6 +854,7 @@ bool readBounded(const std::string& path, std::string& out, std::string& why) {
 struct BufferFiles {
   std::filesystem::path root;  // canonical model folder; empty: no buffer files at all
   std::string refused;         // the first refusal, reported instead of "File not found"
+  size_t bytesRead = 0;        // all buffer files together stay under kMaxGltfFileBytes too
 };
 
 bool insideRoot(BufferFiles& ctx, const std::string& path) {
@@ -875,10 +876,16 @@ bool bufferFileExists(const std::string& path, void* user) {
 }
 std::string keepPath(const std::string& path, void*) { return path; }
 bool readBufferFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
-  if (!insideRoot(*static_cast<BufferFiles*>(user), path)) return false;
+  auto& ctx = *static_cast<BufferFiles*>(user);
+  if (!insideRoot(ctx, path)) return false;
   std::string bytes, why;
   if (!readBounded(path, bytes, why)) {
     if (err) *err += why;
+    return false;
+  }
+  ctx.bytesRead += bytes.size();
+  if (ctx.bytesRead > kMaxGltfFileBytes) {
+    if (err) *err += fmt::format("the buffer files together are larger than the limit of {}", mib(kMaxGltfFileBytes));
     return false;
   }
   out->assign(bytes.begin(), bytes.end());
