@@ -19,6 +19,8 @@ packages=(
   libtinygltf-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev graphviz
   clang-14 libclang-rt-14-dev
+  libglpk-dev
+  libembree-dev
 )
 missing=()
 for p in "${packages[@]}"; do

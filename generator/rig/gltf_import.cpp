@@ -613,6 +613,19 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
     }
   }
 
+  // _OCCLUSION: baked by `shadergen bake occlusion` (docs/bake.md).
+  bool hasOcclusion = false;
+  if (const auto* a = accessorOf("_OCCLUSION")) {
+    if (isFloat(a, TINYGLTF_TYPE_SCALAR)) {
+      hasOcclusion = true;
+      rig.attributes.push_back(makeAttribute("occlusion", VertexFormat::Float32x1, {{"vertex.occlusion", ""}}, file));
+      carried("_OCCLUSION", "occlusion", VertexFormat::Float32x1);
+      data.streams["vertex.occlusion"] = toStream(readAttr("_OCCLUSION"), 0, 1);
+    } else {
+      skip("_OCCLUSION", "occlusion is a float SCALAR (as shadergen bake occlusion writes it)");
+    }
+  }
+
   // Skinning: JOINTS_n / WEIGHTS_n sets.
   int sets = 0;
   for (const auto& [name, idx] : prim.attributes) {
@@ -710,7 +723,8 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   for (const auto& [name, idx] : prim.attributes) {
     const auto& i = imp.attributes[infoIndex.at(name)];
     if (!i.rigAttribute.empty()) continue;
-    if (name == "NORMAL" || name == "TANGENT" || name == "TEXCOORD_0" || name == "TEXCOORD_1" || name == "COLOR_0")
+    if (name == "NORMAL" || name == "TANGENT" || name == "TEXCOORD_0" || name == "TEXCOORD_1" || name == "COLOR_0" ||
+        name == "_OCCLUSION")
       continue;  // already reported
     if (name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0) continue;  // unskinned (reported)
     skip(name, "the vocabulary has no semantic for it");
@@ -769,12 +783,40 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
     rig.attributes.push_back(makeAttribute(fmt::format("{}_morph", k.rigName), VertexFormat::Float32x3,
                                            {{k.semantic, ""}}, file, true));
   }
+  // Occlusion deltas (float SCALAR per target): morph.occlusion, like listing 3-3's normal.w.
+  bool occlusionMorphed = false;
+  if (moved.count("_OCCLUSION") && !hasOcclusion) {
+    imp.notes.push_back("morph target _OCCLUSION deltas are left out: the rig does not carry _OCCLUSION");
+  } else if (moved.count("_OCCLUSION")) {
+    occlusionMorphed = true;
+    for (int t = 0; t < targets; ++t) {
+      const auto& tm = prim.targets[static_cast<size_t>(t)];
+      std::string key = fmt::format("morph.occlusion[{}]", t);
+      auto it = tm.find("_OCCLUSION");
+      if (it == tm.end()) {
+        data.streams[key].assign(data.vertexCount, std::array<float, 4>{0, 0, 0, 0});
+        continue;
+      }
+      std::string what = fmt::format("{} morph target {} _OCCLUSION", where, t);
+      if (it->second < 0 || static_cast<size_t>(it->second) >= model.accessors.size())
+        fail(file, fmt::format("{} refers to accessor {}, which does not exist", what, it->second));
+      const auto& a = model.accessors[static_cast<size_t>(it->second)];
+      if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || a.type != TINYGLTF_TYPE_SCALAR)
+        fail(file, fmt::format("{} is {}{} {}; occlusion deltas are float SCALAR", what,
+                               a.normalized ? "normalized " : "", componentTypeName(a.componentType), typeName(a.type)));
+      if (a.count != data.vertexCount)
+        fail(file, fmt::format("{} has {} elements but POSITION has {}", what, a.count, data.vertexCount));
+      data.streams[key] = toStream(reader.read(it->second, what), 0, 1);
+    }
+    rig.attributes.push_back(
+        makeAttribute("occlusion_morph", VertexFormat::Float32x1, {{"morph.occlusion", ""}}, file, true));
+  }
   for (const auto& n : moved)
-    if (n != "POSITION" && n != "NORMAL" && n != "TANGENT")
+    if (n != "POSITION" && n != "NORMAL" && n != "TANGENT" && n != "_OCCLUSION")
       imp.notes.push_back(fmt::format("morph target {} deltas are left out: the vocabulary morphs position, normal "
                                       "and tangent only",
                                       n));
-  int rigTargets = morphed.empty() ? 0 : targets;
+  int rigTargets = morphed.empty() && !occlusionMorphed ? 0 : targets;
   if (targets > 0 && rigTargets == 0)
     imp.notes.push_back(fmt::format("{} has {} morph target(s) but none moves an attribute the rig carries: imported "
                                     "without morphing",
@@ -783,6 +825,32 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   rig.morphedAttributes = morphed;
   data.meshWeights.assign(static_cast<size_t>(targets), 0.0);
   for (size_t i = 0; i < mesh.weights.size() && i < data.meshWeights.size(); ++i) data.meshWeights[i] = mesh.weights[i];
+
+  // Dawn's layout (listing 3-1): occlusion in normal.w and its deltas in the normal deltas' w.
+  if (opts.packOcclusionInNormal) {
+    if (!hasOcclusion || !hasNormal)
+      fail(file, fmt::format("{}: packing occlusion into normal.w needs NORMAL and _OCCLUSION (bake them with "
+                             "'shadergen bake occlusion')",
+                             where));
+    auto merge = [&](const std::string& into, const std::string& from, const char* xyz, const char* w) {
+      auto named = [&](const std::string& n) {
+        return std::find_if(rig.attributes.begin(), rig.attributes.end(), [&](const RigAttribute& a) { return a.name == n; });
+      };
+      auto a = named(into);
+      if (a == rig.attributes.end() || named(from) == rig.attributes.end()) return false;
+      a->format = VertexFormat::Float32x4;
+      a->shaderType = *vectorType(ScalarKind::Float, 4);
+      a->provides = {{xyz, "xyz"}, {w, "w"}};
+      rig.attributes.erase(named(from));
+      return true;
+    };
+    merge("normal", "occlusion", "vertex.normal", "vertex.occlusion");
+    imp.attributes[infoIndex.at("NORMAL")].format = formatName(VertexFormat::Float32x4);
+    imp.attributes[infoIndex.at("_OCCLUSION")].rigAttribute = "normal (w)";
+    imp.attributes[infoIndex.at("_OCCLUSION")].format = formatName(VertexFormat::Float32x4);
+    if (occlusionMorphed && !merge("normal_morph", "occlusion_morph", "morph.normal", "morph.occlusion"))
+      imp.notes.push_back("occlusion deltas stay a separate attribute: no morph target moves NORMAL");
+  }
 
   // Uniforms.
   if (sets > 0) rig.uniforms.push_back(makeUniform("bones", "skin.bones", Type::Mat4, "bones", imp.joints, file));

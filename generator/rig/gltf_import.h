@@ -51,6 +51,8 @@ struct GltfImportOptions {
   int primitive = 0;
   int maxBones = kMaxBonePalette;  // tests lower it to exercise the diagnostic
   size_t maxDecodedBytes = kMaxGltfDecodedBytes;  // likewise
+  // Dawn's layout: _OCCLUSION in normal.w (float32x4), target deltas in the normal deltas' w.
+  bool packOcclusionInNormal = false;
 };
 
 // One attribute of the primitive as the file stores it, and what the rig made of it.
