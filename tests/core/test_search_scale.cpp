@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,36 @@ TEST(SearchProperty, FiftyLibrariesOf300RulesMatchOracle) {
     ASSERT_TRUE(plan.has_value());
     EXPECT_EQ(plan->cost, oracle->cost);
     EXPECT_TRUE(planIsValid(p, *plan));
+  }
+}
+
+// The larger run documented in docs/search.md (minutes, not in CI):
+//   SHADERGEN_SEARCH_LONG=1 build/tests/core/test_search_scale --gtest_filter='*LargerRun*'
+TEST(SearchProperty, LargerRun) {
+  if (!std::getenv("SHADERGEN_SEARCH_LONG")) GTEST_SKIP() << "set SHADERGEN_SEARCH_LONG=1 for the larger run";
+  struct Batch {
+    int count, minRules, maxRules, cyclicPercent;
+    uint64_t firstSeed;
+  };
+  for (const Batch& b : {Batch{10000, 8, 60, 0, 100000}, Batch{2000, 8, 30, 25, 200000},
+                         Batch{500, 61, 300, 0, 300000}, Batch{100, 1000, 1000, 0, 400000}}) {
+    int64_t mostExpanded = 0;
+    for (int i = 0; i < b.count; ++i) {
+      LibraryShape shape{b.minRules + i % (b.maxRules - b.minRules + 1), b.firstSeed + static_cast<uint64_t>(i)};
+      shape.cyclicPercent = b.cyclicPercent;
+      Problem p = randomLibrary(shape);
+      SCOPED_TRACE(::testing::Message() << "seed " << shape.seed << ", " << shape.rules << " rules");
+      auto oracle = integerProgramSearch(p);
+      ASSERT_TRUE(oracle.has_value());
+      SearchStats st;
+      auto plan = findPlan(p, SearchOptions{}, &st);
+      ASSERT_TRUE(plan.has_value());
+      ASSERT_EQ(plan->cost, oracle->cost);
+      ASSERT_TRUE(planIsValid(p, *plan));
+      mostExpanded = std::max<int64_t>(mostExpanded, st.expanded);
+    }
+    std::printf("%d libraries of %d-%d rules (%d%% cyclic rules): all optimal; most expansions %lld\n", b.count,
+                b.minRules, b.maxRules, b.cyclicPercent, static_cast<long long>(mostExpanded));
   }
 }
 
