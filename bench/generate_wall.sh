@@ -24,8 +24,8 @@ def run(args):
     cost = re.search(r"vs cost (\d+)", out.stdout).group(1)
     return ms, float(m.group(1)), cost
 tmp = tempfile.mkdtemp(prefix="sg-wall-")
-dawn = [f"--rig={here}/examples/dawn/face.rig.yaml", f"-f={here}/examples/dawn/face.frag",
-        f"-r={here}/examples/dawn/rules.yaml", f"-o={tmp}/dawn"]
+dawn = ["--rig", f"{here}/examples/dawn/face.rig.yaml", "-f", f"{here}/examples/dawn/face.frag",
+        "-r", f"{here}/examples/dawn/rules.yaml", "-o", f"{tmp}/dawn"]
 base = [run(dawn) for _ in range(10)]
 base_ms = statistics.median(b[0] for b in base)
 rows = [f"| Dawn face | {base_ms:.0f} | {max(b[0] for b in base):.0f} | 1.0 | {statistics.median(b[1] for b in base):.3f} |"]
@@ -35,8 +35,8 @@ for rules in (100, 300, 1000, 3000):
         d = f"{tmp}/{rules}-{seed}"
         os.makedirs(d)
         subprocess.run([f"{build}/bench/bench_search", "--write-library", d, str(rules), str(seed)], check=True)
-        res.append(run([f"--rig={d}/lib.rig.yaml", f"-f={d}/lib.frag", f"-r={here}/rules/standard.yaml",
-                        f"-r={d}/lib.rules.yaml", f"-o={d}/out"]))
+        res.append(run(["--rig", f"{d}/lib.rig.yaml", "-f", f"{d}/lib.frag", "-r", f"{here}/rules/standard.yaml",
+                        "-r", f"{d}/lib.rules.yaml", "-o", f"{d}/out"]))
     med = statistics.median(r[0] for r in res)
     rows.append(f"| {rules} rules | {med:.0f} | {max(r[0] for r in res):.0f} | {med / base_ms:.1f} | "
                 f"{statistics.median(r[1] for r in res):.3f} |")
