@@ -57,6 +57,13 @@ GenerateOptions GenerateArgs::resolve() const {
   return o;
 }
 
+std::vector<InputFile> inputFiles(const LoadedInputs& in, const std::vector<std::string>& extra) {
+  std::vector<InputFile> files{{in.rig.file, "the rig"}, {in.fragment.file, "the fragment shader"}};
+  for (const auto& f : in.rules.files) files.push_back({f, "a rules file"});
+  for (const auto& f : extra) files.push_back({f, "an input"});
+  return files;
+}
+
 namespace {
 
 struct GenerateCommand {
@@ -120,6 +127,9 @@ struct GenerateCommand {
       std::string dpath = depfilePath.empty() ? files.front().path + ".d" : depfilePath;
       files.push_back({dpath, makeDepfile(targets, r.inputsRead)});
     }
+    std::vector<std::string> outPaths;
+    for (const auto& f : files) outPaths.push_back(f.path);
+    refuseClobbering(outPaths, inputFiles(r.in, r.inputsRead));
     writeFilesAtomically(files);
     if (stats) std::cout << describeStats(r.stats);
     if (!quiet) {

@@ -18,6 +18,8 @@
 
 namespace sg {
 
+constexpr uint32_t kVulkanMinUniformBufferRange = 16384;
+
 struct GenerateOptions {
   std::string rigPath;
   std::string fragmentPath;
@@ -32,6 +34,9 @@ struct GenerateOptions {
   bool optimize = false;
   bool capture = false;  // transform-feedback build for validation
   std::string outputName = "shader.vert";  // how the GLSL is named in diagnostics
+  // The uniform block must fit the device's maxUniformBufferRange; 16384 bytes is what
+  // every Vulkan device guarantees (docs/limits.md). A known device may raise it.
+  uint32_t maxUniformBlockBytes = kVulkanMinUniformBufferRange;
 };
 
 // Everything loaded (kept so later stages and explain/validate reuse it).
