@@ -23,6 +23,7 @@
 
 #include <glm/glm.hpp>
 
+#include "../core/core_test_util.h"
 #include "bake/gltf_bake.h"
 #include "common/diagnostics.h"
 #include "rig/gltf_import.h"
@@ -33,11 +34,7 @@ namespace {
 namespace fs = std::filesystem;
 constexpr double kZ99 = 2.5758293035489;
 
-fs::path tempDir() {
-  fs::path d = fs::temp_directory_path() / fmt::format("sg_bake_test_{}", ::getpid());
-  fs::create_directories(d);
-  return d;
-}
+fs::path tempDir() { return sgtest::freshDir("bake"); }
 
 std::string readFile(const fs::path& p) {
   std::ifstream f(p, std::ios::binary);
@@ -45,7 +42,7 @@ std::string readFile(const fs::path& p) {
   s << f.rdbuf();
   return s.str();
 }
-void writeFile(const fs::path& p, const std::string& bytes) { std::ofstream(p, std::ios::binary) << bytes; }
+void writeFile(const fs::path& p, const std::string& bytes) { sgtest::writeText(p, bytes); }
 
 // --- building models ---------------------------------------------------------------------
 struct Mesh {
@@ -109,6 +106,19 @@ int addMesh(tinygltf::Model& m, const Mesh& mesh) {
   return static_cast<int>(m.meshes.size()) - 1;
 }
 
+void save(tinygltf::Model& m, const fs::path& file);
+
+// A model whose scene is one node drawing `mesh`, saved as `file`.
+void saveSingleMesh(const Mesh& mesh, const fs::path& file) {
+  tinygltf::Model m;
+  addMesh(m, mesh);
+  m.nodes.emplace_back();
+  m.nodes[0].mesh = 0;
+  m.scenes.push_back({});
+  m.scenes[0].nodes = {0};
+  save(m, file);
+}
+
 void save(tinygltf::Model& m, const fs::path& file) {
   m.asset.version = "2.0";
   tinygltf::TinyGLTF w;
@@ -159,13 +169,7 @@ void expectWithinBound(double estimate, double p, int rays, const std::string& w
 
 TEST(GltfBake, MorphTargetClosingACavityGetsTheRightDelta) {
   fs::path dir = tempDir();
-  tinygltf::Model m;
-  addMesh(m, cavityBox());
-  m.nodes.emplace_back();
-  m.nodes[0].mesh = 0;
-  m.scenes.push_back({});
-  m.scenes[0].nodes = {0};
-  save(m, dir / "cavity.glb");
+  saveSingleMesh(cavityBox(), dir / "cavity.glb");
   for (auto [dist, open] : {std::pair{Distribution::Uniform, kOpenUniform}, std::pair{Distribution::Cosine, kOpenCosine}}) {
     GltfBakeOptions o;
     o.occlusion.rays = 16384;
@@ -255,11 +259,7 @@ TEST(GltfBake, AnimationTimePosesTheWholeScene) {
 
 TEST(GltfBake, OutputIsDeterministicAndThreadIndependent) {
   fs::path dir = tempDir();
-  tinygltf::Model m;
-  addMesh(m, cavityBox());
-  m.nodes.emplace_back();
-  m.nodes[0].mesh = 0;
-  save(m, dir / "cavity.glb");
+  saveSingleMesh(cavityBox(), dir / "cavity.glb");
   GltfBakeOptions o;
   o.occlusion.rays = 333;
   o.occlusion.threads = 1;
