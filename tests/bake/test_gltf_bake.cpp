@@ -209,7 +209,9 @@ TEST(GltfBake, MorphTargetClosingACavityGetsTheRightDelta) {
 
 // Two meshes: a floor, and a 2×2 lid that an animation moves from far away (t = 0) to
 // height 1 over the floor's centre (t = 1). The whole scene occludes, posed at --time.
-TEST(GltfBake, AnimationTimePosesTheWholeScene) {
+// Unskinned, the lid's node moves; skinned, the lid is stored far away (its bind pose) and
+// its joint carries it over the floor (the skinned node's own transform is ignored).
+void animatedLid(bool skinned) {
   fs::path dir = tempDir();
   tinygltf::Model m;
   Mesh floor, lid;
@@ -218,15 +220,33 @@ TEST(GltfBake, AnimationTimePosesTheWholeScene) {
   float c[4][2] = {{-9, -9}, {9, -9}, {9, 9}, {-9, 9}};
   for (auto& p : c) floor.positions.insert(floor.positions.end(), {p[0], p[1], 0}), floor.normals.insert(floor.normals.end(), {0, 0, 1});
   for (uint32_t i = 0; i < 4; ++i) floor.indices.insert(floor.indices.end(), {0, 1 + i, 1 + (i + 1) % 4});
-  lid.quad({-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, {0, 0, -1});
+  float x0 = skinned ? 100.0f : 0.0f, z0 = skinned ? 1.0f : 0.0f;  // stored lid: far away when skinned
+  lid.quad({x0 - 1, -1, z0}, {x0 + 1, -1, z0}, {x0 + 1, 1, z0}, {x0 - 1, 1, z0}, {0, 0, -1});
   addMesh(m, floor);
   addMesh(m, lid);
-  m.nodes.resize(2);
+  m.nodes.resize(skinned ? 3 : 2);
   m.nodes[0].mesh = 0;
   m.nodes[1].mesh = 1;
   m.nodes[1].translation = {100, 0, 1};
+  int animated = 1;
+  if (skinned) {
+    std::vector<uint8_t> joints(16, 0);
+    std::vector<float> weights{1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    auto& prim = m.meshes[1].primitives[0];
+    prim.attributes["JOINTS_0"] = addAccessor(m, joints.data(), 16, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_TYPE_VEC4, 4);
+    prim.attributes["WEIGHTS_0"] = addAccessor(m, weights.data(), 64, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, 4);
+    std::vector<float> ibm{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -100, 0, -1, 1};  // joint rest at (100, 0, 1)
+    tinygltf::Skin skin;
+    skin.joints = {2};
+    skin.inverseBindMatrices = addAccessor(m, ibm.data(), 64, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_MAT4, 1);
+    m.skins.push_back(skin);
+    m.nodes[1].skin = 0;
+    m.nodes[1].translation = {7, 7, 7};  // ignored for a skinned mesh
+    m.nodes[2].translation = {100, 0, 1};
+    animated = 2;
+  }
   m.scenes.push_back({});
-  m.scenes[0].nodes = {0, 1};
+  m.scenes[0].nodes = skinned ? std::vector<int>{0, 1, 2} : std::vector<int>{0, 1};
   std::vector<float> times{0, 1}, moves{100, 0, 1, 0, 0, 1};
   tinygltf::Animation anim;
   anim.name = "close";
@@ -239,7 +259,7 @@ TEST(GltfBake, AnimationTimePosesTheWholeScene) {
   anim.samplers.push_back(s);
   tinygltf::AnimationChannel ch;
   ch.sampler = 0;
-  ch.target_node = 1;
+  ch.target_node = animated;
   ch.target_path = "translation";
   anim.channels.push_back(ch);
   m.animations.push_back(anim);
@@ -252,10 +272,15 @@ TEST(GltfBake, AnimationTimePosesTheWholeScene) {
   o.animation = "close";
   float covered = bakeAndImport(dir / "lid.glb", dir / "out.glb", o).data.streams["vertex.occlusion"][0][0];
   expectWithinBound(covered, kOpenUniform, o.occlusion.rays, "lid over the floor at t = 1");
+  o.time = 0.5;  // half way: the lid spans x in [49, 51], far from the floor's centre
+  EXPECT_LT(bakeAndImport(dir / "lid.glb", dir / "out.glb", o).data.streams["vertex.occlusion"][0][0], 0.01f);
   o.animation = "nope";
   EXPECT_THROW(bakeGltfOcclusion((dir / "lid.glb").string(), o), InputError);
   fs::remove_all(dir);
 }
+
+TEST(GltfBake, AnimationTimePosesTheWholeScene) { animatedLid(false); }
+TEST(GltfBake, AnimationTimeSkinsSkinnedMeshes) { animatedLid(true); }
 
 TEST(GltfBake, OutputIsDeterministicAndThreadIndependent) {
   fs::path dir = tempDir();
