@@ -52,6 +52,7 @@ struct RigImportCommand {
     if (output.empty() || output == "-") {
       std::cout << yaml;
     } else {
+      refuseClobbering({output}, {{ref.file, "the glTF model"}});
       writeFilesAtomically({PendingFile{output, yaml}});
     }
     return 0;

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/output_files.h"
 #include "pipeline/generate.h"
 
 namespace sg {
@@ -24,6 +25,9 @@ struct GenerateArgs {
   void add(CLI::App& cmd);
   GenerateOptions resolve() const;  // parses --map and --target-env (throws CLI::ValidationError)
 };
+
+// Every file `in` was loaded from (plus `extra`), named for refuseClobbering (output_files.h).
+std::vector<InputFile> inputFiles(const LoadedInputs& in, const std::vector<std::string>& extra = {});
 
 void registerCommands(CLI::App& app, CliState& state);
 void registerGenerate(CLI::App& app, CliState& state);

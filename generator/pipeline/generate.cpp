@@ -22,6 +22,9 @@ LoadedInputs loadInputs(const GenerateOptions& opts) {
   in.rules = loadRules(opts.rulesPaths);
   in.fragment = reflectFragmentFile(opts.fragmentPath);
   in.varyings = bindVaryings(in.fragment, in.rules, opts.overrides);
+  for (const auto& b : opts.bannedRules)  // a misspelt --ban would otherwise change nothing silently
+    if (std::none_of(in.rules.rules.begin(), in.rules.rules.end(), [&](const Rule& r) { return r.name == b; }))
+      throw InputError(SourceLoc{}, fmt::format("--ban {}: no rule of that name in the rules files", b));
   resolveAutoCosts(in.rules, in.rig);  // `cost: auto`: measured for this rig
   in.problem = buildProblem(in.rig, in.rules, in.varyings);
   return in;
@@ -37,9 +40,14 @@ GenerateResult generate(const GenerateOptions& opts) { return generateFrom(loadI
 GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts) {
   GenerateResult res;
   if (!opts.bannedRules.empty()) in.problem = withoutRules(in.problem, opts.bannedRules);
-  auto h = makeHeuristic(opts.heuristic, in.problem);
-  if (!h) throw InputError(SourceLoc{}, fmt::format("unknown heuristic '{}' (blind, hmax, lmcut)", opts.heuristic));
-  std::optional<Plan> plan = astarSearch(in.problem, *h, &res.stats);
+  if (!makeHeuristic(opts.heuristic, in.problem))
+    throw InputError(SourceLoc{}, fmt::format("unknown heuristic '{}' (blind, hmax, lmcut)", opts.heuristic));
+  std::optional<Plan> plan;
+  try {
+    plan = findPlan(in.problem, SearchOptions{opts.searchEngine, opts.heuristic, opts.searchLimits}, &res.stats);
+  } catch (const std::invalid_argument& e) {  // unknown engine, or regression on a cyclic rule graph
+    throw InputError(SourceLoc{}, e.what());
+  }
   if (!plan) {
     std::string why = formatUnreachable(in.problem, analyzeUnreachable(in.problem, in.rules, in.varyings));
     // Point at the first fragment input whose request cannot be met.
@@ -72,6 +80,25 @@ GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts) {
   }
   if (std::string err = validateSpirv(res.spirv.words, opts.targetEnv); !err.empty())
     throw InputError(SourceLoc{opts.outputName, 0, 0}, "generated SPIR-V fails validation: " + err);
+  if (res.spirv.uniformBlockSize > opts.maxUniformBlockBytes) {
+    // Point at the largest uniform the plan reads (a bone palette, usually).
+    SourceLoc at{in.rig.file, 0, 0};
+    std::string list;
+    int64_t largest = -1;
+    for (const auto& u : res.glsl.uniforms) {
+      const RigUniform& ru = in.rig.uniforms[u.uniform];
+      int64_t bytes = int64_t{componentCount(ru.type)} * 4 * std::max(1, ru.arraySize);
+      list += fmt::format("{}{} {}{}", list.empty() ? "" : ", ", glslName(ru.type), ru.name,
+                          ru.arraySize ? fmt::format("[{}]", ru.arraySize) : "");
+      if (bytes > largest) {
+        largest = bytes;
+        at = ru.loc;
+      }
+    }
+    throw InputError(at, fmt::format("the uniform block is {} bytes (std140: {}), larger than the {} bytes of "
+                                     "maxUniformBufferRange that every Vulkan device supports",
+                                     res.spirv.uniformBlockSize, list, opts.maxUniformBlockBytes));
+  }
   checkLink(res.glsl, in.fragment.source, in.fragment.file, opts.targetEnv);
   if (opts.optimize) {
     res.spirv.words = optimizeSpirv(res.spirv.words, opts.targetEnv);

@@ -12,10 +12,13 @@
 #include "rig/rig.h"
 #include "rules/rules.h"
 #include "search/astar.h"
+#include "search/search.h"
 #include "search/plan.h"
 #include "search/problem.h"
 
 namespace sg {
+
+constexpr uint32_t kVulkanMinUniformBufferRange = 16384;
 
 struct GenerateOptions {
   std::string rigPath;
@@ -24,11 +27,16 @@ struct GenerateOptions {
   std::vector<VaryingOverride> overrides;
   std::vector<std::string> bannedRules;  // force alternatives (cross-check, explain)
   std::string heuristic = "lmcut";
+  std::string searchEngine = "auto";  // auto, regression, forward, ip (search/search.h)
+  SearchLimits searchLimits;
   std::string templateDir;  // "" = defaultTemplateDir()
   TargetEnv targetEnv = TargetEnv::Vulkan1_0;
   bool optimize = false;
   bool capture = false;  // transform-feedback build for validation
   std::string outputName = "shader.vert";  // how the GLSL is named in diagnostics
+  // The uniform block must fit the device's maxUniformBufferRange; 16384 bytes is what
+  // every Vulkan device guarantees (docs/limits.md). A known device may raise it.
+  uint32_t maxUniformBlockBytes = kVulkanMinUniformBufferRange;
 };
 
 // Everything loaded (kept so later stages and explain/validate reuse it).

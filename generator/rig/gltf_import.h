@@ -12,6 +12,10 @@
 
 #include "rig/rig.h"
 
+namespace tinygltf {
+class Model;
+}
+
 namespace sg {
 
 // The bone palette is one uniform array of mat4: 256 × 64 B = 16 KiB, Vulkan's guaranteed
@@ -19,6 +23,20 @@ namespace sg {
 constexpr int kMaxBonePalette = 256;
 // Influences per vertex the rules serve: two JOINTS_n/WEIGHTS_n sets of 4.
 constexpr int kMaxInfluenceSets = 2;
+
+// Hostile-input limits (docs/limits.md), each checked before the memory it guards is used.
+// The model file and each buffer file it names.
+constexpr size_t kMaxGltfFileBytes = size_t{1} << 30;
+// JSON nesting ({ and [); real models nest under 10 deep.
+constexpr int kMaxGltfJsonDepth = 64;
+// Elements of one accessor (vertices, keyframes, matrices).
+constexpr size_t kMaxGltfElements = size_t{1} << 24;
+// Decoded data of one import (accessor values and per-vertex streams, zeros included):
+// at most min(kMaxGltfDecodedBytes, kMinGltfDecodedBudget + kGltfDecodedPerInputByte × bytes
+// of the file and its buffers), so a 2 KB file claiming a billion vertices allocates nothing.
+constexpr size_t kMaxGltfDecodedBytes = size_t{1} << 30;
+constexpr size_t kMinGltfDecodedBudget = size_t{64} << 20;
+constexpr size_t kGltfDecodedPerInputByte = 256;
 
 // "model.glb", "model.gltf", "model.glb#1/0" (mesh 1, primitive 0).
 struct GltfRef {
@@ -36,6 +54,7 @@ struct GltfImportOptions {
   int mesh = 0;
   int primitive = 0;
   int maxBones = kMaxBonePalette;  // tests lower it to exercise the diagnostic
+  size_t maxDecodedBytes = kMaxGltfDecodedBytes;  // likewise
   // Dawn's layout: _OCCLUSION in normal.w (float32x4), target deltas in the normal deltas' w.
   bool packOcclusionInNormal = false;
 };
@@ -131,9 +150,15 @@ struct GltfImport {
 // the mesh and the limit for anything the rules cannot serve (too many joints, JOINTS_2+,
 // quantized positions, ...), and for malformed files.
 GltfImport importGltf(const std::string& file, const GltfImportOptions& opts = {});
-// Same, from glTF JSON text (buffers as data URIs; external files relative to baseDir).
+// Same, from glTF JSON text (buffers as data URIs; buffer files only inside baseDir, none
+// when it is empty).
 GltfImport importGltfText(const std::string& json, const std::string& fileName, const GltfImportOptions& opts = {},
                           const std::string& baseDir = "");
+
+// The checked loader behind importGltf (bounded read, JSON depth, GLB layout, buffer files
+// confined to the model's folder), for tools that rewrite a model (bake/gltf_bake.cpp). The
+// caller includes tiny_gltf.h with the configuration of gltf_import.cpp.
+void loadGltfModel(const std::string& file, tinygltf::Model& model);
 
 // Any rig path: "rig.yaml" (loadRigFile) or "model.glb[#m/p]" (importGltf).
 Rig loadRig(const std::string& path);

@@ -195,6 +195,10 @@ class Builder {
                                              rule.name));
     act.cost = rule.cost.eval(env_);
     if (act.cost < 0) throw InputError(rule.loc, fmt::format("rule '{}' has negative cost {}", rule.name, act.cost));
+    // Above this, sums of costs could reach the search's "infinite" and plans would be lost.
+    if (act.cost > kMaxRuleCost)
+      throw InputError(rule.loc, fmt::format("rule '{}' has cost {}, above the limit of {}", rule.name, act.cost,
+                                             kMaxRuleCost));
 
     SnippetContext ctx;
     ctx.rigEnv = env_;

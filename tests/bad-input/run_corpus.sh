@@ -10,7 +10,7 @@
 # leave its own directory byte-identical, and write nothing (no output, no temporary)
 # when it fails. The command runs in the fresh output directory @O.
 set -uo pipefail
-SG=$1 SRC=$2 AREA=$3
+SG=$(realpath "$1") SRC=$(realpath "$2") AREA=$3
 shift 3
 SCALE=${SHADERGEN_CORPUS_TIME_SCALE:-1}
 LIMIT=$(awk -v s="$SCALE" 'BEGIN { printf "%.2f", 2 * s }')
@@ -57,7 +57,9 @@ for D in "${cases[@]}"; do
   for w in "${raw[@]}"; do args+=("$(expand "$w" "$D" "$O" "$T")"); done
   want=$(head -n1 "$D/expect" | tr -d '[:space:]')
   start=$(date +%s.%N)
-  (cd "$O" && exec timeout -s KILL "$LIMIT" "$SG" "${args[@]}" </dev/null >"$C/stdout" 2>"$C/stderr")
+  cwd=$O
+  [ -f "$D/cwd" ] && cwd=$(expand "$(tr -d '[:space:]' < "$D/cwd")" "$D" "$O" "$T")
+  (cd "$cwd" && exec timeout -s KILL "$LIMIT" "$SG" "${args[@]}" </dev/null >"$C/stdout" 2>"$C/stderr")
   got=$?
   secs=$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { printf "%.2f", b - a }')
   problems=()
@@ -68,6 +70,7 @@ for D in "${cases[@]}"; do
     [ -z "$line" ] && continue
     line=${line//@D/$D}
     line=${line//@O/$O}
+    line=${line//@T/$T}
     grep -qF -- "$line" "$C/stderr" || problems+=("stderr lacks: $line")
   done < <(tail -n +2 "$D/expect")
   grep -q 'runtime error:\|AddressSanitizer\|LeakSanitizer\|UndefinedBehaviorSanitizer' "$C/stderr" &&
