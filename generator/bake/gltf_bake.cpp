@@ -156,7 +156,13 @@ Posed posePrimitive(const PrimitiveData& p, const Instance& inst, int target, co
         if (jt == d.streams.end() || wt == d.streams.end()) break;
         for (size_t c = 0; c < 4; ++c) {
           double w = wt->second[v][c];
-          if (w != 0) M += w * joints[static_cast<size_t>(jt->second[v][c])];
+          size_t j = static_cast<size_t>(jt->second[v][c]);  // checked against the import's skin
+          if (j >= joints.size())
+            throw InputError(SourceLoc{d.file, 0, 0},
+                             fmt::format("node '{}' draws mesh '{}' with skin {}, which has {} joints; vertex {} uses "
+                                         "joint {}",
+                                         node->name, d.meshName, skin, joints.size(), v, j));
+          if (w != 0) M += w * joints[j];
         }
       }
     }
