@@ -407,6 +407,11 @@ GltfBakeResult bakeGltfOcclusion(const std::string& file, const GltfBakeOptions&
       result.notes.push_back(fmt::format("image '{}' stays an external reference ('{}'), relative to the output file",
                                          img.name, img.uri));
 
+  result.inputs.push_back(file);
+  for (const auto& b : model.buffers)
+    if (!b.uri.empty() && b.uri.rfind("data:", 0) != 0)
+      result.inputs.push_back((std::filesystem::path(file).parent_path() / b.uri).string());
+
   // Every buffer is embedded: buffer 0 in the GLB binary chunk, the others as data URIs.
   for (auto& b : model.buffers) b.uri.clear();
   tinygltf::TinyGLTF writer;
