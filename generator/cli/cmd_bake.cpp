@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -39,6 +40,8 @@ struct BakeOcclusionCommand {
     if (ext != ".glb" && ext != ".gltf")
       throw CLI::ValidationError("--output", fmt::format("'{}' must end in .glb or .gltf", output));
     if (!animation.empty() && !time) throw CLI::ValidationError("--animation", "needs --time");
+    if (time && !std::isfinite(*time)) throw CLI::ValidationError("--time", "must be a finite number of seconds");
+    refuseClobbering({output}, {{model, "the glTF model"}});  // before the work; buffer files after
     bake::GltfBakeOptions o;
     o.occlusion.rays = rays;
     o.occlusion.distribution = distribution == "cosine" ? bake::Distribution::Cosine : bake::Distribution::Uniform;
@@ -60,6 +63,9 @@ struct BakeOcclusionCommand {
     bake::GltfBakeResult r = bake::bakeGltfOcclusion(model, o);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (tty) std::cerr << "\r\033[K" << std::flush;
+    std::vector<InputFile> inputs;
+    for (const auto& in : r.inputs) inputs.push_back({in, in == model ? "the glTF model" : "a buffer file of the model"});
+    refuseClobbering({output}, inputs);
     writeFilesAtomically({PendingFile{output, r.bytes}});
     if (!quiet) {
       for (const auto& n : r.notes) std::cerr << fmt::format("{}: warning: {}\n", model, n);
