@@ -2,29 +2,105 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
-#include <functional>
-#include <set>
-
 #include "analysis/cost.h"
 #include "analysis/explain.h"
 #include "analysis/probe.h"
-#include "emit/templates.h"
 #include "rig/gltf_import.h"
+#include "rig/rig_lod.h"
 
 namespace sg {
 
 const char* shadergenVersion() { return SHADERGEN_VERSION; }
 
-LoadedInputs loadInputs(const GenerateOptions& opts) {
+// ---- stages -----------------------------------------------------------------------------
+
+Rig loadRigStage(const std::string& path) { return loadRig(path); }
+
+RuleSet loadRulesStage(const std::vector<std::string>& paths) { return loadRules(paths); }
+
+FragmentInterface loadFragmentStage(const std::string& path, TargetEnv env) { return reflectFragmentFile(path, env); }
+
+TemplateSet loadTemplatesStage(const std::string& dir) {
+  return TemplateSet::load(dir.empty() ? defaultTemplateDir() : dir);
+}
+
+LoadedInputs instantiateStage(Rig rig, RuleSet rules, FragmentInterface fragment,
+                              const std::vector<VaryingOverride>& overrides) {
   LoadedInputs in;
-  in.rig = loadRig(opts.rigPath);  // YAML, or a glTF model "model.glb#mesh/primitive"
-  in.rules = loadRules(opts.rulesPaths);
-  in.fragment = reflectFragmentFile(opts.fragmentPath);
-  in.varyings = bindVaryings(in.fragment, in.rules, opts.overrides);
+  in.rig = std::move(rig);
+  in.rules = std::move(rules);
+  in.fragment = std::move(fragment);
+  in.varyings = bindVaryings(in.fragment, in.rules, overrides);
   resolveAutoCosts(in.rules, in.rig);  // `cost: auto`: measured for this rig
   in.problem = buildProblem(in.rig, in.rules, in.varyings);
   return in;
+}
+
+Plan searchStage(const LoadedInputs& in, const std::string& heuristic, SearchStats* stats) {
+  const Problem& p = in.problem;
+  auto h = makeHeuristic(heuristic, p);
+  if (!h) throw InputError(SourceLoc{}, fmt::format("unknown heuristic '{}' (blind, hmax, lmcut)", heuristic));
+  std::optional<Plan> plan = astarSearch(p, *h, stats);
+  if (plan) return *plan;
+  std::string why = formatUnreachable(p, analyzeUnreachable(p, in.rules, in.varyings));
+  // Point at the first fragment input whose request cannot be met.
+  SourceLoc at{in.fragment.file, 0, 0};
+  std::vector<bool> reach = reachableFacts(p);
+  for (const auto& v : in.varyings)
+    for (const auto& s : v.semantics) {
+      int f = p.findFact(s);
+      if (f >= 0 && !reach[f] && at.line == 0) at = v.loc.line ? v.loc : at;
+    }
+  if (!why.empty() && why.back() == '\n') why.pop_back();
+  throw InputError(at, fmt::format("the request cannot be met for rig '{}':\n{}", in.rig.name, why));
+}
+
+EmittedGlsl emitStage(const LoadedInputs& in, const Plan& plan, const TemplateSet& templates,
+                      const EmitOptions& opts) {
+  return emitGlsl(in.rig, in.problem, plan, in.varyings, templates, in.fragment.file, opts);
+}
+
+CompiledVertexShader compileStage(const LoadedInputs& in, const Plan& plan, const EmittedGlsl& glsl,
+                                  const std::string& glslName, TargetEnv env) {
+  try {
+    return compileVertex(glsl, glslName, env);
+  } catch (const InputError& e) {
+    // glslang reports lines only: point the columns at the snippet text in the rules file.
+    std::vector<SourceLoc> snippetLines;
+    for (int a : plan.actions)
+      for (const auto& l : in.problem.actions[a].code) snippetLines.push_back(l.loc);
+    throw refineSnippetError(e, snippetLines);
+  }
+}
+
+std::vector<uint32_t> checkStage(const CompiledVertexShader& vertex, const FragmentInterface& fragment,
+                                 const std::string& glslName, TargetEnv env, bool optimize) {
+  std::vector<uint32_t> words = vertex.module.words;
+  if (std::string err = validateSpirv(words, env); !err.empty())
+    throw InputError(SourceLoc{glslName, 0, 0}, "generated SPIR-V fails validation: " + err);
+  checkLink(vertex.parsed, GlslShader(GlslUnit{Stage::Fragment, fragment.source, fragment.file, {}}, env));
+  if (optimize) {
+    words = optimizeSpirv(words, env);
+    if (std::string err = validateSpirv(words, env); !err.empty())
+      throw InputError(SourceLoc{glslName, 0, 0}, "optimised SPIR-V fails validation: " + err);
+  }
+  return words;
+}
+
+std::vector<std::string> inputsRead(const LoadedInputs& in, const TemplateSet& templates) {
+  std::vector<std::string> files{in.rig.file, in.fragment.file};
+  files.insert(files.end(), in.rules.files.begin(), in.rules.files.end());
+  files.push_back(templates.file());
+  return files;
+}
+
+// ---- the stages in order ------------------------------------------------------------------
+
+LoadedInputs loadInputs(const GenerateOptions& opts) {
+  Rig rig = loadRigStage(opts.rigPath);
+  if (!opts.rigParams.empty()) rig = rigWithParameters(rig, opts.rigParams, SourceLoc{});
+  return instantiateStage(std::move(rig), loadRulesStage(opts.rulesPaths),
+                          loadFragmentStage(opts.fragmentPath, opts.targetEnv), opts.overrides);
 }
 
 std::string explainUnreachable(const Problem& p, const RuleSet& rules) {
@@ -35,53 +111,22 @@ std::string explainUnreachable(const Problem& p, const RuleSet& rules) {
 GenerateResult generate(const GenerateOptions& opts) { return generateFrom(loadInputs(opts), opts); }
 
 GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts) {
+  return generateWith(std::move(in), loadTemplatesStage(opts.templateDir), opts);
+}
+
+GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const GenerateOptions& opts) {
   GenerateResult res;
   if (!opts.bannedRules.empty()) in.problem = withoutRules(in.problem, opts.bannedRules);
-  auto h = makeHeuristic(opts.heuristic, in.problem);
-  if (!h) throw InputError(SourceLoc{}, fmt::format("unknown heuristic '{}' (blind, hmax, lmcut)", opts.heuristic));
-  std::optional<Plan> plan = astarSearch(in.problem, *h, &res.stats);
-  if (!plan) {
-    std::string why = formatUnreachable(in.problem, analyzeUnreachable(in.problem, in.rules, in.varyings));
-    // Point at the first fragment input whose request cannot be met.
-    SourceLoc at{in.fragment.file, 0, 0};
-    std::vector<bool> reach = reachableFacts(in.problem);
-    for (const auto& v : in.varyings)
-      for (const auto& s : v.semantics) {
-        int f = in.problem.findFact(s);
-        if (f >= 0 && !reach[f] && at.line == 0) at = v.loc.line ? v.loc : at;
-      }
-    if (!why.empty() && why.back() == '\n') why.pop_back();
-    throw InputError(at, fmt::format("the request cannot be met for rig '{}':\n{}", in.rig.name, why));
-  }
-  res.plan = *plan;
-
-  TemplateSet templates = TemplateSet::load(opts.templateDir.empty() ? defaultTemplateDir() : opts.templateDir);
+  res.plan = searchStage(in, opts.heuristic, &res.stats);
   EmitOptions eo;
   eo.capture = opts.capture;
   eo.heuristic = opts.heuristic;
   eo.version = shadergenVersion();
-  res.glsl = emitGlsl(in.rig, in.problem, res.plan, in.varyings, templates, in.fragment.file, eo);
-  try {
-    res.spirv = compileVertexShader(res.glsl, opts.outputName, opts.targetEnv);
-  } catch (const InputError& e) {
-    // glslang reports lines only: point the columns at the snippet text in the rules file.
-    std::vector<SourceLoc> snippetLines;
-    for (int a : res.plan.actions)
-      for (const auto& l : in.problem.actions[a].code) snippetLines.push_back(l.loc);
-    throw refineSnippetError(e, snippetLines);
-  }
-  if (std::string err = validateSpirv(res.spirv.words, opts.targetEnv); !err.empty())
-    throw InputError(SourceLoc{opts.outputName, 0, 0}, "generated SPIR-V fails validation: " + err);
-  checkLink(res.glsl, in.fragment.source, in.fragment.file, opts.targetEnv);
-  if (opts.optimize) {
-    res.spirv.words = optimizeSpirv(res.spirv.words, opts.targetEnv);
-    if (std::string err = validateSpirv(res.spirv.words, opts.targetEnv); !err.empty())
-      throw InputError(SourceLoc{opts.outputName, 0, 0}, "optimised SPIR-V fails validation: " + err);
-  }
-  res.inputsRead.push_back(in.rig.file);
-  res.inputsRead.push_back(in.fragment.file);
-  for (const auto& f : in.rules.files) res.inputsRead.push_back(f);
-  res.inputsRead.push_back(templates.file());
+  res.glsl = emitStage(in, res.plan, templates, eo);
+  CompiledVertexShader compiled = compileStage(in, res.plan, res.glsl, opts.outputName, opts.targetEnv);
+  res.spirv = compiled.module;
+  res.spirv.words = checkStage(compiled, in.fragment, opts.outputName, opts.targetEnv, opts.optimize);
+  res.inputsRead = inputsRead(in, templates);
   res.in = std::move(in);
   return res;
 }
