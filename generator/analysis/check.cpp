@@ -135,11 +135,20 @@ class Checker {
                            name, didYouMean(name)));
       }
     }
-    static const std::regex outRe(R"(\$\{\s*out\s*\})");
+    // `${ out }` found by hand: std::regex recursion grows with the line (snippet lines
+    // may be megabytes long).
+    auto mentionsOut = [](const std::string& t) {
+      for (size_t at = t.find("${"); at != std::string::npos; at = t.find("${", at + 2)) {
+        size_t p = t.find_first_not_of(" \t", at + 2);
+        if (p == std::string::npos || t.compare(p, 3, "out") != 0) continue;
+        p = t.find_first_not_of(" \t", p + 3);
+        if (p != std::string::npos && t[p] == '}') return true;
+      }
+      return false;
+    };
     bool writesOut = false;
     for (const auto& l : rule.glsl)
-      if (std::regex_search(l.text, outRe) || l.text.find("${" + rule.produces + "}") != std::string::npos)
-        writesOut = true;
+      if (mentionsOut(l.text) || l.text.find("${" + rule.produces + "}") != std::string::npos) writesOut = true;
     if (!writesOut) {
       SourceLoc at = keysOf(rule).glsl.line ? keysOf(rule).glsl : rule.loc;
       bad(at, fmt::format("the snippet of rule '{}' never writes its product (no '${{out}}')", rule.name));
@@ -398,6 +407,10 @@ class Checker {
           if (*row.stated < 0)
             error(keysOf(rule).cost.line ? keysOf(rule).cost : rule.loc,
                   fmt::format("rule '{}' has negative cost {} for {}", rule.name, *row.stated, chosen->name));
+          else if (*row.stated > kMaxRuleCost)
+            error(keysOf(rule).cost.line ? keysOf(rule).cost : rule.loc,
+                  fmt::format("rule '{}' has cost {} for {}, above the limit of {}", rule.name, *row.stated,
+                              chosen->name, kMaxRuleCost));
         } catch (const InputError& e) {
           add(unknownName, e.diagnostic().loc,
               fmt::format("rule '{}': cannot evaluate 'cost' for {}: {}", rule.name, chosen->name,

@@ -45,7 +45,9 @@ std::string compactFactList(const std::vector<std::string>& names) {
 std::optional<Plan> searchPlan(const Problem& p, const std::string& heuristic, SearchStats* stats) {
   auto h = makeHeuristic(heuristic, p);
   if (!h) throw InputError(SourceLoc{}, fmt::format("unknown heuristic '{}' (blind, hmax, lmcut)", heuristic));
-  return astarSearch(p, *h, stats);
+  SearchOptions o;  // the default engine: regression A* where the rule graph allows it
+  o.heuristic = heuristic;
+  return findPlan(p, o, stats);
 }
 
 Explanation explainPlan(const LoadedInputs& in, const Plan& plan, const ExplainOptions& opts) {

@@ -4,6 +4,7 @@
 
 #include <fstream>
 
+#include "common/input_file.h"
 #include "rig/rig.h"
 #include "rules/snippet.h"
 #include "search/problem.h"
@@ -170,11 +171,15 @@ void refineSnippetColumns(std::vector<Diagnostic>& diags, const std::vector<Sour
     auto it = fileLines.find(file);
     if (it == fileLines.end()) {
       std::vector<std::string> ls;
-      std::ifstream in(file, std::ios::binary);
-      std::string l;
-      while (std::getline(in, l)) {
+      std::string text;
+      tryReadInputFile(file, text);  // bounded; unreadable = no lines
+      for (size_t start = 0; start < text.size();) {
+        size_t nl = text.find('\n', start);
+        std::string l = text.substr(start, nl == std::string::npos ? std::string::npos : nl - start);
         if (!l.empty() && l.back() == '\r') l.pop_back();
-        ls.push_back(l);
+        ls.push_back(std::move(l));
+        if (nl == std::string::npos) break;
+        start = nl + 1;
       }
       it = fileLines.emplace(file, std::move(ls)).first;
     }

@@ -60,6 +60,10 @@ struct GraphCommand {
                        fmt::format("the request cannot be met for rig '{}':\n{}", in.rig.name, why));
     }
     std::string dot = planToDot(in, *plan);
+    std::vector<std::string> outs;
+    if (!output.empty() && output != "-") outs.push_back(output);
+    if (!svg.empty()) outs.push_back(svg);
+    refuseClobbering(outs, inputFiles(in));
     if (output.empty() || output == "-") std::cout << dot;
     else writeFilesAtomically({{output, dot}});
     if (!svg.empty()) renderSvg(dot, svg);

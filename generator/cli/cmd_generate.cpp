@@ -20,6 +20,16 @@ void GenerateArgs::add(CLI::App& cmd) {
   cmd.add_option("--map", maps, "Map a fragment input to semantics: Name=sem or Name=s1,s2,... (packs)");
   cmd.add_option("--heuristic", opts.heuristic, "A* heuristic: lmcut (default), hmax, blind")
       ->check(CLI::IsMember({"lmcut", "hmax", "blind"}));
+  cmd.add_option("--search", opts.searchEngine,
+                 "Search engine: auto (default: regression A* on acyclic rule graphs, else forward A*), "
+                 "regression, forward, ip (exact integer program, GLPK)")
+      ->check(CLI::IsMember({"auto", "regression", "forward", "ip"}));
+  cmd.add_option("--search-time-limit", opts.searchLimits.maxSeconds,
+                 "Give up (error) when one search runs longer than this many seconds (0 = no limit)")
+      ->check(CLI::NonNegativeNumber);
+  cmd.add_option("--max-expansions", opts.searchLimits.maxExpansions,
+                 "Give up (error) after this many A* expansions")
+      ->check(CLI::PositiveNumber);
   cmd.add_option("--target-env", targetEnv, "vulkan1.0 (default), vulkan1.1, vulkan1.2, vulkan1.3")
       ->check(CLI::IsMember({"vulkan", "vulkan1.0", "vulkan1.1", "vulkan1.2", "vulkan1.3"}));
   cmd.add_option("--templates", opts.templateDir, "Directory with vertex.glsl templates");
@@ -61,6 +71,13 @@ GenerateOptions GenerateArgs::resolve() const {
   return o;
 }
 
+std::vector<InputFile> inputFiles(const LoadedInputs& in, const std::vector<std::string>& extra) {
+  std::vector<InputFile> files{{in.rig.file, "the rig"}, {in.fragment.file, "the fragment shader"}};
+  for (const auto& f : in.rules.files) files.push_back({f, "a rules file"});
+  for (const auto& f : extra) files.push_back({f, "an input"});
+  return files;
+}
+
 namespace {
 
 struct GenerateCommand {
@@ -72,6 +89,7 @@ struct GenerateCommand {
   std::string depfilePath;
   bool quiet = false;
   bool capture = false;
+  bool stats = false;
 
   int run() {
     GenerateOptions o = args.resolve();
@@ -123,7 +141,11 @@ struct GenerateCommand {
       std::string dpath = depfilePath.empty() ? files.front().path + ".d" : depfilePath;
       files.push_back({dpath, makeDepfile(targets, r.inputsRead)});
     }
+    std::vector<std::string> outPaths;
+    for (const auto& f : files) outPaths.push_back(f.path);
+    refuseClobbering(outPaths, inputFiles(r.in, r.inputsRead));
     writeFilesAtomically(files);
+    if (stats) std::cout << describeStats(r.stats);
     if (!quiet) {
       std::cout << fmt::format("plan for rig '{}' ({} rules, {} expanded, {} heuristic):\n", r.in.rig.name,
                                r.plan.actions.size(), r.stats.expanded, o.heuristic);
@@ -150,6 +172,9 @@ void registerGenerate(CLI::App& app, CliState& state) {
                 "(rig, fragment shader, rules files and their includes, templates)");
   sub->add_option("--MF", cmd->depfilePath, "-MF FILE: depfile path (implies -MD)");
   sub->add_flag("-q,--quiet", cmd->quiet, "Do not print the plan");
+  sub->add_flag("--stats", cmd->stats,
+                "Print search statistics: engine, expansions, generated nodes, heuristic time, "
+                "initial h against the final cost");
   sub->add_flag("--capture", cmd->capture,
                 "Transform-feedback build: add xfb_buffer/xfb_offset/xfb_stride to gl_Position and every "
                 "output so sg::rt::Harness can read them back (testing/validation, not for rendering)")

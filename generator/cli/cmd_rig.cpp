@@ -17,12 +17,14 @@ struct RigImportCommand {
   int primitive = -1;
   std::string output;
   bool quiet = false;
+  bool packOcclusion = false;
 
   int run() {
     GltfRef ref = parseGltfRef(model);
     GltfImportOptions o;
     o.mesh = mesh >= 0 ? mesh : ref.mesh;
     o.primitive = primitive >= 0 ? primitive : ref.primitive;
+    o.packOcclusionInNormal = packOcclusion;
     GltfImport imp = importGltf(ref.file, o);
     std::vector<std::string> header{
         fmt::format("Imported by shadergen {} rig import from {}, mesh {} '{}', primitive {}.", shadergenVersion(),
@@ -50,6 +52,7 @@ struct RigImportCommand {
     if (output.empty() || output == "-") {
       std::cout << yaml;
     } else {
+      refuseClobbering({output}, {{ref.file, "the glTF model"}});
       writeFilesAtomically({PendingFile{output, yaml}});
     }
     return 0;
@@ -68,6 +71,8 @@ void registerRig(CLI::App& app, CliState& state) {
   imp->add_option("--primitive", cmd->primitive, "Primitive index within the mesh (default 0)")
       ->check(CLI::NonNegativeNumber);
   imp->add_option("-o,--output", cmd->output, "Output rig YAML (default: standard output)");
+  imp->add_flag("--pack-occlusion", cmd->packOcclusion,
+                "Dawn's layout: baked _OCCLUSION in normal.w (float32x4) and its target deltas in the normal deltas' w");
   imp->add_flag("-q,--quiet", cmd->quiet, "Do not print warnings about attributes left out");
   imp->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }

@@ -1,6 +1,8 @@
 // `shadergen validate`: generate, run on lavapipe, compare with the GLM reference.
 #include <fmt/format.h>
 
+#include <cmath>
+#include <cstdlib>
 #include <iostream>
 
 #include "cli/commands.h"
@@ -67,13 +69,25 @@ void registerValidate(CLI::App& app, CliState& state) {
       ->check(CLI::IsMember({"head", "limb", "dawn"}));
   sub->add_option("--seed", cmd->seed, "Seed of the random poses");
   sub->add_option("--poses", cmd->poses, "Number of random poses")->check(CLI::Range(1, 100));
-  sub->add_option("--time", cmd->times, "glTF rig (MODEL.glb#m/p): animation time in seconds (repeatable)");
+  // CLI11 reads "nan", "inf" and "-1" as doubles; none is a time or a tolerance.
+  CLI::Validator finiteNonNegative(
+      [](std::string& s) -> std::string {
+        char* end = nullptr;
+        double v = std::strtod(s.c_str(), &end);
+        if (s.empty() || *end != '\0' || !std::isfinite(v) || v < 0) return "must be a finite number >= 0, got '" + s + "'";
+        return "";
+      },
+      "NUMBER >= 0");
+  sub->add_option("--time", cmd->times, "glTF rig (MODEL.glb#m/p): animation time in seconds (repeatable)")
+      ->check(finiteNonNegative);
   sub->add_option("--animation", cmd->animation, "glTF rig: animation name or index (default: the first)");
   sub->add_flag("--cross-check", cmd->crossCheck, "Also force and check every alternative derivation");
   sub->add_option("--device", cmd->device, "Vulkan device name (substring); default lavapipe");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer");
-  sub->add_option("--tolerance-abs", cmd->tol.abs, "Absolute tolerance (see docs/validation.md)");
-  sub->add_option("--tolerance-rel", cmd->tol.rel, "Relative tolerance (see docs/validation.md)");
+  sub->add_option("--tolerance-abs", cmd->tol.abs, "Absolute tolerance (see docs/validation.md)")
+      ->check(finiteNonNegative);
+  sub->add_option("--tolerance-rel", cmd->tol.rel, "Relative tolerance (see docs/validation.md)")
+      ->check(finiteNonNegative);
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }
 

@@ -8,6 +8,7 @@ void registerCommands(CLI::App& app, CliState& state) {
   registerCheck(app, state);
   registerExplain(app, state);
   registerRig(app, state);
+  registerBake(app, state);
   registerBuild(app, state);
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/output_files.h"
 #include "pipeline/generate.h"
 
 namespace sg {
@@ -26,6 +27,9 @@ struct GenerateArgs {
   GenerateOptions resolve() const;  // parses --map and --target-env (throws CLI::ValidationError)
 };
 
+// Every file `in` was loaded from (plus `extra`), named for refuseClobbering (output_files.h).
+std::vector<InputFile> inputFiles(const LoadedInputs& in, const std::vector<std::string>& extra = {});
+
 void registerCommands(CLI::App& app, CliState& state);
 void registerGenerate(CLI::App& app, CliState& state);
 void registerValidate(CLI::App& app, CliState& state);
@@ -33,5 +37,6 @@ void registerCheck(CLI::App& app, CliState& state);    // cmd_check.cpp
 void registerExplain(CLI::App& app, CliState& state);  // cmd_explain.cpp: explain + graph
 void registerRig(CLI::App& app, CliState& state);      // cmd_rig.cpp: rig import
 void registerBuild(CLI::App& app, CliState& state);    // cmd_build.cpp: variant manifests
+void registerBake(CLI::App& app, CliState& state);     // cmd_bake.cpp: bake occlusion
 
 }  // namespace sg

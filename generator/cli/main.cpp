@@ -48,6 +48,14 @@ int main(int argc, char** argv) {
       std::cerr << sg::renderDiagnostic(d) << "\n";
     }
     return 1;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // "path: error: No such file or directory", not the library's "filesystem error: ..."
+    std::string where = e.path1().empty() ? "shadergen" : e.path1().string();
+    std::cerr << sg::formatDiagnostic(sg::Diagnostic{sg::Severity::Error, {where, 0, 0}, e.code().message()}) << "\n";
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "shadergen: error: out of memory\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "shadergen: error: " << e.what() << "\n";
     return 1;

@@ -1,6 +1,7 @@
 #include "cli/output_files.h"
 
 #include <fmt/format.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -9,7 +10,60 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "common/diagnostics.h"
+
 namespace sg {
+
+namespace {
+
+// The file a path names: resolved links and '..' (parents that do not exist yet are kept
+// lexically), and its inode when it exists.
+struct Identity {
+  std::string path;
+  bool exists = false;
+  dev_t dev = 0;
+  ino_t ino = 0;
+};
+Identity identify(const std::string& p) {
+  Identity id;
+  std::error_code ec;
+  std::filesystem::path abs = std::filesystem::weakly_canonical(std::filesystem::absolute(p, ec), ec);
+  id.path = ec ? std::filesystem::path(p).lexically_normal().string() : abs.string();
+  struct stat st {};
+  if (::stat(p.c_str(), &st) == 0) {
+    id.exists = true;
+    id.dev = st.st_dev;
+    id.ino = st.st_ino;
+  }
+  return id;
+}
+bool same(const Identity& a, const Identity& b) {
+  return a.path == b.path || (a.exists && b.exists && a.dev == b.dev && a.ino == b.ino);
+}
+
+}  // namespace
+
+void refuseClobbering(const std::vector<std::string>& outputs, const std::vector<InputFile>& inputs) {
+  std::vector<Identity> ins;
+  for (const auto& i : inputs) ins.push_back(identify(i.path));
+  std::vector<Identity> outs;
+  for (const auto& o : outputs) {
+    Identity id = identify(o);
+    for (size_t i = 0; i < ins.size(); ++i)
+      if (same(id, ins[i]))
+        throw InputError(SourceLoc{},
+                         fmt::format("output '{}' is {} ('{}'); refusing to overwrite an input", o, inputs[i].what,
+                                     inputs[i].path));
+    for (size_t j = 0; j < outs.size(); ++j)
+      if (same(id, outs[j]))
+        throw InputError(SourceLoc{}, fmt::format("outputs '{}' and '{}' are the same file", outputs[j], o));
+    struct stat st {};
+    if (::stat(o.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+      throw InputError(SourceLoc{}, fmt::format("output '{}' exists and is not a regular file ({})", o,
+                                                S_ISDIR(st.st_mode) ? "a directory" : "a device, FIFO or socket"));
+    outs.push_back(id);
+  }
+}
 
 void writeFilesAtomically(const std::vector<PendingFile>& files) {
   namespace fs = std::filesystem;
@@ -88,6 +142,10 @@ std::string makeDepfile(const std::vector<std::string>& targets, const std::vect
     }
     return o;
   };
+  for (const auto* list : {&targets, &deps})
+    for (const auto& p : *list)
+      if (p.find_first_of("\n\r") != std::string::npos)
+        throw InputError(SourceLoc{}, fmt::format("cannot write a depfile naming '{}': the path contains a newline", p));
   std::string out;
   for (const auto& t : targets) out += (out.empty() ? "" : " ") + esc(t);
   out += ":";

@@ -16,7 +16,18 @@ struct PendingFile {
 // removed, and no temporary is left behind. Throws std::runtime_error naming the file.
 void writeFilesAtomically(const std::vector<PendingFile>& files);
 
+// Refuses (throws InputError) before anything is written: an output that resolves to one
+// of `inputs` (same path after resolving links and '..', or the same inode), two outputs
+// naming one file, and an output that exists but is not a regular file (a device, a FIFO:
+// renaming over it would replace it). `what` names each input in the message.
+struct InputFile {
+  std::string path;
+  std::string what;  // "the rig", "a rules file", ...
+};
+void refuseClobbering(const std::vector<std::string>& outputs, const std::vector<InputFile>& inputs);
+
 // "target1 target2: dep1 dep2 ..." with spaces, '#' and '$' escaped (Make/Ninja syntax).
+// A path with a newline cannot be written in that syntax: throws InputError.
 std::string makeDepfile(const std::vector<std::string>& targets, const std::vector<std::string>& deps);
 inline std::string makeDepfile(const std::string& target, const std::vector<std::string>& deps) {
   return makeDepfile(std::vector<std::string>{target}, deps);

@@ -2,7 +2,7 @@
 
 #include <fmt/format.h>
 
-#include <fstream>
+#include "common/input_file.h"
 
 namespace sg {
 
@@ -10,24 +10,36 @@ InputError::InputError(Diagnostic d) : std::runtime_error(formatDiagnostic(d)), 
 InputError::InputError(SourceLoc loc, const std::string& message)
     : InputError(Diagnostic{Severity::Error, std::move(loc), message}) {}
 
+namespace {
+// Names from input files end up in messages: show control bytes as \xNN so that a
+// message cannot move the cursor or fake another diagnostic line.
+std::string printable(const std::string& s, bool keepNewlines) {
+  std::string o;
+  for (char c : s) {
+    auto u = static_cast<unsigned char>(c);
+    if ((u < 0x20 && c != '\t' && !(keepNewlines && c == '\n')) || u == 0x7f) o += fmt::format("\\x{:02x}", u);
+    else o += c;
+  }
+  return o;
+}
+}  // namespace
+
 std::string formatDiagnostic(const Diagnostic& d) {
   const char* sev = d.severity == Severity::Error ? "error" : d.severity == Severity::Warning ? "warning" : "note";
-  std::string where = d.loc.file.empty() ? "shadergen" : d.loc.file;
+  std::string where = d.loc.file.empty() ? "shadergen" : printable(d.loc.file, false);
   if (d.loc.line > 0) where += fmt::format(":{}", d.loc.line);
   if (d.loc.line > 0 && d.loc.col > 0) where += fmt::format(":{}", d.loc.col);
-  return fmt::format("{}: {}: {}", where, sev, d.message);
+  return fmt::format("{}: {}: {}", where, sev, printable(d.message, true));
 }
 
 std::string renderDiagnostic(const Diagnostic& d) {
   std::string out = formatDiagnostic(d);
   if (d.loc.file.empty() || d.loc.line <= 0) return out;
-  std::ifstream in(d.loc.file, std::ios::binary);
-  std::string line;
-  for (int i = 0; i < d.loc.line && std::getline(in, line); ++i) {
-  }
-  if (!in && line.empty()) return out;
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-  if (line.size() > 200) return out;  // don't quote minified/huge lines
+  // Bounded: a FIFO, a device or an oversize file is not re-read (common/input_file.h).
+  std::string line = inputFileLine(d.loc.file, d.loc.line);
+  if (line.empty() || line.size() > 200) return out;  // don't quote minified/huge lines
+  for (char& c : line)
+    if (static_cast<unsigned char>(c) < 0x20 && c != '\t') c = '?';  // no terminal control codes
   out += "\n  " + line;
   if (d.loc.col > 0) out += "\n  " + std::string(static_cast<size_t>(d.loc.col - 1), ' ') + "^";
   return out;

@@ -12,7 +12,6 @@
 #include <algorithm>
 #include <map>
 #include <mutex>
-#include <regex>
 #include <sstream>
 #include <stdexcept>
 
@@ -251,31 +250,55 @@ std::string GlslShader::linkWith(const GlslShader& next) const {
   return log.empty() ? "link failed" : log;
 }
 
+namespace {
+
+// "ERROR: 0:12: message" → severity, source string, line, message. Parsed by hand: a
+// std::regex over a message that quotes a 30 KB token recurses once per character.
+bool splitLogLine(const std::string& line, Severity& sev, size_t& src, int& lineNo, std::string& msg) {
+  size_t p = 0;
+  if (line.rfind("ERROR: ", 0) == 0) {
+    sev = Severity::Error;
+    p = 7;
+  } else if (line.rfind("WARNING: ", 0) == 0) {
+    sev = Severity::Warning;
+    p = 9;
+  } else {
+    return false;
+  }
+  auto number = [&](unsigned long long& v) {
+    size_t b = p;
+    v = 0;
+    while (p < line.size() && line[p] >= '0' && line[p] <= '9') {
+      if (v < 1'000'000'000ull) v = v * 10 + static_cast<unsigned>(line[p] - '0');  // saturates, never throws
+      ++p;
+    }
+    return p > b;
+  };
+  unsigned long long s = 0, l = 0;
+  if (!number(s) || p >= line.size() || line[p++] != ':') return false;
+  if (!number(l) || line.compare(p, 2, ": ") != 0) return false;
+  src = static_cast<size_t>(s);
+  lineNo = static_cast<int>(std::min<unsigned long long>(l, 1'000'000'000ull));
+  msg = line.substr(p + 2);
+  return true;
+}
+
+}  // namespace
+
 std::vector<Diagnostic> parseGlslangLog(const std::string& log, const GlslUnit& unit) {
   std::vector<Diagnostic> out;
-  // The source is a string number (after `#line L S`) or the unit's file name.
-  static const std::regex re(R"(^(ERROR|WARNING): (.*?):(\d+): (.*)$)");
   std::istringstream in(log);
   std::string line;
   while (std::getline(in, line)) {
-    std::smatch m;
-    if (!std::regex_match(line, m, re)) {
+    Diagnostic d;
+    size_t src = 0;
+    if (!splitLogLine(line, d.severity, src, d.loc.line, d.message)) {
       // Unlocated messages (e.g. linker errors) still matter.
       if (line.rfind("ERROR: ", 0) == 0 && line.find("compilation errors") == std::string::npos)
         out.push_back(Diagnostic{Severity::Error, SourceLoc{unit.fileName, 0, 0}, line.substr(7)});
       continue;
     }
-    Diagnostic d;
-    d.severity = m[1] == "ERROR" ? Severity::Error : Severity::Warning;
-    std::string source = m[2];
-    if (!source.empty() && std::all_of(source.begin(), source.end(), [](char c) { return c >= '0' && c <= '9'; })) {
-      size_t src = std::stoul(source);
-      d.loc.file = (src >= 1 && src <= unit.sourceFiles.size()) ? unit.sourceFiles[src - 1] : unit.fileName;
-    } else {
-      d.loc.file = source.empty() ? unit.fileName : source;
-    }
-    d.loc.line = std::stoi(m[3]);
-    d.message = m[4];
+    d.loc.file = (src >= 1 && src <= unit.sourceFiles.size()) ? unit.sourceFiles[src - 1] : unit.fileName;
     while (!d.message.empty() && d.message.back() == ' ') d.message.pop_back();
     if (d.message == "compilation terminated") continue;  // follows the real error
     out.push_back(std::move(d));

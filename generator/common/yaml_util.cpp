@@ -5,30 +5,64 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <sstream>
+#include <vector>
 
 namespace sg {
 
-std::string readInputFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw InputError(SourceLoc{path, 0, 0}, fmt::format("cannot open file: {}", std::strerror(errno)));
-  auto size = static_cast<size_t>(in.tellg());
-  if (size > kMaxInputBytes)
-    throw InputError(SourceLoc{path, 0, 0},
-                     fmt::format("file is {} bytes, larger than the {} byte limit for inputs", size, kMaxInputBytes));
-  std::string text(size, '\0');
-  in.seekg(0);
-  in.read(text.data(), static_cast<std::streamsize>(size));
-  return text;
+namespace {
+
+// Walks the parsed document without recursion: refuses nesting deeper than
+// kMaxYamlDepth, more than kMaxYamlNodes nodes (aliases make a small file a huge tree)
+// and a key repeated in one mapping (yaml-cpp keeps the last one silently).
+void checkYamlShape(const YAML::Node& root, const std::string& file) {
+  struct Item {
+    YAML::Node node;
+    int depth;
+  };
+  std::vector<Item> stack{{root, 1}};
+  size_t visited = 0;
+  while (!stack.empty()) {
+    Item item = std::move(stack.back());
+    stack.pop_back();
+    if (++visited > kMaxYamlNodes)
+      throw InputError(locOf(item.node, file),
+                       fmt::format("YAML document has more than {} nodes (aliases expanded)", kMaxYamlNodes));
+    if (item.depth > kMaxYamlDepth)
+      throw InputError(locOf(item.node, file), fmt::format("YAML nesting is deeper than {} levels", kMaxYamlDepth));
+    if (item.node.IsSequence()) {
+      for (auto it = item.node.begin(); it != item.node.end(); ++it) stack.push_back({YAML::Node(*it), item.depth + 1});
+    } else if (item.node.IsMap()) {
+      std::map<std::string, SourceLoc> seen;
+      for (auto it = item.node.begin(); it != item.node.end(); ++it) {
+        YAML::Node key = it->first, value = it->second;
+        if (key.IsScalar()) {
+          SourceLoc at = locOf(key, file);
+          auto [prev, fresh] = seen.emplace(key.Scalar(), at);
+          if (!fresh)
+            throw InputError(at, fmt::format("duplicate key '{}' (first at line {})", key.Scalar(), prev->second.line));
+        } else {
+          stack.push_back({key, item.depth + 1});
+        }
+        stack.push_back({value, item.depth + 1});
+      }
+    }
+  }
 }
 
+}  // namespace
+
 YAML::Node parseYaml(const std::string& text, const std::string& file) {
+  YAML::Node root;
   try {
-    return YAML::Load(text);
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     std::string msg = e.msg.empty() ? "malformed YAML" : e.msg;
     throw InputError(SourceLoc{file, e.mark.line + 1, e.mark.column + 1}, "malformed YAML: " + msg);
   }
+  checkYamlShape(root, file);
+  return root;
 }
 
 SourceLoc locOf(const YAML::Node& n, const std::string& file) {

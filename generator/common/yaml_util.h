@@ -6,16 +6,17 @@
 #include <string>
 
 #include "common/diagnostics.h"
+#include "common/input_file.h"
 
 namespace sg {
 
-// Input files larger than this are rejected before parsing (guards against runaway input).
-constexpr size_t kMaxInputBytes = 16u << 20;
+// Documents nested deeper than this, or with more nodes (aliases expanded), are refused:
+// the formats need a few levels and a few thousand nodes (docs/limits.md).
+constexpr int kMaxYamlDepth = 32;
+constexpr size_t kMaxYamlNodes = 1u << 20;
 
-// Reads a whole file; throws InputError if it is missing, unreadable or too large.
-std::string readInputFile(const std::string& path);
-
-// Parses YAML text; parse errors become "file:line:col: error: ...".
+// Parses YAML text; parse errors become "file:line:col: error: ...". Also refuses
+// duplicate keys in a mapping and the limits above.
 YAML::Node parseYaml(const std::string& text, const std::string& file);
 
 SourceLoc locOf(const YAML::Node& n, const std::string& file);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <set>
+#include <stdexcept>
 
 namespace sg {
 
@@ -17,9 +18,32 @@ std::string tempName(const std::string& fact) {
   return s;
 }
 
+std::string commentSafe(const std::string& text) {
+  std::string s;
+  for (char c : text) {
+    auto u = static_cast<unsigned char>(c);
+    // A newline would end the comment and inject code; a trailing '\\' would splice the
+    // next line into the comment (GLSL line continuation).
+    s += (u < 0x20 || u == 0x7f || c == '\\') ? '?' : c;
+  }
+  return s;
+}
+
 namespace {
 
-std::string baseName(const std::string& path) { return std::filesystem::path(path).filename().string(); }
+std::string baseName(const std::string& path) { return commentSafe(std::filesystem::path(path).filename().string()); }
+
+// The fact id inside an internal reference "\x01<id>\x02" (rules/snippet.h): snippets
+// cannot contain these bytes (the rules loader refuses control bytes), so a malformed
+// one is a bug here, not an input error.
+int refFact(const std::string& s, size_t begin, size_t facts) {
+  size_t i = begin + 1;
+  long long v = 0;
+  while (i < s.size() && s[i] >= '0' && s[i] <= '9' && v < 1'000'000'000) v = v * 10 + (s[i++] - '0');
+  if (i == begin + 1 || i >= s.size() || s[i] != kFactRefEnd || v < 0 || static_cast<size_t>(v) >= facts)
+    throw std::logic_error("internal error: malformed fact reference in a snippet");
+  return static_cast<int>(v);
+}
 
 class Emitter {
  public:
@@ -67,7 +91,7 @@ class Emitter {
     std::map<std::string, std::string> v{
         {"version", opts_.version},
         {"extensions", ""},
-        {"rig", rig_.name},
+        {"rig", commentSafe(rig_.name)},
         {"fragment", baseName(fragmentName)},
         {"cost", std::to_string(plan_.cost)},
         {"heuristic", opts_.heuristic},
@@ -99,7 +123,7 @@ class Emitter {
 
   void markRefs(const std::string& s) {
     for (size_t i = s.find(kFactRefBegin); i != std::string::npos; i = s.find(kFactRefBegin, i + 1))
-      used_[std::stoi(s.substr(i + 1))] = true;
+      used_[refFact(s, i, p_.facts.size())] = true;
   }
 
   void declareInputs() {
@@ -189,7 +213,7 @@ class Emitter {
       }
       size_t e = s.find(kFactRefEnd, b);
       out += s.substr(i, b - i);
-      out += factExpr(std::stoi(s.substr(b + 1, e - b - 1)));
+      out += factExpr(refFact(s, b, p_.facts.size()));
       i = e + 1;
     }
     return out;

@@ -56,5 +56,8 @@ EmittedGlsl emitGlsl(const Rig& rig, const Problem& p, const Plan& plan, const s
 
 // GLSL identifier for a computed fact: "world.normal" → "t_world_normal", "a[2]" → "t_a_2".
 std::string tempName(const std::string& fact);
+// Text safe inside a `//` comment: control bytes and '\\' become '?' (names from the rig,
+// the glTF mesh or a file name must not end the comment or splice the next line).
+std::string commentSafe(const std::string& text);
 
 }  // namespace sg

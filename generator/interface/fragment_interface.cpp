@@ -3,7 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <regex>
+#include <string_view>
 
 #include "common/glsl_compile.h"
 #include "common/yaml_util.h"
@@ -13,21 +13,64 @@ namespace sg {
 namespace {
 
 // Where `name` is declared as an input: glslang's reflection carries no source location.
-SourceLoc findDeclaration(const std::string& source, const std::string& file, const std::string& name) {
-  std::regex decl("\\bin\\b[^;{}]*\\b" + name + "\\s*;");
+// A linear scan over tokens (comments and preprocessor lines skipped): the statement
+// that contains the word `in` and whose last identifier is `name`. No regex: a long
+// line must cost linear time and constant stack.
+SourceLoc findDeclaration(const std::string& src, const std::string& file, const std::string& name) {
+  auto isIdStart = [](char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; };
+  auto isId = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
   int line = 1;
-  size_t start = 0;
-  while (start <= source.size()) {
-    size_t end = source.find('\n', start);
-    std::string l = source.substr(start, end == std::string::npos ? std::string::npos : end - start);
-    std::smatch m;
-    if (std::regex_search(l, m, decl)) {
-      size_t col = l.find(name, static_cast<size_t>(m.position(0)));
-      return SourceLoc{file, line, static_cast<int>(col) + 1};
+  size_t lineStart = 0;
+  bool sawIn = false;
+  SourceLoc last{file, 0, 0};
+  std::string lastName;
+  bool atLineStart = true;
+  for (size_t i = 0; i < src.size();) {
+    char c = src[i];
+    if (c == '\n') {
+      ++line;
+      lineStart = ++i;
+      atLineStart = true;
+      continue;
     }
-    if (end == std::string::npos) break;
-    start = end + 1;
-    ++line;
+    if (c == '/' && i + 1 < src.size() && src[i + 1] == '/') {
+      while (i < src.size() && src[i] != '\n') ++i;
+      continue;
+    }
+    if (c == '/' && i + 1 < src.size() && src[i + 1] == '*') {
+      size_t end = src.find("*/", i + 2);
+      end = end == std::string::npos ? src.size() : end + 2;
+      for (; i < end; ++i)
+        if (src[i] == '\n') {
+          ++line;
+          lineStart = i + 1;
+        }
+      continue;
+    }
+    if (c == '#' && atLineStart) {  // preprocessor line (continuations are rare here)
+      while (i < src.size() && src[i] != '\n') ++i;
+      continue;
+    }
+    if (std::isspace(static_cast<unsigned char>(c))) {
+      ++i;
+      continue;
+    }
+    atLineStart = false;
+    if (isIdStart(c)) {
+      size_t b = i;
+      while (i < src.size() && isId(src[i])) ++i;
+      std::string_view word(src.data() + b, i - b);
+      if (word == "in") sawIn = true;
+      lastName.assign(word);
+      last = SourceLoc{file, line, static_cast<int>(b - lineStart) + 1};
+      continue;
+    }
+    if (c == ';' && sawIn && lastName == name) return last;
+    if (c == ';' || c == '{' || c == '}') {
+      sawIn = false;
+      lastName.clear();
+    }
+    ++i;
   }
   return SourceLoc{file, 0, 0};
 }
@@ -43,7 +86,34 @@ const SemanticDecl* semanticNamed(const RuleSet& rules, const std::string& input
   return nullptr;
 }
 
+// glslang gives lines only; its messages start with the offending token in quotes
+// ("'foo' : undeclared identifier"): point the column at that token on the line.
+void addColumn(Diagnostic& d, const std::string& source) {
+  if (d.loc.line <= 0 || d.loc.col > 0 || d.message.size() < 3 || d.message[0] != '\'') return;
+  size_t close = d.message.find('\'', 1);
+  if (close == std::string::npos || close == 1) return;
+  std::string token = d.message.substr(1, close - 1);
+  size_t start = 0;
+  for (int l = 1; l < d.loc.line; ++l) {
+    start = source.find('\n', start);
+    if (start == std::string::npos) return;
+    ++start;
+  }
+  size_t end = source.find('\n', start);
+  std::string_view line(source.data() + start, (end == std::string::npos ? source.size() : end) - start);
+  size_t at = line.find(token);
+  if (at != std::string_view::npos) d.loc.col = static_cast<int>(at) + 1;
+}
+
 }  // namespace
+
+const char* reservedNameUse(const std::string& name) {
+  if (name.rfind("t_", 0) == 0) return "starts with 't_', the prefix of the generator's temporaries";
+  if (name.rfind("a_", 0) == 0) return "starts with 'a_', the prefix of the generated vertex attributes";
+  if (name.rfind("u_", 0) == 0) return "starts with 'u_', the prefix of the generated uniforms";
+  if (name == kUniformBlockName) return "is the name of the generated uniform block";
+  return nullptr;
+}
 
 FragmentInterface reflectFragmentFile(const std::string& path, TargetEnv env) {
   return reflectFragmentSource(readInputFile(path), path, env);
@@ -54,7 +124,11 @@ FragmentInterface reflectFragmentSource(const std::string& source, const std::st
   fi.file = fileName;
   fi.source = source;
   GlslShader shader(GlslUnit{Stage::Fragment, source, fileName, {}}, env);
-  if (!shader.ok()) throwDiagnostics(shader.diagnostics(), fileName, "the fragment shader does not compile");
+  if (!shader.ok()) {
+    std::vector<Diagnostic> diags = shader.diagnostics();
+    for (auto& d : diags) addColumn(d, source);
+    throwDiagnostics(std::move(diags), fileName, "the fragment shader does not compile");
+  }
   for (const StageVariable& r : shader.inputs()) {
     if (r.name.rfind("gl_", 0) == 0) continue;  // gl_FragCoord etc. are not vertex outputs
     FragmentInput in;
@@ -83,6 +157,16 @@ FragmentInterface reflectFragmentSource(const std::string& source, const std::st
 
 std::vector<Varying> bindVaryings(const FragmentInterface& frag, const RuleSet& rules,
                                   const std::vector<VaryingOverride>& overrides) {
+  for (const auto& o : overrides) {
+    bool found = std::any_of(frag.inputs.begin(), frag.inputs.end(), [&](const FragmentInput& in) { return in.name == o.name; });
+    if (!found) {
+      std::string names;
+      for (const auto& in : frag.inputs) names += (names.empty() ? "" : ", ") + in.name;
+      throw InputError(SourceLoc{frag.file, 0, 0},
+                       fmt::format("--map {}=...: the fragment shader has no input '{}' (its inputs: {})", o.name,
+                                   o.name, names.empty() ? "none" : names));
+    }
+  }
   std::vector<Varying> out;
   Varying pos;
   pos.name = "gl_Position";
@@ -92,6 +176,8 @@ std::vector<Varying> bindVaryings(const FragmentInterface& frag, const RuleSet& 
   out.push_back(pos);
 
   for (const auto& in : frag.inputs) {
+    if (const char* why = reservedNameUse(in.name))
+      throw InputError(in.loc, fmt::format("fragment input '{}' {}; rename it", in.name, why));
     Varying v;
     v.name = in.name;
     v.type = in.type;

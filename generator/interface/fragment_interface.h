@@ -43,6 +43,13 @@ struct Varying {
   SourceLoc loc;
 };
 
+// The generated vertex shader names its own declarations t_<fact> (temporaries), a_<name>
+// (attributes), u_<name> (uniforms) and kUniformBlockName; its outputs take the fragment
+// inputs' names, so an input with such a name would collide. Returns why `name` is
+// reserved, or nullptr.
+inline constexpr const char* kUniformBlockName = "ShadergenUniforms";
+const char* reservedNameUse(const std::string& name);
+
 // Command-line override "Name=sem" or "Name=sem1,sem2,...".
 struct VaryingOverride {
   std::string name;

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <stdexcept>
+
 #include "analysis/cost.h"
 #include "analysis/explain.h"
 #include "analysis/probe.h"
@@ -36,11 +39,16 @@ LoadedInputs instantiateStage(Rig rig, RuleSet rules, FragmentInterface fragment
   return in;
 }
 
-Plan searchStage(const LoadedInputs& in, const std::string& heuristic, SearchStats* stats) {
+Plan searchStage(const LoadedInputs& in, const SearchOptions& opts, SearchStats* stats) {
   const Problem& p = in.problem;
-  auto h = makeHeuristic(heuristic, p);
-  if (!h) throw InputError(SourceLoc{}, fmt::format("unknown heuristic '{}' (blind, hmax, lmcut)", heuristic));
-  std::optional<Plan> plan = astarSearch(p, *h, stats);
+  if (!makeHeuristic(opts.heuristic, p))
+    throw InputError(SourceLoc{}, fmt::format("unknown heuristic '{}' (blind, hmax, lmcut)", opts.heuristic));
+  std::optional<Plan> plan;
+  try {
+    plan = findPlan(p, opts, stats);
+  } catch (const std::invalid_argument& e) {  // unknown engine, or regression on a cyclic rule graph
+    throw InputError(SourceLoc{}, e.what());
+  }
   if (plan) return *plan;
   std::string why = formatUnreachable(p, analyzeUnreachable(p, in.rules, in.varyings));
   // Point at the first fragment input whose request cannot be met.
@@ -73,16 +81,35 @@ CompiledVertexShader compileStage(const LoadedInputs& in, const Plan& plan, cons
   }
 }
 
-std::vector<uint32_t> checkStage(const CompiledVertexShader& vertex, const FragmentInterface& fragment,
-                                 const std::string& glslName, TargetEnv env, bool optimize) {
+std::vector<uint32_t> checkStage(const LoadedInputs& in, const EmittedGlsl& glsl, const CompiledVertexShader& vertex,
+                                 const CheckOptions& opts) {
   std::vector<uint32_t> words = vertex.module.words;
-  if (std::string err = validateSpirv(words, env); !err.empty())
-    throw InputError(SourceLoc{glslName, 0, 0}, "generated SPIR-V fails validation: " + err);
-  checkLink(vertex.parsed, GlslShader(GlslUnit{Stage::Fragment, fragment.source, fragment.file, {}}, env));
-  if (optimize) {
-    words = optimizeSpirv(words, env);
-    if (std::string err = validateSpirv(words, env); !err.empty())
-      throw InputError(SourceLoc{glslName, 0, 0}, "optimised SPIR-V fails validation: " + err);
+  if (std::string err = validateSpirv(words, opts.env); !err.empty())
+    throw InputError(SourceLoc{opts.glslName, 0, 0}, "generated SPIR-V fails validation: " + err);
+  if (vertex.module.uniformBlockSize > opts.maxUniformBlockBytes) {
+    // Point at the largest uniform the plan reads (a bone palette, usually).
+    SourceLoc at{in.rig.file, 0, 0};
+    std::string list;
+    int64_t largest = -1;
+    for (const auto& u : glsl.uniforms) {
+      const RigUniform& ru = in.rig.uniforms[u.uniform];
+      int64_t bytes = int64_t{componentCount(ru.type)} * 4 * std::max(1, ru.arraySize);
+      list += fmt::format("{}{} {}{}", list.empty() ? "" : ", ", glslName(ru.type), ru.name,
+                          ru.arraySize ? fmt::format("[{}]", ru.arraySize) : "");
+      if (bytes > largest) {
+        largest = bytes;
+        at = ru.loc;
+      }
+    }
+    throw InputError(at, fmt::format("the uniform block is {} bytes (std140: {}), larger than the {} bytes of "
+                                     "maxUniformBufferRange that every Vulkan device supports",
+                                     vertex.module.uniformBlockSize, list, opts.maxUniformBlockBytes));
+  }
+  checkLink(vertex.parsed, GlslShader(GlslUnit{Stage::Fragment, in.fragment.source, in.fragment.file, {}}, opts.env));
+  if (opts.optimize) {
+    words = optimizeSpirv(words, opts.env);
+    if (std::string err = validateSpirv(words, opts.env); !err.empty())
+      throw InputError(SourceLoc{opts.glslName, 0, 0}, "optimised SPIR-V fails validation: " + err);
   }
   return words;
 }
@@ -99,8 +126,12 @@ std::vector<std::string> inputsRead(const LoadedInputs& in, const TemplateSet& t
 LoadedInputs loadInputs(const GenerateOptions& opts) {
   Rig rig = loadRigStage(opts.rigPath);
   if (!opts.rigParams.empty()) rig = rigWithParameters(rig, opts.rigParams, SourceLoc{});
-  return instantiateStage(std::move(rig), loadRulesStage(opts.rulesPaths),
-                          loadFragmentStage(opts.fragmentPath, opts.targetEnv), opts.overrides);
+  LoadedInputs in = instantiateStage(std::move(rig), loadRulesStage(opts.rulesPaths),
+                                     loadFragmentStage(opts.fragmentPath, opts.targetEnv), opts.overrides);
+  for (const auto& b : opts.bannedRules)  // a misspelt --ban would otherwise change nothing silently
+    if (std::none_of(in.rules.rules.begin(), in.rules.rules.end(), [&](const Rule& r) { return r.name == b; }))
+      throw InputError(SourceLoc{}, fmt::format("--ban {}: no rule of that name in the rules files", b));
+  return in;
 }
 
 std::string explainUnreachable(const Problem& p, const RuleSet& rules) {
@@ -117,7 +148,7 @@ GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts) {
 GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const GenerateOptions& opts) {
   GenerateResult res;
   if (!opts.bannedRules.empty()) in.problem = withoutRules(in.problem, opts.bannedRules);
-  res.plan = searchStage(in, opts.heuristic, &res.stats);
+  res.plan = searchStage(in, SearchOptions{opts.searchEngine, opts.heuristic, opts.searchLimits}, &res.stats);
   EmitOptions eo;
   eo.capture = opts.capture;
   eo.heuristic = opts.heuristic;
@@ -125,7 +156,8 @@ GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const
   res.glsl = emitStage(in, res.plan, templates, eo);
   CompiledVertexShader compiled = compileStage(in, res.plan, res.glsl, opts.outputName, opts.targetEnv);
   res.spirv = compiled.module;
-  res.spirv.words = checkStage(compiled, in.fragment, opts.outputName, opts.targetEnv, opts.optimize);
+  res.spirv.words =
+      checkStage(in, res.glsl, compiled, CheckOptions{opts.outputName, opts.targetEnv, opts.optimize, opts.maxUniformBlockBytes});
   res.inputsRead = inputsRead(in, templates);
   res.in = std::move(in);
   return res;

@@ -15,11 +15,14 @@
 #include "rules/rules.h"
 #include "search/astar.h"
 #include "search/instance.h"
+#include "search/search.h"
 #include "search/plan.h"
 #include "search/problem.h"
 #include "pipeline/stages.h"
 
 namespace sg {
+
+constexpr uint32_t kVulkanMinUniformBufferRange = 16384;
 
 struct GenerateOptions {
   std::string rigPath;
@@ -29,11 +32,16 @@ struct GenerateOptions {
   std::map<std::string, int64_t> rigParams;  // deformer parameters set on the rig (--set)
   std::vector<std::string> bannedRules;  // force alternatives (cross-check, explain)
   std::string heuristic = "lmcut";
+  std::string searchEngine = "auto";  // auto, regression, forward, ip (search/search.h)
+  SearchLimits searchLimits;
   std::string templateDir;  // "" = defaultTemplateDir()
   TargetEnv targetEnv = TargetEnv::Vulkan1_0;
   bool optimize = false;
   bool capture = false;  // transform-feedback build for validation
   std::string outputName = "shader.vert";  // how the GLSL is named in diagnostics
+  // The uniform block must fit the device's maxUniformBufferRange; 16384 bytes is what
+  // every Vulkan device guarantees (docs/limits.md). A known device may raise it.
+  uint32_t maxUniformBlockBytes = kVulkanMinUniformBufferRange;
 };
 
 struct GenerateResult {

@@ -23,6 +23,7 @@
 #include "search/astar.h"
 #include "search/instance.h"
 #include "search/plan.h"
+#include "search/search.h"
 
 namespace sg {
 
@@ -42,8 +43,8 @@ LoadedInputs instantiateStage(Rig rig, RuleSet rules, FragmentInterface fragment
 // ---- search -----------------------------------------------------------------------------
 // The optimal plan (to force alternatives, remove rules first: withoutRules). Throws
 // InputError at the first fragment input whose request cannot be met, explaining why;
-// and for an unknown heuristic name.
-Plan searchStage(const LoadedInputs& in, const std::string& heuristic, SearchStats* stats = nullptr);
+// and for an unknown engine or heuristic name.
+Plan searchStage(const LoadedInputs& in, const SearchOptions& opts, SearchStats* stats = nullptr);
 
 // ---- emit -------------------------------------------------------------------------------
 EmittedGlsl emitStage(const LoadedInputs& in, const Plan& plan, const TemplateSet& templates,
@@ -56,10 +57,17 @@ CompiledVertexShader compileStage(const LoadedInputs& in, const Plan& plan, cons
                                   const std::string& glslName, TargetEnv env);
 
 // ---- check ------------------------------------------------------------------------------
-// spirv-val, the link with the fragment shader, and (optimize) spirv-opt -O + spirv-val
-// again. Returns the final SPIR-V words.
-std::vector<uint32_t> checkStage(const CompiledVertexShader& vertex, const FragmentInterface& fragment,
-                                 const std::string& glslName, TargetEnv env, bool optimize);
+struct CheckOptions {
+  std::string glslName;  // how the GLSL is named in diagnostics
+  TargetEnv env = TargetEnv::Vulkan1_0;
+  bool optimize = false;
+  uint32_t maxUniformBlockBytes = 16384;  // maxUniformBufferRange every Vulkan device has
+};
+// spirv-val, the uniform block against maxUniformBlockBytes (located at the largest
+// uniform the plan reads), the link with the fragment shader, and (optimize) spirv-opt -O
+// + spirv-val again. Returns the final SPIR-V words.
+std::vector<uint32_t> checkStage(const LoadedInputs& in, const EmittedGlsl& glsl, const CompiledVertexShader& vertex,
+                                 const CheckOptions& opts);
 
 // Every file the stages read for this context (rig, fragment shader, rules files and their
 // includes, templates): the depfile's prerequisites.

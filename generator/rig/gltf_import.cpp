@@ -12,9 +12,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cerrno>
+#include <cstdint>
 #include <cstring>
+#include <cstdio>
 #include <filesystem>
-#include <functional>
+#include <fstream>
 #include <optional>
 #include <set>
 
@@ -123,27 +126,59 @@ struct AccessorData {
   std::vector<float> values;  // count * components
 };
 
+// a + b, or nullopt when it does not fit in size_t (offsets and lengths come from the file).
+std::optional<size_t> addSize(size_t a, size_t b) {
+  if (a > SIZE_MAX - b) return std::nullopt;
+  return a + b;
+}
+std::optional<size_t> mulSize(size_t a, size_t b) {
+  if (b != 0 && a > SIZE_MAX / b) return std::nullopt;
+  return a * b;
+}
+
+std::string mib(size_t bytes) { return fmt::format("{:.1f} MiB", static_cast<double>(bytes) / (1024.0 * 1024.0)); }
+
 class Reader {
  public:
-  Reader(const tinygltf::Model& m, std::string file) : m_(m), file_(std::move(file)) {}
+  Reader(const tinygltf::Model& m, std::string file, size_t budget)
+      : m_(m), file_(std::move(file)), budget_(budget) {}
 
-  // Pointer to `bytes` bytes at `offset` of buffer view `bv`, bounds-checked.
+  // Counts `bytes` of decoded data against the budget before they are allocated: the counts
+  // in a small file must not make the reader allocate gigabytes.
+  void charge(size_t count, size_t bytesEach, const std::string& what) {
+    auto bytes = mulSize(count, bytesEach);
+    if (!bytes || *bytes > budget_ - used_)
+      fail(file_, fmt::format("{}: decoding {} elements would take the decoded data past this model's limit of {} "
+                              "({} already; the limit is {} plus {} per byte of the file and its buffers, at most {})",
+                              what, count, mib(budget_), mib(used_), mib(kMinGltfDecodedBudget),
+                              fmt::format("{} bytes", kGltfDecodedPerInputByte), mib(kMaxGltfDecodedBytes)));
+    used_ += *bytes;
+  }
+
+  // Pointer to `bytes` bytes at `offset` of buffer view `bv`, bounds-checked without overflow.
   const unsigned char* at(int bv, size_t offset, size_t bytes, const std::string& what) const {
     if (bv < 0 || static_cast<size_t>(bv) >= m_.bufferViews.size())
       fail(file_, fmt::format("{} refers to buffer view {}, which does not exist", what, bv));
     const auto& view = m_.bufferViews[static_cast<size_t>(bv)];
     if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= m_.buffers.size())
-      fail(file_, fmt::format("{}: buffer view {} refers to a missing buffer", what, bv));
+      fail(file_, fmt::format("{}: buffer view {} refers to buffer {}, which does not exist", what, bv, view.buffer));
     const auto& buf = m_.buffers[static_cast<size_t>(view.buffer)].data;
-    if (offset + bytes > view.byteLength || view.byteOffset + view.byteLength > buf.size())
-      fail(file_, fmt::format("{} reads past the end of buffer view {} (or its buffer is missing or short)", what, bv));
+    auto viewEnd = addSize(view.byteOffset, view.byteLength);
+    if (!viewEnd || *viewEnd > buf.size())
+      fail(file_, fmt::format("{}: buffer view {} (bytes {}..+{}) lies outside buffer {} ({} bytes)", what, bv,
+                              view.byteOffset, view.byteLength, view.buffer, buf.size()));
+    auto end = addSize(offset, bytes);
+    if (!end || *end > view.byteLength)
+      fail(file_, fmt::format("{} reads bytes {}..+{} of buffer view {}, which has {} bytes", what, offset, bytes, bv,
+                              view.byteLength));
     return buf.data() + view.byteOffset + offset;
   }
 
-  AccessorData read(int index, const std::string& what) const {
+  AccessorData read(int index, const std::string& what) {
     if (index < 0 || static_cast<size_t>(index) >= m_.accessors.size())
       fail(file_, fmt::format("{} refers to accessor {}, which does not exist", what, index));
     const tinygltf::Accessor& a = m_.accessors[static_cast<size_t>(index)];
+    std::string accName = fmt::format("{} (accessor {})", what, index);
     AccessorData d;
     d.components = tinygltf::GetNumComponentsInType(static_cast<uint32_t>(a.type));
     int csize = tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(a.componentType));
@@ -151,56 +186,94 @@ class Reader {
       fail(file_, fmt::format("{}: accessor {} has an invalid type or component type", what, index));
     if ((a.type == TINYGLTF_TYPE_MAT2 || a.type == TINYGLTF_TYPE_MAT3) && csize < 4)
       fail(file_, fmt::format("{}: accessor {} is a padded 8/16-bit matrix, which is not supported", what, index));
+    if (a.count > kMaxGltfElements)
+      fail(file_, fmt::format("{} has {} elements; the limit is {}", accName, a.count, kMaxGltfElements));
     d.count = a.count;
     d.componentType = a.componentType;
     d.type = a.type;
     d.normalized = a.normalized;
-    d.values.assign(d.count * static_cast<size_t>(d.components), 0.0f);
-    size_t elem = static_cast<size_t>(csize) * static_cast<size_t>(d.components);
-    std::string accName = fmt::format("{} (accessor {})", what, index);
+    const size_t comps = static_cast<size_t>(d.components);
+    const size_t elem = static_cast<size_t>(csize) * comps;
+    // Bounds first, allocation after: every byte the accessor reads must lie in its view.
+    const unsigned char* base = nullptr;
+    size_t stride = elem;
     if (a.bufferView >= 0) {
       at(a.bufferView, 0, 0, accName);  // validates the view index
       const auto& view = m_.bufferViews[static_cast<size_t>(a.bufferView)];
-      size_t stride = view.byteStride ? view.byteStride : elem;
+      if (view.byteStride != 0) {
+        if (view.byteStride < elem)
+          fail(file_, fmt::format("{}: buffer view {} has byteStride {}, less than the {}-byte element", accName,
+                                  a.bufferView, view.byteStride, elem));
+        stride = view.byteStride;
+      }
       if (d.count > 0) {
-        const unsigned char* base = at(a.bufferView, a.byteOffset, (d.count - 1) * stride + elem, accName);
-        for (size_t i = 0; i < d.count; ++i)
-          for (int c = 0; c < d.components; ++c)
-            d.values[i * static_cast<size_t>(d.components) + static_cast<size_t>(c)] =
-                readComponent(base + i * stride + static_cast<size_t>(c * csize), a.componentType, a.normalized);
+        // count <= kMaxGltfElements and stride <= 252 (tinygltf checks it): no overflow here.
+        base = at(a.bufferView, a.byteOffset, (d.count - 1) * stride + elem, accName);
       }
     }
+    size_t n = 0;
+    const unsigned char* idx = nullptr;
+    const unsigned char* val = nullptr;
+    int ict = 0;
+    size_t isize = 0;
     if (a.sparse.isSparse) {
       d.sparse = true;
-      size_t n = static_cast<size_t>(a.sparse.count);
-      int ict = a.sparse.indices.componentType;
-      int isize = tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(ict));
+      if (a.sparse.count < 0 || static_cast<size_t>(a.sparse.count) > d.count)
+        fail(file_, fmt::format("{}: sparse count {} is not between 0 and the accessor's count {}", accName,
+                                a.sparse.count, d.count));
+      if (a.sparse.indices.byteOffset < 0 || a.sparse.values.byteOffset < 0)
+        fail(file_, fmt::format("{}: sparse byteOffset is negative", accName));
+      n = static_cast<size_t>(a.sparse.count);
+      ict = a.sparse.indices.componentType;
       if (ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
           ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
         fail(file_, fmt::format("{}: sparse indices must be unsigned byte, short or int", accName));
+      isize = static_cast<size_t>(tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(ict)));
       if (n > 0) {
-        const unsigned char* idx = at(a.sparse.indices.bufferView, static_cast<size_t>(a.sparse.indices.byteOffset),
-                                      n * static_cast<size_t>(isize), accName + " sparse indices");
-        const unsigned char* val = at(a.sparse.values.bufferView, static_cast<size_t>(a.sparse.values.byteOffset),
-                                      n * elem, accName + " sparse values");
-        for (size_t k = 0; k < n; ++k) {
-          uint32_t i = readIndex(idx + k * static_cast<size_t>(isize), ict);
-          if (i >= d.count)
-            fail(file_, fmt::format("{}: sparse index {} is out of range (count {})", accName, i, d.count));
-          for (int c = 0; c < d.components; ++c)
-            d.values[i * static_cast<size_t>(d.components) + static_cast<size_t>(c)] =
-                readComponent(val + k * elem + static_cast<size_t>(c * csize), a.componentType, a.normalized);
-        }
+        idx = at(a.sparse.indices.bufferView, static_cast<size_t>(a.sparse.indices.byteOffset), n * isize,
+                 accName + " sparse indices");
+        val = at(a.sparse.values.bufferView, static_cast<size_t>(a.sparse.values.byteOffset), n * elem,
+                 accName + " sparse values");
       }
+    }
+    charge(d.count, comps * sizeof(float), accName);
+    d.values.assign(d.count * comps, 0.0f);
+    for (size_t i = 0; base && i < d.count; ++i)
+      for (size_t c = 0; c < comps; ++c)
+        d.values[i * comps + c] = readComponent(base + i * stride + c * static_cast<size_t>(csize), a.componentType,
+                                                a.normalized);
+    for (size_t k = 0; k < n; ++k) {
+      uint32_t i = readIndex(idx + k * isize, ict);
+      if (i >= d.count)
+        fail(file_, fmt::format("{}: sparse index {} is out of range (count {})", accName, i, d.count));
+      for (size_t c = 0; c < comps; ++c)
+        d.values[i * comps + c] =
+            readComponent(val + k * elem + c * static_cast<size_t>(csize), a.componentType, a.normalized);
     }
     for (float v : d.values)
       if (!std::isfinite(v)) fail(file_, fmt::format("{} holds a non-finite value", accName));
     return d;
   }
 
+  // Accessor data (d.components each) as a per-vertex stream of components [from, from+n).
+  std::vector<std::array<float, 4>> stream(const AccessorData& d, int from, int n, const std::string& what) {
+    charge(d.count, sizeof(std::array<float, 4>), what);
+    std::vector<std::array<float, 4>> s(d.count, std::array<float, 4>{0, 0, 0, 0});
+    for (size_t i = 0; i < d.count; ++i)
+      for (int c = 0; c < n; ++c)
+        s[i][static_cast<size_t>(c)] = d.values[i * static_cast<size_t>(d.components) + static_cast<size_t>(from + c)];
+    return s;
+  }
+  std::vector<std::array<float, 4>> zeros(size_t count, const std::string& what) {
+    charge(count, sizeof(std::array<float, 4>), what);
+    return std::vector<std::array<float, 4>>(count, std::array<float, 4>{0, 0, 0, 0});
+  }
+
  private:
   const tinygltf::Model& m_;
   std::string file_;
+  size_t budget_;
+  size_t used_ = 0;
 };
 
 std::string kibText(int bones) {
@@ -234,15 +307,6 @@ RigUniform makeUniform(const std::string& name, const std::string& semantic, Typ
   return u;
 }
 
-// Stores accessor data (n components each) as a per-vertex stream, components [from, from+n).
-std::vector<std::array<float, 4>> toStream(const AccessorData& d, int from, int n) {
-  std::vector<std::array<float, 4>> s(d.count, std::array<float, 4>{0, 0, 0, 0});
-  for (size_t i = 0; i < d.count; ++i)
-    for (int c = 0; c < n; ++c)
-      s[i][static_cast<size_t>(c)] = d.values[i * static_cast<size_t>(d.components) + static_cast<size_t>(from + c)];
-  return s;
-}
-
 // Parses "N/P" after '#'.
 bool parseSelection(const std::string& s, int& mesh, int& prim) {
   auto slash = s.find('/');
@@ -262,7 +326,7 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   GltfModelData& data = imp.data;
   data.file = file;
   data.stem = std::filesystem::path(file).stem().string();
-  Reader reader(model, file);
+  Reader reader(model, file, opts.maxDecodedBytes);
 
   if (opts.mesh < 0 || static_cast<size_t>(opts.mesh) >= model.meshes.size())
     fail(file, fmt::format("the model has {} mesh(es); there is no mesh {}", model.meshes.size(), opts.mesh));
@@ -307,10 +371,19 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
           fail(file, fmt::format("node {} has two parents; glTF node hierarchies are trees", c));
         parent[static_cast<size_t>(c)] = static_cast<int>(i);
       }
+    // Every node has at most one parent, so following parents either ends at a root or
+    // comes back: one linear pass with three colours (a long chain costs O(n), not O(n²)).
+    std::vector<char> state(parent.size(), 0);  // 0 unvisited, 1 on the current walk, 2 done
     for (size_t i = 0; i < parent.size(); ++i) {
-      size_t steps = 0;
-      for (int p = parent[i]; p >= 0; p = parent[static_cast<size_t>(p)])
-        if (++steps > parent.size()) fail(file, fmt::format("node {} is part of a cycle in the node hierarchy", i));
+      int p = static_cast<int>(i);
+      while (p >= 0 && state[static_cast<size_t>(p)] == 0) {
+        state[static_cast<size_t>(p)] = 1;
+        p = parent[static_cast<size_t>(p)];
+      }
+      if (p >= 0 && state[static_cast<size_t>(p)] == 1)
+        fail(file, fmt::format("node {} is part of a cycle in the node hierarchy", p));
+      for (int q = static_cast<int>(i); q >= 0 && state[static_cast<size_t>(q)] == 1; q = parent[static_cast<size_t>(q)])
+        state[static_cast<size_t>(q)] = 2;
     }
     int sceneIndex = model.defaultScene >= 0 ? model.defaultScene : (model.scenes.empty() ? -1 : 0);
     if (sceneIndex >= 0 && static_cast<size_t>(sceneIndex) < model.scenes.size()) {
@@ -322,15 +395,19 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
     for (int r : data.sceneRoots)
       if (r < 0 || static_cast<size_t>(r) >= model.nodes.size())
         fail(file, fmt::format("the scene refers to node {}, which does not exist", r));
-    // The node that instantiates the mesh: first in the scene (depth first), else any.
-    std::function<int(int)> find = [&](int n) -> int {
-      if (data.nodes[static_cast<size_t>(n)].mesh == opts.mesh) return n;
-      for (int c : data.nodes[static_cast<size_t>(n)].children)
-        if (int f = find(c); f >= 0) return f;
-      return -1;
-    };
-    for (int r : data.sceneRoots)
-      if (data.meshNode < 0) data.meshNode = find(r);
+    // The node that instantiates the mesh: first in the scene (depth first, pre-order), else
+    // any. Iterative: a chain of nodes as long as the file allows must not overflow the stack.
+    std::vector<int> todo(data.sceneRoots.rbegin(), data.sceneRoots.rend());
+    std::vector<char> seen(data.nodes.size(), 0);  // a scene may list a root twice
+    while (!todo.empty() && data.meshNode < 0) {
+      int n = todo.back();
+      todo.pop_back();
+      if (seen[static_cast<size_t>(n)]) continue;
+      seen[static_cast<size_t>(n)] = 1;
+      const GltfNode& node = data.nodes[static_cast<size_t>(n)];
+      if (node.mesh == opts.mesh) data.meshNode = n;
+      todo.insert(todo.end(), node.children.rbegin(), node.children.rend());
+    }
     if (data.meshNode < 0)
       for (size_t i = 0; i < data.nodes.size(); ++i)
         if (data.nodes[i].mesh == opts.mesh) {
@@ -398,7 +475,7 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
       size_t perKey = ch.interpolation == GltfInterpolation::CubicSpline ? 3 : 1;
       size_t total = out.values.size();
       if (ch.path == GltfPath::Weights) {
-        if (total % (ch.times.size() * perKey) != 0)
+        if (total == 0 || total % (ch.times.size() * perKey) != 0)
           fail(file, fmt::format("{}: {} output values do not divide into {} keyframes", what, total, ch.times.size()));
         ch.components = static_cast<int>(total / (ch.times.size() * perKey));
       } else {
@@ -480,7 +557,7 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
                            where, formatText(imp.attributes[infoIndex.at("POSITION")])));
   rig.attributes.push_back(makeAttribute("position", VertexFormat::Float32x3, {{"vertex.position", ""}}, file));
   carried("POSITION", "position", VertexFormat::Float32x3);
-  data.streams["vertex.position"] = toStream(readAttr("POSITION"), 0, 3);
+  data.streams["vertex.position"] = reader.stream(readAttr("POSITION"), 0, 3, where + " attribute POSITION");
 
   bool hasNormal = false, hasTangent = false;
   if (const auto* a = accessorOf("NORMAL")) {
@@ -488,7 +565,7 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
       hasNormal = true;
       rig.attributes.push_back(makeAttribute("normal", VertexFormat::Float32x3, {{"vertex.normal", ""}}, file));
       carried("NORMAL", "normal", VertexFormat::Float32x3);
-      data.streams["vertex.normal"] = toStream(readAttr("NORMAL"), 0, 3);
+      data.streams["vertex.normal"] = reader.stream(readAttr("NORMAL"), 0, 3, where + " attribute NORMAL");
     } else {
       skip("NORMAL", "only float VEC3 normals are supported");
     }
@@ -500,8 +577,8 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
                                              {{"vertex.tangent", "xyz"}, {"vertex.handedness", "w"}}, file));
       carried("TANGENT", "tangent", VertexFormat::Float32x4);
       AccessorData d = readAttr("TANGENT");
-      data.streams["vertex.tangent"] = toStream(d, 0, 3);
-      data.streams["vertex.handedness"] = toStream(d, 3, 1);
+      data.streams["vertex.tangent"] = reader.stream(d, 0, 3, where + " attribute TANGENT");
+      data.streams["vertex.handedness"] = reader.stream(d, 3, 1, where + " attribute TANGENT");
     } else {
       skip("TANGENT", "only float VEC4 tangents are supported");
     }
@@ -514,7 +591,7 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
         rig.attributes.push_back(
             makeAttribute(rn, VertexFormat::Float32x2, {{fmt::format("vertex.texcoord{}", t), ""}}, file));
         carried(name, rn, VertexFormat::Float32x2);
-        data.streams[fmt::format("vertex.texcoord{}", t)] = toStream(readAttr(name), 0, 2);
+        data.streams[fmt::format("vertex.texcoord{}", t)] = reader.stream(readAttr(name), 0, 2, where + " attribute " + name);
       } else {
         skip(name, "the rig formats have no normalized 2-component format (expand to float32x2)");
       }
@@ -530,9 +607,22 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
     if (f) {
       rig.attributes.push_back(makeAttribute("color0", *f, {{"vertex.color0", ""}}, file));
       carried("COLOR_0", "color0", *f);
-      data.streams["vertex.color0"] = toStream(readAttr("COLOR_0"), 0, 4);
+      data.streams["vertex.color0"] = reader.stream(readAttr("COLOR_0"), 0, 4, where + " attribute COLOR_0");
     } else {
       skip("COLOR_0", "vertex.color0 is a vec4 (RGB colours must be widened to RGBA by the application)");
+    }
+  }
+
+  // _OCCLUSION: baked by `shadergen bake occlusion` (docs/bake.md).
+  bool hasOcclusion = false;
+  if (const auto* a = accessorOf("_OCCLUSION")) {
+    if (isFloat(a, TINYGLTF_TYPE_SCALAR)) {
+      hasOcclusion = true;
+      rig.attributes.push_back(makeAttribute("occlusion", VertexFormat::Float32x1, {{"vertex.occlusion", ""}}, file));
+      carried("_OCCLUSION", "occlusion", VertexFormat::Float32x1);
+      data.streams["vertex.occlusion"] = toStream(readAttr("_OCCLUSION"), 0, 1);
+    } else {
+      skip("_OCCLUSION", "occlusion is a float SCALAR (as shadergen bake occlusion writes it)");
     }
   }
 
@@ -620,8 +710,8 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
             fail(file, fmt::format("{}: {} of vertex {} is joint {}, but the skin has {} joints", where, jn, v,
                                    static_cast<long>(j), joints));
         }
-      data.streams[fmt::format("skin.joints[{}]", s)] = toStream(jd, 0, 4);
-      data.streams[fmt::format("skin.weights[{}]", s)] = toStream(readAttr(wn), 0, 4);
+      data.streams[fmt::format("skin.joints[{}]", s)] = reader.stream(jd, 0, 4, where + " attribute " + jn);
+      data.streams[fmt::format("skin.weights[{}]", s)] = reader.stream(readAttr(wn), 0, 4, where + " attribute " + wn);
     }
   }
 
@@ -629,7 +719,8 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   for (const auto& [name, idx] : prim.attributes) {
     const auto& i = imp.attributes[infoIndex.at(name)];
     if (!i.rigAttribute.empty()) continue;
-    if (name == "NORMAL" || name == "TANGENT" || name == "TEXCOORD_0" || name == "TEXCOORD_1" || name == "COLOR_0")
+    if (name == "NORMAL" || name == "TANGENT" || name == "TEXCOORD_0" || name == "TEXCOORD_1" || name == "COLOR_0" ||
+        name == "_OCCLUSION")
       continue;  // already reported
     if (name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0) continue;  // unskinned (reported)
     skip(name, "the vocabulary has no semantic for it");
@@ -666,7 +757,7 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
       std::string key = fmt::format("{}[{}]", k.semantic, t);
       auto it = tm.find(k.gltf);
       if (it == tm.end()) {
-        data.streams[key].assign(data.vertexCount, std::array<float, 4>{0, 0, 0, 0});
+        data.streams[key] = reader.zeros(data.vertexCount, where + " " + key);
         continue;
       }
       std::string what = fmt::format("{} morph target {} {}", where, t, k.gltf);
@@ -683,17 +774,45 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
         imp.notes.push_back(fmt::format("morph target {} {} is a sparse accessor: the application must expand it to "
                                         "a dense float32x3 stream",
                                         t, k.gltf));
-      data.streams[key] = toStream(d, 0, 3);
+      data.streams[key] = reader.stream(d, 0, 3, what);
     }
     rig.attributes.push_back(makeAttribute(fmt::format("{}_morph", k.rigName), VertexFormat::Float32x3,
                                            {{k.semantic, ""}}, file, true));
   }
+  // Occlusion deltas (float SCALAR per target): morph.occlusion, like listing 3-3's normal.w.
+  bool occlusionMorphed = false;
+  if (moved.count("_OCCLUSION") && !hasOcclusion) {
+    imp.notes.push_back("morph target _OCCLUSION deltas are left out: the rig does not carry _OCCLUSION");
+  } else if (moved.count("_OCCLUSION")) {
+    occlusionMorphed = true;
+    for (int t = 0; t < targets; ++t) {
+      const auto& tm = prim.targets[static_cast<size_t>(t)];
+      std::string key = fmt::format("morph.occlusion[{}]", t);
+      auto it = tm.find("_OCCLUSION");
+      if (it == tm.end()) {
+        data.streams[key].assign(data.vertexCount, std::array<float, 4>{0, 0, 0, 0});
+        continue;
+      }
+      std::string what = fmt::format("{} morph target {} _OCCLUSION", where, t);
+      if (it->second < 0 || static_cast<size_t>(it->second) >= model.accessors.size())
+        fail(file, fmt::format("{} refers to accessor {}, which does not exist", what, it->second));
+      const auto& a = model.accessors[static_cast<size_t>(it->second)];
+      if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || a.type != TINYGLTF_TYPE_SCALAR)
+        fail(file, fmt::format("{} is {}{} {}; occlusion deltas are float SCALAR", what,
+                               a.normalized ? "normalized " : "", componentTypeName(a.componentType), typeName(a.type)));
+      if (a.count != data.vertexCount)
+        fail(file, fmt::format("{} has {} elements but POSITION has {}", what, a.count, data.vertexCount));
+      data.streams[key] = toStream(reader.read(it->second, what), 0, 1);
+    }
+    rig.attributes.push_back(
+        makeAttribute("occlusion_morph", VertexFormat::Float32x1, {{"morph.occlusion", ""}}, file, true));
+  }
   for (const auto& n : moved)
-    if (n != "POSITION" && n != "NORMAL" && n != "TANGENT")
+    if (n != "POSITION" && n != "NORMAL" && n != "TANGENT" && n != "_OCCLUSION")
       imp.notes.push_back(fmt::format("morph target {} deltas are left out: the vocabulary morphs position, normal "
                                       "and tangent only",
                                       n));
-  int rigTargets = morphed.empty() ? 0 : targets;
+  int rigTargets = morphed.empty() && !occlusionMorphed ? 0 : targets;
   if (targets > 0 && rigTargets == 0)
     imp.notes.push_back(fmt::format("{} has {} morph target(s) but none moves an attribute the rig carries: imported "
                                     "without morphing",
@@ -702,6 +821,32 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   rig.morphedAttributes = morphed;
   data.meshWeights.assign(static_cast<size_t>(targets), 0.0);
   for (size_t i = 0; i < mesh.weights.size() && i < data.meshWeights.size(); ++i) data.meshWeights[i] = mesh.weights[i];
+
+  // Dawn's layout (listing 3-1): occlusion in normal.w and its deltas in the normal deltas' w.
+  if (opts.packOcclusionInNormal) {
+    if (!hasOcclusion || !hasNormal)
+      fail(file, fmt::format("{}: packing occlusion into normal.w needs NORMAL and _OCCLUSION (bake them with "
+                             "'shadergen bake occlusion')",
+                             where));
+    auto merge = [&](const std::string& into, const std::string& from, const char* xyz, const char* w) {
+      auto named = [&](const std::string& n) {
+        return std::find_if(rig.attributes.begin(), rig.attributes.end(), [&](const RigAttribute& a) { return a.name == n; });
+      };
+      auto a = named(into);
+      if (a == rig.attributes.end() || named(from) == rig.attributes.end()) return false;
+      a->format = VertexFormat::Float32x4;
+      a->shaderType = *vectorType(ScalarKind::Float, 4);
+      a->provides = {{xyz, "xyz"}, {w, "w"}};
+      rig.attributes.erase(named(from));
+      return true;
+    };
+    merge("normal", "occlusion", "vertex.normal", "vertex.occlusion");
+    imp.attributes[infoIndex.at("NORMAL")].format = formatName(VertexFormat::Float32x4);
+    imp.attributes[infoIndex.at("_OCCLUSION")].rigAttribute = "normal (w)";
+    imp.attributes[infoIndex.at("_OCCLUSION")].format = formatName(VertexFormat::Float32x4);
+    if (occlusionMorphed && !merge("normal_morph", "occlusion_morph", "morph.normal", "morph.occlusion"))
+      imp.notes.push_back("occlusion deltas stay a separate attribute: no morph target moves NORMAL");
+  }
 
   // Uniforms.
   if (sets > 0) rig.uniforms.push_back(makeUniform("bones", "skin.bones", Type::Mat4, "bones", imp.joints, file));
@@ -715,28 +860,175 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   return imp;
 }
 
+// --- loading: the file, its JSON and its buffer files, checked before tinygltf sees them ---
+
+// The first bracket nested deeper than kMaxGltfJsonDepth (1-based line and column), if any.
+// tinygltf copies extras and extensions recursively, so depth is checked before parsing.
+std::optional<std::pair<int, int>> tooDeep(const char* p, size_t n) {
+  int depth = 0, line = 1, col = 1;
+  bool inString = false, escaped = false;
+  for (size_t i = 0; i < n; ++i) {
+    char c = p[i];
+    if (inString) {
+      if (escaped) escaped = false;
+      else if (c == '\\') escaped = true;
+      else if (c == '"') inString = false;
+    } else if (c == '"') {
+      inString = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxGltfJsonDepth) return std::make_pair(line, col);
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+    if (c == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return std::nullopt;
+}
+
+// Reads a model or buffer file: regular files only (a FIFO or /dev/zero would block or never
+// end), at most kMaxGltfFileBytes.
+bool readBounded(const std::string& path, std::string& out, std::string& why) {
+  std::error_code ec;
+  auto st = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(st)) return why = "no such file", false;
+  if (!std::filesystem::is_regular_file(st)) return why = "not a regular file", false;
+  if (std::filesystem::file_size(path, ec) > kMaxGltfFileBytes)
+    return why = fmt::format("larger than the limit of {}", mib(kMaxGltfFileBytes)), false;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return why = std::strerror(errno), false;
+  out.clear();
+  char chunk[65536];
+  while (in) {
+    in.read(chunk, sizeof chunk);
+    out.append(chunk, static_cast<size_t>(in.gcount()));
+    if (out.size() > kMaxGltfFileBytes)
+      return why = fmt::format("larger than the limit of {}", mib(kMaxGltfFileBytes)), false;
+  }
+  if (in.bad()) return why = "read error", false;
+  return true;
+}
+
+// Buffer files (uri: "x.bin") must resolve, symlinks followed, inside the model's folder: a
+// model from elsewhere must not read /etc/passwd or ../../secrets into a shader's inputs.
+struct BufferFiles {
+  std::filesystem::path root;  // canonical model folder; empty: no buffer files at all
+  std::string refused;         // the first refusal, reported instead of "File not found"
+};
+
+bool insideRoot(BufferFiles& ctx, const std::string& path) {
+  std::error_code ec;
+  auto c = std::filesystem::weakly_canonical(path, ec);
+  bool inside = !ec && !ctx.root.empty() &&
+                std::mismatch(ctx.root.begin(), ctx.root.end(), c.begin(), c.end()).first == ctx.root.end();
+  if (!inside && ctx.refused.empty())
+    ctx.refused = ctx.root.empty()
+                      ? fmt::format("buffer file '{}' refused: this model has no folder to read files from", path)
+                      : fmt::format("buffer file '{}' lies outside the model's folder '{}'", path, ctx.root.string());
+  return inside;
+}
+
+bool bufferFileExists(const std::string& path, void* user) {
+  auto& ctx = *static_cast<BufferFiles*>(user);
+  std::error_code ec;
+  return (ctx.root.empty() || std::filesystem::exists(path, ec)) && insideRoot(ctx, path);
+}
+std::string keepPath(const std::string& path, void*) { return path; }
+bool readBufferFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+  if (!insideRoot(*static_cast<BufferFiles*>(user), path)) return false;
+  std::string bytes, why;
+  if (!readBounded(path, bytes, why)) {
+    if (err) *err += why;
+    return false;
+  }
+  out->assign(bytes.begin(), bytes.end());
+  return true;
+}
+bool writeNothing(std::string*, const std::string&, const std::vector<unsigned char>&, void*) { return false; }
+
+uint32_t le32(const std::string& b, size_t at) {
+  uint32_t v;
+  std::memcpy(&v, b.data() + at, 4);
+  return v;  // glTF is little-endian, as is every host this builds for
+}
+
+// GLB layout checked with 64-bit arithmetic (tinygltf 2.7 lets a BIN chunk header run 8
+// bytes past the end). Returns the JSON chunk.
+std::pair<size_t, size_t> checkGlb(const std::string& b, const std::string& file) {
+  if (b.size() < 20 || b.compare(0, 4, "glTF") != 0)
+    fail(file, "not a binary glTF file (no 'glTF' header); a .glb must start with the GLB header");
+  uint64_t length = le32(b, 8), json = le32(b, 12);
+  if (le32(b, 4) != 2) fail(file, fmt::format("GLB version {} is not supported (only 2)", le32(b, 4)));
+  if (length > b.size())
+    fail(file, fmt::format("the GLB header claims {} bytes but the file has {}", length, b.size()));
+  if (le32(b, 16) != 0x4E4F534A || json == 0 || 20 + json > length)
+    fail(file, fmt::format("the GLB's first chunk must be JSON of at most {} bytes", length - 20));
+  uint64_t bin = 20 + json;
+  if (bin < length) {
+    if (bin + 8 > length || bin + 8 + le32(b, static_cast<size_t>(bin)) > length)
+      fail(file, fmt::format("the GLB's BIN chunk at byte {} runs past the end of the file ({} bytes)", bin, length));
+  }
+  return {20, static_cast<size_t>(json)};
+}
+
+// tinygltf's message, with nlohmann's "parse error at line L, column C" made a location.
+[[noreturn]] void failLoad(const std::string& file, std::string err, bool glb, const BufferFiles& files) {
+  if (!files.refused.empty()) fail(file, files.refused);
+  while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();
+  std::replace(err.begin(), err.end(), '\n', ' ');
+  if (err.empty()) err = "unknown error";
+  int line = 0, col = 0;
+  auto at = err.find("parse error at line ");
+  if (at != std::string::npos && std::sscanf(err.c_str() + at, "parse error at line %d, column %d", &line, &col) == 2) {
+    auto colon = err.find(": ", at);
+    std::string what = colon == std::string::npos ? err : err.substr(colon + 2);
+    if (!glb) throw InputError(SourceLoc{file, line, col}, "invalid JSON: " + what);
+    fail(file, fmt::format("invalid JSON in the GLB's JSON chunk at line {}, column {}: {}", line, col, what));
+  }
+  fail(file, "cannot load the glTF model: " + err);
+}
+
 GltfImport loadAndImport(const std::string& file, const GltfImportOptions& opts, const std::string* text,
                          const std::string& baseDir) {
+  std::string bytes, why;
+  if (!text && !readBounded(file, bytes, why)) fail(file, "cannot read the glTF model: " + why);
+  const std::string& b = text ? *text : bytes;
+  if (b.size() > kMaxGltfFileBytes) fail(file, fmt::format("the glTF model is larger than {}", mib(kMaxGltfFileBytes)));
+  bool glb = !text && lower(std::filesystem::path(file).extension().string()) == ".glb";
+  auto [jsonAt, jsonSize] = glb ? checkGlb(b, file) : std::make_pair(size_t{0}, b.size());
+  if (auto deep = tooDeep(b.data() + jsonAt, jsonSize)) {
+    std::string msg = fmt::format("JSON nested deeper than {} levels", kMaxGltfJsonDepth);
+    if (!glb) throw InputError(SourceLoc{file, deep->first, deep->second}, msg);
+    fail(file, fmt::format("{} in the GLB's JSON chunk (line {}, column {})", msg, deep->first, deep->second));
+  }
+
+  BufferFiles files;
+  std::string dir = text ? baseDir : std::filesystem::path(file).parent_path().string();
+  if (!text && dir.empty()) dir = ".";
+  std::error_code ec;
+  if (!dir.empty()) files.root = std::filesystem::canonical(dir, ec);
+  if (ec) files.root.clear();
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(skipImage, nullptr);
+  loader.SetFsCallbacks(tinygltf::FsCallbacks{bufferFileExists, keepPath, readBufferFile, writeNothing, &files});
   tinygltf::Model model;
   std::string err, warn;
-  bool ok;
-  if (text) {
-    ok = loader.LoadASCIIFromString(&model, &err, &warn, text->data(), static_cast<unsigned int>(text->size()), baseDir);
-  } else {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(file, ec)) fail(file, "cannot open the glTF model (no such file)");
-    if (lower(std::filesystem::path(file).extension().string()) == ".glb")
-      ok = loader.LoadBinaryFromFile(&model, &err, &warn, file);
-    else
-      ok = loader.LoadASCIIFromFile(&model, &err, &warn, file);
-  }
-  if (!ok) {
-    while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();
-    fail(file, "cannot load the glTF model: " + (err.empty() ? std::string("unknown error") : err));
-  }
-  return importModel(model, file, opts);
+  const auto* data = reinterpret_cast<const unsigned char*>(b.data());
+  std::string base = files.root.string();
+  bool ok = glb ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, static_cast<unsigned int>(b.size()), base)
+                : loader.LoadASCIIFromString(&model, &err, &warn, b.data(), static_cast<unsigned int>(b.size()), base);
+  if (!ok) failLoad(file, err, glb, files);
+  // Decoded data in proportion to the input: what a few KB can claim stays small.
+  size_t input = b.size();
+  for (const auto& buf : model.buffers) input += buf.data.size();
+  GltfImportOptions o = opts;
+  input = std::min(input, kMaxGltfDecodedBytes);  // keeps the product below in range
+  o.maxDecodedBytes = std::min(opts.maxDecodedBytes, kMinGltfDecodedBudget + input * kGltfDecodedPerInputByte);
+  return importModel(model, file, o);
 }
 
 std::string yamlQuote(const std::string& s) {

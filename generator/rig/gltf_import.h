@@ -20,6 +20,20 @@ constexpr int kMaxBonePalette = 256;
 // Influences per vertex the rules serve: two JOINTS_n/WEIGHTS_n sets of 4.
 constexpr int kMaxInfluenceSets = 2;
 
+// Hostile-input limits (docs/limits.md), each checked before the memory it guards is used.
+// The model file and each buffer file it names.
+constexpr size_t kMaxGltfFileBytes = size_t{1} << 30;
+// JSON nesting ({ and [); real models nest under 10 deep.
+constexpr int kMaxGltfJsonDepth = 64;
+// Elements of one accessor (vertices, keyframes, matrices).
+constexpr size_t kMaxGltfElements = size_t{1} << 24;
+// Decoded data of one import (accessor values and per-vertex streams, zeros included):
+// at most min(kMaxGltfDecodedBytes, kMinGltfDecodedBudget + kGltfDecodedPerInputByte × bytes
+// of the file and its buffers), so a 2 KB file claiming a billion vertices allocates nothing.
+constexpr size_t kMaxGltfDecodedBytes = size_t{1} << 30;
+constexpr size_t kMinGltfDecodedBudget = size_t{64} << 20;
+constexpr size_t kGltfDecodedPerInputByte = 256;
+
 // "model.glb", "model.gltf", "model.glb#1/0" (mesh 1, primitive 0).
 struct GltfRef {
   std::string file;
@@ -36,6 +50,9 @@ struct GltfImportOptions {
   int mesh = 0;
   int primitive = 0;
   int maxBones = kMaxBonePalette;  // tests lower it to exercise the diagnostic
+  size_t maxDecodedBytes = kMaxGltfDecodedBytes;  // likewise
+  // Dawn's layout: _OCCLUSION in normal.w (float32x4), target deltas in the normal deltas' w.
+  bool packOcclusionInNormal = false;
 };
 
 // One attribute of the primitive as the file stores it, and what the rig made of it.
@@ -129,7 +146,8 @@ struct GltfImport {
 // the mesh and the limit for anything the rules cannot serve (too many joints, JOINTS_2+,
 // quantized positions, ...), and for malformed files.
 GltfImport importGltf(const std::string& file, const GltfImportOptions& opts = {});
-// Same, from glTF JSON text (buffers as data URIs; external files relative to baseDir).
+// Same, from glTF JSON text (buffers as data URIs; buffer files only inside baseDir, none
+// when it is empty).
 GltfImport importGltfText(const std::string& json, const std::string& fileName, const GltfImportOptions& opts = {},
                           const std::string& baseDir = "");
 

@@ -12,6 +12,12 @@
 
 namespace sg {
 
+// Limits of a rig file (docs/limits.md); deformer parameters are 0..65535.
+constexpr size_t kMaxRigNameBytes = 256;
+constexpr int kMaxMorphTargets = 256;
+constexpr size_t kMaxRigAttributes = 64;
+constexpr size_t kMaxRigUniforms = 256;
+
 // How the application stores a vertex attribute (maps 1:1 to a VkFormat).
 enum class VertexFormat {
   Float32x1, Float32x2, Float32x3, Float32x4,

@@ -88,6 +88,12 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
   rig.file = fileName;
   if (!root["rig"]) y.fail(root, "missing 'rig' (the rig's name)");
   rig.name = y.scalar(root["rig"], "'rig'");
+  // The name is quoted in generated comments and messages: printable text, one line.
+  if (rig.name.empty() || rig.name.size() > kMaxRigNameBytes)
+    y.fail(root["rig"], fmt::format("the rig's name must be 1..{} characters", kMaxRigNameBytes));
+  for (char c : rig.name)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+      y.fail(root["rig"], fmt::format("the rig's name contains control character 0x{:02x}", static_cast<unsigned char>(c)));
 
   rig.params = {{"bones", 0}, {"influences", 0}, {"morph_targets", 0}};
   if (auto d = root["deformers"]) {
@@ -96,7 +102,8 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
       std::string key = y.scalar(it->first, "a deformer key");
       if (key == "morphs") {
         y.expectSeq(it->second, "'morphs'");
-        for (const auto& m : it->second) {
+        YAML::Node morphs = it->second;  // a copy: it->second lives in a temporary proxy
+        for (const auto& m : morphs) {
           std::string a = y.scalar(m, "a morphed attribute");
           if (a != "position" && a != "normal" && a != "tangent")
             y.fail(m, fmt::format("morph targets can move position, normal or tangent, not '{}'", a));
@@ -111,6 +118,8 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
       rig.paramLocs[key] = locOf(it->second, fileName);
     }
   }
+  if (rig.morphTargets() > kMaxMorphTargets)
+    throw InputError(rig.paramLocs["morph_targets"], fmt::format("at most {} morph targets are supported", kMaxMorphTargets));
   if (rig.param("influences") > 8)
     throw InputError(rig.paramLocs["influences"], "at most 8 bone influences per vertex are supported");
 
@@ -118,11 +127,13 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
   y.expectMap(root["attributes"], "'attributes'");
   std::set<std::string> providedSemantics;
   for (auto it = root["attributes"].begin(); it != root["attributes"].end(); ++it) {
+    if (rig.attributes.size() >= kMaxRigAttributes)
+      y.fail(it->first, fmt::format("more than {} attributes", kMaxRigAttributes));
     RigAttribute a;
     a.name = y.scalar(it->first, "an attribute name");
     a.loc = locOf(it->first, fileName);
     if (!validIdentifier(a.name)) y.fail(it->first, fmt::format("'{}' is not a valid attribute name", a.name));
-    const YAML::Node& body = it->second;
+    YAML::Node body = it->second;  // a copy: it->second lives in a temporary proxy
     y.expectMap(body, "an attribute");
     y.checkKeys(body, {"format", "provides", "per_target", "doc"});
     if (!body["format"]) y.fail(body, fmt::format("attribute '{}' has no 'format'", a.name));
@@ -135,7 +146,7 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
     int n = formatComponents(a.format);
     a.shaderType = *vectorType(formatIsInteger(a.format) ? ScalarKind::UInt : ScalarKind::Float, n);
     if (body["per_target"]) a.perMorphTarget = y.boolean(body["per_target"], "'per_target'");
-    const YAML::Node& prov = body["provides"];
+    YAML::Node prov = body["provides"];
     if (!prov) y.fail(body, fmt::format("attribute '{}' provides no semantic ('provides')", a.name));
     auto addPart = [&](const YAML::Node& semNode, const YAML::Node* swzNode) {
       ProvidedPart p;
@@ -162,11 +173,12 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
   if (auto u = root["uniforms"]) {
     y.expectMap(u, "'uniforms'");
     for (auto it = u.begin(); it != u.end(); ++it) {
+      if (rig.uniforms.size() >= kMaxRigUniforms) y.fail(it->first, fmt::format("more than {} uniforms", kMaxRigUniforms));
       RigUniform un;
       un.name = y.scalar(it->first, "a uniform name");
       un.loc = locOf(it->first, fileName);
       if (!validIdentifier(un.name)) y.fail(it->first, fmt::format("'{}' is not a valid uniform name", un.name));
-      const YAML::Node& body = it->second;
+      YAML::Node body = it->second;  // a copy: it->second lives in a temporary proxy
       y.expectMap(body, "a uniform");
       y.checkKeys(body, {"type", "semantic", "array", "doc"});
       if (!body["type"]) y.fail(body, fmt::format("uniform '{}' has no 'type'", un.name));

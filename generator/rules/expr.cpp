@@ -2,13 +2,16 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cctype>
+#include <climits>
 #include <vector>
 
 namespace sg {
 
 struct Expr::Node {
   enum Kind { Num, Name, Has, Unary, Binary } kind;
+  int depth = 1;     // height of this subtree (evaluation recursion is bounded by it)
   int64_t value = 0;
   std::string text;  // name, semantic or operator
   int col = 0;       // 0-based column of the token within the expression
@@ -23,6 +26,8 @@ class Parser {
  public:
   Parser(const std::string& s, const SourceLoc& loc) : s_(s), loc_(loc) {}
   NodeP parseAll() {
+    if (s_.size() > kMaxExprChars)
+      fail(0, fmt::format("expression is {} characters long, more than the limit of {}", s_.size(), kMaxExprChars));
     NodeP n = parseOr();
     skip();
     if (pos_ != s_.size()) fail(pos_, fmt::format("unexpected '{}' in expression", s_.substr(pos_, 1)));
@@ -48,6 +53,19 @@ class Parser {
     }
     return false;
   }
+  // Every node built checks the height of the tree below it: a chain `1+1+...` or
+  // `((((...))))` deeper than kMaxExprDepth is refused instead of overflowing the stack.
+  void checkDepth(Expr::Node& n, size_t at) {
+    n.depth = 1 + std::max(n.a ? n.a->depth : 0, n.b ? n.b->depth : 0);
+    if (n.depth > kMaxExprDepth) fail(at, fmt::format("expression is nested deeper than {} levels", kMaxExprDepth));
+  }
+  struct Nesting {  // recursion guard for parentheses and unary chains
+    Parser& p;
+    Nesting(Parser& p, size_t at) : p(p) {
+      if (++p.nesting_ > kMaxExprDepth) p.fail(at, fmt::format("expression is nested deeper than {} levels", kMaxExprDepth));
+    }
+    ~Nesting() { --p.nesting_; }
+  };
   NodeP bin(const char* op, NodeP a, NodeP b, size_t at) {
     auto n = std::make_shared<Expr::Node>();
     n->kind = Expr::Node::Binary;
@@ -55,6 +73,7 @@ class Parser {
     n->a = std::move(a);
     n->b = std::move(b);
     n->col = static_cast<int>(at);
+    checkDepth(*n, at);
     return n;
   }
   // Position of the next token (an operator's column, not the blank before it).
@@ -109,12 +128,14 @@ class Parser {
   NodeP parseUnary() {
     skip();
     size_t at = pos_;
+    Nesting guard(*this, at);
     if (s_.compare(pos_, 2, "!=") != 0 && eat("!")) {
       auto n = std::make_shared<Expr::Node>();
       n->kind = Expr::Node::Unary;
       n->text = "!";
       n->a = parseUnary();
       n->col = static_cast<int>(at);
+      checkDepth(*n, at);
       return n;
     }
     if (eat("-")) {
@@ -123,6 +144,7 @@ class Parser {
       n->text = "-";
       n->a = parseUnary();
       n->col = static_cast<int>(at);
+      checkDepth(*n, at);
       return n;
     }
     return parsePrimary();
@@ -143,8 +165,10 @@ class Parser {
     if (std::isdigit(static_cast<unsigned char>(c))) {
       int64_t v = 0;
       while (pos_ < s_.size() && std::isdigit(static_cast<unsigned char>(s_[pos_]))) {
-        if (v > (INT64_MAX - 9) / 10) fail(at, "number too large");
-        v = v * 10 + (s_[pos_++] - '0');
+        int d = s_[pos_] - '0';
+        if (v > (INT64_MAX - d) / 10) fail(at, "number too large");
+        v = v * 10 + d;
+        ++pos_;
       }
       n->kind = Expr::Node::Num;
       n->value = v;
@@ -179,6 +203,7 @@ class Parser {
   const std::string& s_;
   SourceLoc loc_;
   size_t pos_ = 0;
+  int nesting_ = 0;
 };
 
 int64_t evalNode(const Expr::Node& n, const ExprEnv& env, const SourceLoc& loc) {
@@ -199,7 +224,9 @@ int64_t evalNode(const Expr::Node& n, const ExprEnv& env, const SourceLoc& loc) 
       return env.has && env.has(n.text) ? 1 : 0;
     case Expr::Node::Unary: {
       int64_t a = evalNode(*n.a, env, loc);
-      return n.text == "!" ? !a : -a;
+      if (n.text == "!") return !a;
+      if (a == INT64_MIN) return failAt(n.col, "integer overflow in expression (-INT64_MIN)");
+      return -a;
     }
     case Expr::Node::Binary: {
       const std::string& op = n.text;
@@ -208,11 +235,20 @@ int64_t evalNode(const Expr::Node& n, const ExprEnv& env, const SourceLoc& loc) 
       if (op == "||" && a) return 1;
       int64_t b = evalNode(*n.b, env, loc);
       if (op == "&&" || op == "||") return b != 0;
-      if (op == "+") return a + b;
-      if (op == "-") return a - b;
-      if (op == "*") return a * b;
+      // Checked: a wrapped value would be undefined behaviour and could land in the GLSL.
+      int64_t r = 0;
+      auto overflow = [&]() -> int64_t {
+        return failAt(n.col, fmt::format("integer overflow in expression ({} {} {})", a, op, b));
+      };
+      if (op == "+") return __builtin_add_overflow(a, b, &r) ? overflow() : r;
+      if (op == "-") return __builtin_sub_overflow(a, b, &r) ? overflow() : r;
+      if (op == "*") return __builtin_mul_overflow(a, b, &r) ? overflow() : r;
       if (op == "/" || op == "%") {
         if (b == 0) return failAt(n.col, "division by zero in expression");
+        if (a == INT64_MIN && b == -1) {
+          if (op == "%") return 0;
+          return overflow();
+        }
         return op == "/" ? a / b : a % b;
       }
       if (op == "==") return a == b;

@@ -11,6 +11,10 @@
 
 namespace sg {
 
+// Limits (docs/limits.md): longer or deeper expressions are refused when parsed.
+constexpr size_t kMaxExprChars = 4096;
+constexpr int kMaxExprDepth = 64;
+
 struct ExprEnv {
   // Value of an identifier, or nullopt-like false return if unknown.
   std::function<bool(const std::string& name, int64_t& value)> lookup;
@@ -23,7 +27,8 @@ class Expr {
   Expr() = default;
   // Parses `text`; `loc` is where text starts in its file (errors point inside it).
   static Expr parse(const std::string& text, const SourceLoc& loc);
-  int64_t eval(const ExprEnv& env) const;  // throws InputError (unknown name, division by zero)
+  // Throws InputError (unknown name, division by zero, 64-bit overflow).
+  int64_t eval(const ExprEnv& env) const;
   const std::string& text() const { return text_; }
   bool empty() const { return !root_; }
   struct Node;

@@ -138,6 +138,9 @@ int64_t ruleCost(const Rule& rule, const RigShape& shape) {
                                            rule.name));
   int64_t cost = rule.cost.eval(shapeEnv(shape));
   if (cost < 0) throw InputError(rule.loc, fmt::format("rule '{}' has negative cost {}", rule.name, cost));
+  // Above this, sums of costs could reach the search's "infinite" and plans would be lost.
+  if (cost > kMaxRuleCost)
+    throw InputError(rule.loc, fmt::format("rule '{}' has cost {}, above the limit of {}", rule.name, cost, kMaxRuleCost));
   return cost;
 }
 

@@ -61,7 +61,7 @@ struct RuleInstance {
 // when it cannot be evaluated.
 bool ruleApplies(const Rule& rule, const RigShape& shape);
 
-// The rule's `cost` for the shape. Throws InputError for a negative cost and for an
+// The rule's `cost` for the shape. Throws InputError for a cost outside 0..kMaxRuleCost and for an
 // unresolved `cost: auto` (analysis/cost.h resolveAutoCosts measures it first).
 int64_t ruleCost(const Rule& rule, const RigShape& shape);
 

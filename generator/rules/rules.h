@@ -2,6 +2,7 @@
 // from others at a cost, under conditions on the rig, with a GLSL snippet template.
 // Format: docs/rules-format.md.
 #pragma once
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -12,6 +13,13 @@
 #include "rules/expr.h"
 
 namespace sg {
+
+// Limits (docs/limits.md). A rule's cost, once evaluated for a rig, must be 0..kMaxRuleCost:
+// the search adds costs in 64 bits and keeps values near INT64_MAX/4 for "unreachable".
+constexpr int64_t kMaxRuleCost = 1'000'000'000;
+constexpr size_t kMaxRules = 10000;
+constexpr size_t kMaxSemantics = 10000;
+constexpr size_t kMaxIncludeDepth = 32;
 
 struct SemanticDecl {
   std::string name;  // "world.normal"

@@ -67,6 +67,7 @@ SemanticRef parseRef(const YamlCtx& y, const YAML::Node& n) {
 void loadSemantics(RuleSet& set, const YamlCtx& y, const YAML::Node& sems) {
   y.expectMap(sems, "'semantics'");
   for (auto it = sems.begin(); it != sems.end(); ++it) {
+    if (set.semantics.size() >= kMaxSemantics) y.fail(it->first, fmt::format("more than {} semantics", kMaxSemantics));
     SemanticDecl d;
     d.name = y.scalar(it->first, "a semantic name");
     d.loc = locOf(it->first, y.file);
@@ -76,7 +77,7 @@ void loadSemantics(RuleSet& set, const YamlCtx& y, const YAML::Node& sems) {
       y.fail(it->first, fmt::format("semantic '{}' is declared twice (first at {}:{})", d.name, prev->loc.file,
                                     prev->loc.line));
     }
-    const YAML::Node& body = it->second;
+    YAML::Node body = it->second;  // a copy: it->second lives in a temporary proxy
     std::string typeName;
     if (body.IsScalar()) {
       typeName = body.Scalar();
@@ -107,7 +108,8 @@ void loadVaryings(RuleSet& set, const YamlCtx& y, const YAML::Node& vars) {
       v.semantics.push_back(it->second.Scalar());
     } else {
       y.expectSeq(it->second, "a varying mapping");
-      for (const auto& s : it->second) v.semantics.push_back(y.scalar(s, "a semantic name"));
+      YAML::Node list = it->second;  // a copy: it->second lives in a temporary proxy
+      for (const auto& s : list) v.semantics.push_back(y.scalar(s, "a semantic name"));
       if (v.semantics.empty()) y.fail(it->second, fmt::format("varying '{}' maps to no semantic", v.name));
     }
     set.varyings.push_back(std::move(v));
@@ -137,6 +139,16 @@ std::vector<TemplateLine> snippetLines(const YamlCtx& y, const YAML::Node& n, co
       tl.loc.col = static_cast<int>(pos == std::string::npos ? 0 : pos) + 1;
     } else if (n.Tag() == "!") {
       tl.loc.col += 1;  // quoted
+    }
+    // Control bytes have no place in GLSL, and \x01/\x02 mark fact references inside
+    // the generator (search/problem.h): refuse them where they are written.
+    for (size_t c = 0; c < tl.text.size(); ++c) {
+      auto u = static_cast<unsigned char>(tl.text[c]);
+      if ((u < 0x20 && u != '\t') || u == 0x7f) {
+        SourceLoc bad = tl.loc;
+        if (block && bad.col > 0) bad.col += static_cast<int>(c);
+        throw InputError(bad, fmt::format("control character 0x{:02x} in a GLSL snippet", u));
+      }
     }
     out.push_back(std::move(tl));
   }
@@ -199,15 +211,26 @@ void loadParsed(RuleSet& set, const std::string& text, const std::string& path, 
       if (std::find(stack.begin(), stack.end(), incPath) != stack.end())
         y.fail(i, fmt::format("include cycle: '{}' includes itself", incPath));
       if (std::find(set.files.begin(), set.files.end(), incPath) != set.files.end()) continue;  // already loaded
-      if (!std::filesystem::exists(p)) y.fail(i, fmt::format("included file '{}' does not exist", incPath));
-      loadFile(set, incPath, stack);
+      std::error_code ec;
+      if (!std::filesystem::exists(p, ec)) y.fail(i, fmt::format("included file '{}' does not exist", incPath));
+      if (stack.size() >= kMaxIncludeDepth) y.fail(i, fmt::format("includes nest deeper than {} files", kMaxIncludeDepth));
+      try {
+        loadFile(set, incPath, stack);
+      } catch (const InputError& e) {
+        // An unreadable include (a directory, a FIFO...) is reported at the include line.
+        if (e.diagnostic().loc.file != incPath || e.diagnostic().loc.line != 0) throw;
+        y.fail(i, fmt::format("cannot include '{}': {}", incPath, e.diagnostic().message));
+      }
     }
   }
   if (auto s = root["semantics"]) loadSemantics(set, y, s);
   if (auto v = root["varyings"]) loadVaryings(set, y, v);
   if (auto rs = root["rules"]) {
     y.expectSeq(rs, "'rules'");
-    for (const auto& r : rs) loadRule(set, y, r, raw);
+    for (const auto& r : rs) {
+      if (set.rules.size() >= kMaxRules) y.fail(r, fmt::format("more than {} rules", kMaxRules));
+      loadRule(set, y, r, raw);
+    }
   }
 }
 

@@ -74,6 +74,9 @@ class Expander {
           end = block(bodyStart, false, &term);
         } else {
           for (int64_t k = 0; k < count; ++k) {
+            // Nested loops multiply: bound the total work, not just each count.
+            if (++iterations_ > kMaxSnippetIterations)
+              fail(l, ind, fmt::format("'@for' loops unroll more than {} iterations in total", kMaxSnippetIterations));
             vars_.emplace_back(var, k);
             end = block(bodyStart, true, &term);
             vars_.pop_back();
@@ -99,7 +102,13 @@ class Expander {
         continue;
       }
       if (!t.empty() && t[0] == '@') fail(l, ind, fmt::format("unknown directive '{}'", t.substr(0, t.find(' '))));
-      if (emit) out_.push_back(ExpandedLine{substitute(l), l.loc});
+      if (emit) {
+        out_.push_back(ExpandedLine{substitute(l), l.loc});
+        bytes_ += out_.back().text.size() + 1;
+        if (out_.size() > kMaxSnippetLines || bytes_ > kMaxSnippetBytes)
+          fail(l, ind == std::string::npos ? 0 : ind,
+               fmt::format("the snippet unrolls to more than {} lines or {} bytes", kMaxSnippetLines, kMaxSnippetBytes));
+      }
       ++i;
     }
     return i;
@@ -155,6 +164,8 @@ class Expander {
   ExprEnv env_;
   std::vector<std::pair<std::string, int64_t>> vars_;
   std::vector<ExpandedLine> out_;
+  size_t bytes_ = 0;
+  int64_t iterations_ = 0;
 };
 
 }  // namespace

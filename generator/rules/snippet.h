@@ -14,6 +14,11 @@
 
 namespace sg {
 
+// Limits of one unrolled snippet (docs/limits.md).
+constexpr size_t kMaxSnippetLines = 16384;
+constexpr size_t kMaxSnippetBytes = 1u << 20;
+constexpr int64_t kMaxSnippetIterations = 1 << 20;
+
 struct SnippetContext {
   ExprEnv rigEnv;  // rig parameters and has()
   // Resolves a semantic reference (name, evaluated index or -1) to replacement text.

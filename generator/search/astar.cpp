@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "search/budget.h"
+
 namespace sg {
 
 std::vector<bool> reachableFacts(const Problem& p) {
@@ -67,25 +69,37 @@ struct OpenEntry {
 }  // namespace
 
 std::optional<Plan> astarSearch(const Problem& p, Heuristic& h, SearchStats* stats, const SearchLimits& limits) {
+  std::vector<Node> nodes;
+  std::unordered_map<FactSet, int, FactSetHash> index;
+  std::priority_queue<OpenEntry, std::vector<OpenEntry>, std::greater<>> open;
   SearchStats local;
   SearchStats& st = stats ? *stats : local;
   st = SearchStats{};
+  st.engine = "forward";
+  st.heuristic = h.name();
+  SearchBudget budget(limits);
+  auto estimate = [&](const FactSet& s) { return timed(st.heuristicSeconds, [&] { return h.estimate(s); }); };
+  auto finish = [&](std::optional<Plan> plan) {
+    st.finalCost = plan ? plan->cost : -1;
+    st.totalSeconds = budget.seconds();
+    size_t stateBytes = (p.facts.size() + 63) / 64 * 8;
+    st.peakBytes = static_cast<int64_t>(nodes.capacity() * (sizeof(Node) + stateBytes) +
+                                        index.size() * (sizeof(FactSet) + stateBytes + 32) +
+                                        open.size() * sizeof(OpenEntry));
+    return plan;
+  };
   std::vector<bool> relevant = relevantActions(p);
   std::vector<int> acts;
   for (size_t a = 0; a < p.actions.size(); ++a)
     if (relevant[a]) acts.push_back(static_cast<int>(a));
   st.relevantActions = static_cast<int64_t>(acts.size());
-
-  std::vector<Node> nodes;
-  std::unordered_map<FactSet, int, FactSetHash> index;
-  std::priority_queue<OpenEntry, std::vector<OpenEntry>, std::greater<>> open;
   int64_t seq = 0;
 
   FactSet init(p.facts.size());
   for (int f : p.init) init.set(f);
-  int64_t h0 = h.estimate(init);
+  int64_t h0 = estimate(init);
   st.initialH = h0;
-  if (h0 >= kInfiniteCost) return std::nullopt;
+  if (h0 >= kInfiniteCost) return finish(std::nullopt);
   nodes.push_back(Node{init, 0, -1, -1, false});
   index.emplace(init, 0);
   open.push(OpenEntry{h0, 0, seq++, 0});
@@ -99,10 +113,9 @@ std::optional<Plan> astarSearch(const Problem& p, Heuristic& h, SearchStats* sta
     if (n.state.containsAll(p.goals)) {
       std::vector<int> rev;
       for (int i = e.node; nodes[i].action >= 0; i = nodes[i].parent) rev.push_back(nodes[i].action);
-      return tidyPlan(p, std::vector<int>(rev.rbegin(), rev.rend()));
+      return finish(tidyPlan(p, std::vector<int>(rev.rbegin(), rev.rend())));
     }
-    if (++st.expanded > limits.maxExpansions)
-      throw std::runtime_error(fmt::format("search gave up after {} expansions", limits.maxExpansions));
+    budget.onExpansion(++st.expanded);
     FactSet state = n.state;  // copy: nodes may reallocate below
     int64_t g = n.g;
     int parent = e.node;
@@ -121,12 +134,13 @@ std::optional<Plan> astarSearch(const Problem& p, Heuristic& h, SearchStats* sta
         old.g = ng;
         old.parent = parent;
         old.action = a;
+        if (old.closed) ++st.reopened;
         old.closed = false;
-        int64_t hv = h.estimate(next);
+        int64_t hv = estimate(next);
         open.push(OpenEntry{ng + hv, ng, seq++, it->second});
         continue;
       }
-      int64_t hv = h.estimate(next);
+      int64_t hv = estimate(next);
       if (hv >= kInfiniteCost) continue;
       int id = static_cast<int>(nodes.size());
       nodes.push_back(Node{next, ng, parent, a, false});
@@ -134,7 +148,7 @@ std::optional<Plan> astarSearch(const Problem& p, Heuristic& h, SearchStats* sta
       open.push(OpenEntry{ng + hv, ng, seq++, id});
     }
   }
-  return std::nullopt;
+  return finish(std::nullopt);
 }
 
 }  // namespace sg

@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 
 #include "runtime/reference.h"
 
@@ -178,16 +177,24 @@ std::vector<glm::dmat4> gltfNodeGlobals(const GltfModelData& data, int anim, dou
   std::vector<int> parent(N, -1);
   for (size_t i = 0; i < N; ++i)
     for (int c : data.nodes[i].children) parent[static_cast<size_t>(c)] = static_cast<int>(i);
+  // Parents before children, without recursion (node chains can be as long as the file):
+  // walk up to the first finished ancestor, then fill the chain top-down. The importer
+  // refused cycles.
   std::vector<glm::dmat4> global(N);
-  std::vector<bool> done(N, false);
-  std::function<const glm::dmat4&(size_t)> g = [&](size_t i) -> const glm::dmat4& {
-    if (!done[i]) {
-      global[i] = parent[i] < 0 ? local[i] : g(static_cast<size_t>(parent[i])) * local[i];
-      done[i] = true;
+  std::vector<char> done(N, 0);
+  std::vector<size_t> chain;
+  for (size_t i = 0; i < N; ++i) {
+    chain.clear();
+    for (size_t k = i; !done[k]; k = static_cast<size_t>(parent[k])) {
+      chain.push_back(k);
+      if (parent[k] < 0) break;
     }
-    return global[i];
-  };
-  for (size_t i = 0; i < N; ++i) g(i);
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+      size_t k = *it;
+      global[k] = parent[k] < 0 ? local[k] : global[static_cast<size_t>(parent[k])] * local[k];
+      done[k] = 1;
+    }
+  }
   return global;
 }
 

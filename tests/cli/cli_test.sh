@@ -251,6 +251,32 @@ EOF
   fi
   ;;
 
+search)
+  # --search picks the engine, --stats reports the effort; every engine finds cost 81.
+  expect 0 "--stats (default engine)" -- "$SG" generate "${DAWN[@]}" -o s/face --stats
+  grep -q '^search (regression A\*, lmcut): [0-9]* expanded, [0-9]* generated' last.out && ok "--stats names engine and counts" ||
+    fail "--stats printed: $(head -2 last.out)"
+  grep -q 'initial h 81 vs cost 81; heuristic [0-9.]* ms of [0-9.]* ms' last.out && ok "--stats: initial h vs cost, heuristic time" ||
+    fail "--stats printed: $(head -2 last.out)"
+  for engine in forward ip regression; do
+    expect 0 "--search $engine" -- "$SG" generate "${DAWN[@]}" -o "s/$engine" --search "$engine" --stats
+    grep -q "^search ($engine" last.out && grep -q 'total cost 81$' last.out && ok "--search $engine: cost 81" ||
+      fail "--search $engine printed: $(head -3 last.out)"
+  done
+  expect 2 "unknown --search" -- "$SG" generate "${DAWN[@]}" -o x --search sideways
+  expect 2 "negative --search-time-limit" -- "$SG" generate "${DAWN[@]}" -o x --search-time-limit -1
+  expect 2 "--max-expansions 0" -- "$SG" generate "${DAWN[@]}" -o x --max-expansions 0
+  expect 1 "--max-expansions below the need" -- "$SG" generate "${DAWN[@]}" -o x --max-expansions 3
+  grep -q '^shadergen: error: search gave up: expansion limit of 3 reached' last.err && ok "names the expansion limit" ||
+    fail "expansion limit error: $(head -1 last.err)"
+  expect 1 "--search-time-limit too short" -- "$SG" generate "${DAWN[@]}" -o x --search forward --search-time-limit 0.000001
+  grep -q 'time limit of 1e-06 s reached' last.err && ok "names the time limit" || fail "time limit error: $(head -1 last.err)"
+  [ ! -e x.vert ] && [ ! -e x.spv ] && ok "a search that gave up wrote nothing" || fail "a search that gave up wrote outputs"
+  expect 0 "generous limits" -- "$SG" generate "${DAWN[@]}" -o s/limited -q --search-time-limit 60 --max-expansions 1000
+  cmp -s s/limited.spv s/face.spv && ok "limits do not change the output" || fail "limits changed the output"
+  ;;
+
+
 build)
   # `shadergen build`: one process, cache across runs (and between two concurrent builds),
   # unchanged outputs untouched, byte-identical to `generate --set`, located errors.

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <string>
 
 #include "common/diagnostics.h"
@@ -25,6 +26,11 @@ inline sg::Diagnostic errorOf(const std::function<void()>& f) {
   }
   ADD_FAILURE() << "expected sg::InputError, nothing was thrown";
   return {};
+}
+
+inline std::string readFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 inline void writeText(const std::filesystem::path& path, const std::string& text) {

@@ -373,4 +373,57 @@ TEST(GenerateCapture, XfbQualifiersAndStride) {
   EXPECT_EQ(outputsOf(r.glsl.text).size(), 6u);
 }
 
+// Hostile input (issue 10): names that reach the generated GLSL, and limits checked
+// against the generated program.
+
+TEST(GenerateHostile, CommentSafeText) {
+  EXPECT_EQ(sg::commentSafe("face\n#error x"), "face?#error x");
+  EXPECT_EQ(sg::commentSafe("dir\\"), "dir?");  // a trailing '\' would splice the next line
+  EXPECT_EQ(sg::commentSafe("caf\xc3\xa9 ok"), "caf\xc3\xa9 ok");
+}
+
+TEST(GenerateHostile, FileNameWithNewlineCannotInjectCode) {
+  auto dir = freshDir("inject");
+  // The file name ends up in the generated header comment; a newline used to end the
+  // comment and the rest compiled as code.
+  const std::string name = "x\n#error injected\nfloat injected_decl;\\";
+  std::filesystem::copy_file(kDawnFrag, dir / (name + ".frag"));
+  sg::GenerateOptions o = dawnOptions();
+  o.fragmentPath = (dir / (name + ".frag")).string();
+  sg::GenerateResult r = sg::generate(o);
+  EXPECT_EQ(r.glsl.text.find("\n#error"), std::string::npos) << r.glsl.text;
+  EXPECT_EQ(r.glsl.text.find("\nfloat injected_decl"), std::string::npos) << r.glsl.text;
+  EXPECT_NE(r.glsl.text.find("x?#error injected?float injected_decl;?.frag"), std::string::npos) << r.glsl.text;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(GenerateHostile, UniformBlockLargerThanTheVulkanGuaranteeIsRefused) {
+  auto dir = freshDir("ubo");
+  std::string rig = sgtest::readFile(kDawnRig);
+  size_t at = rig.find("bones: 98");
+  ASSERT_NE(at, std::string::npos);
+  rig.replace(at, 9, "bones: 300");  // 300 mat4 = 19200 bytes > 16384
+  writeText(dir / "big.rig.yaml", rig);
+  sg::GenerateOptions o = dawnOptions();
+  o.rigPath = (dir / "big.rig.yaml").string();
+  auto d = errorOf([&] { sg::generate(o); });
+  EXPECT_EQ(d.loc.file, o.rigPath);
+  EXPECT_EQ(d.loc.line, lineOf(rig, "bone_xf:"));
+  EXPECT_EQ(d.loc.col, 3);
+  EXPECT_NE(d.message.find("larger than the 16384 bytes of maxUniformBufferRange"), std::string::npos)
+      << sg::formatDiagnostic(d);
+  EXPECT_NE(d.message.find("mat4 bone_xf[300]"), std::string::npos) << sg::formatDiagnostic(d);
+  // A device with a larger limit accepts the same rig.
+  o.maxUniformBlockBytes = 65536;
+  EXPECT_GT(sg::generate(o).spirv.uniformBlockSize, 16384u);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(GenerateHostile, BanMustNameARule) {
+  sg::GenerateOptions o = dawnOptions();
+  o.bannedRules = {"no_such_rule"};
+  auto d = errorOf([&] { sg::generate(o); });
+  EXPECT_NE(d.message.find("--ban no_such_rule: no rule of that name"), std::string::npos) << sg::formatDiagnostic(d);
+}
+
 }  // namespace

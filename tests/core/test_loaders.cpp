@@ -2,7 +2,10 @@
 // snippet templates, fragment-shader reflection and varying binding, problem building.
 // Every error case asserts the exact file:line:col of the diagnostic and a key phrase.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+#include <climits>
 
 #include <filesystem>
 #include <fstream>
@@ -14,6 +17,7 @@
 #include <vector>
 
 #include "common/diagnostics.h"
+#include "common/input_file.h"
 #include "core_test_util.h"
 #include "common/types.h"
 #include "interface/fragment_interface.h"
@@ -650,7 +654,8 @@ TEST(RulesLoader, DuplicateSemantic) {
   sg::RuleSet set;
   auto d = errorOf([&] { sg::loadRulesText(set, text, "bad.yaml"); });
   EXPECT_LOC(d, "bad.yaml", 4, 3);
-  EXPECT_MSG(d, "semantic 'a.b' is declared twice (first at bad.yaml:2)");
+  // Within one mapping the YAML check answers first (yaml-cpp would keep the last silently).
+  EXPECT_MSG(d, "duplicate key 'a.b' (first at line 2)");
 
   // Across files loaded into one set.
   sg::RuleSet two;
@@ -739,7 +744,7 @@ TEST(RulesLoader, OtherShapeErrors) {
   sg::RuleSet set2;
   auto d2 = errorOf([&] { sg::loadRulesText(set2, "semantics:\n  a.b: float\nvaryings:\n  X: a.b\n  X: a.b\n", "bad.yaml"); });
   EXPECT_LOC(d2, "bad.yaml", 5, 3);
-  EXPECT_MSG(d2, "mapped twice");
+  EXPECT_MSG(d2, "duplicate key 'X' (first at line 4)");
   sg::RuleSet set3;
   auto d3 = errorOf([&] { sg::loadRulesText(set3, "rules: {}\n", "bad.yaml"); });
   EXPECT_LOC(d3, "bad.yaml", 1, 8);
@@ -1402,6 +1407,243 @@ TEST(Problem, UnknownRequestedSemanticAndWhenSkipping) {
   auto d = errorOf([&] { sg::buildProblem(rig, rules, bad); });
   EXPECT_LOC(d, "f.frag", 3, 4);
   EXPECT_MSG(d, "unknown semantic 'no.such'");
+}
+
+// ---------------------------------------------------------------------------------------
+// Hostile input (issue 10): every case below crashed, hung, overflowed or was accepted
+// before; each asserts the located diagnostic that replaces it.
+// ---------------------------------------------------------------------------------------
+
+const std::string kMiniRig = "rig: mini\nattributes:\n  position: { format: float32x3, provides: vertex.position }\n";
+
+TEST(Hostile, DuplicateYamlKeysAreRefused) {
+  // yaml-cpp keeps the second `bones` silently; the loader must not.
+  const std::string rig = "rig: mini\ndeformers:\n  bones: 2\n  bones: 3\n" + kMiniRig.substr(kMiniRig.find("attributes"));
+  auto d = errorOf([&] { sg::loadRigText(rig, "r.yaml"); });
+  EXPECT_LOC(d, "r.yaml", 4, 3);
+  EXPECT_MSG(d, "duplicate key 'bones' (first at line 3)");
+  sg::RuleSet set;
+  const std::string rules = "semantics:\n  a.b: vec3\nrules:\n  - name: r\n    produces: a.b\n    cost: 1\n    cost: 2\n"
+                            "    glsl: \"${out} = vec3(0);\"\n";
+  auto d2 = errorOf([&] { sg::loadRulesText(set, rules, "s.yaml"); });
+  EXPECT_LOC(d2, "s.yaml", 7, 5);
+  EXPECT_MSG(d2, "duplicate key 'cost'");
+}
+
+TEST(Hostile, YamlDepthAndAliasBombsAreBounded) {
+  std::string deep = "rig: mini\nattributes:\n";
+  for (int i = 1; i < 40; ++i) deep += std::string(2 * i, ' ') + "k" + std::to_string(i) + ":\n";
+  auto d = errorOf([&] { sg::loadRigText(deep, "deep.yaml"); });
+  EXPECT_MSG(d, "nesting is deeper than 32 levels");
+  EXPECT_EQ(d.loc.file, "deep.yaml");
+  EXPECT_GT(d.loc.line, 30);
+  // 100000 '[': yaml-cpp's own depth guard answers, located, instead of overflowing the stack.
+  auto d2 = errorOf([&] { sg::loadRigText("rig: [" + std::string(100000, '[') + "\n", "flow.yaml"); });
+  EXPECT_EQ(d2.loc.file, "flow.yaml");
+  EXPECT_GE(d2.loc.line, 1);
+  EXPECT_MSG(d2, "malformed YAML");
+  // 10^9 nodes through aliases in a few hundred bytes.
+  std::string bomb = "a: &a [x, x, x, x, x, x, x, x, x, x]\n";
+  for (char c = 'b'; c <= 'i'; ++c) {
+    char p = static_cast<char>(c - 1);
+    bomb += std::string(1, c) + ": &" + c + " [";
+    for (int k = 0; k < 10; ++k) bomb += std::string(k ? ", " : "") + "*" + p;
+    bomb += "]\n";
+  }
+  auto d3 = errorOf([&] { sg::loadRigText(bomb + kMiniRig, "bomb.yaml"); });
+  EXPECT_MSG(d3, "more than 1048576 nodes");
+}
+
+TEST(Hostile, RigNameCannotCarryControlCharacters) {
+  auto d = errorOf([&] { sg::loadRigText("rig: \"x\\n#define main oops\"\n" + kMiniRig.substr(kMiniRig.find("attributes")), "r.yaml"); });
+  EXPECT_LOC(d, "r.yaml", 1, 6);
+  EXPECT_MSG(d, "control character 0x0a");
+  auto d2 = errorOf([&] { sg::loadRigText("rig: " + std::string(300, 'n') + "\n" + kMiniRig.substr(kMiniRig.find("attributes")), "r.yaml"); });
+  EXPECT_MSG(d2, "1..256 characters");
+}
+
+TEST(Hostile, RigCountsAreLimited) {
+  auto d = errorOf([&] { sg::loadRigText("rig: m\ndeformers:\n  morph_targets: 300\n" + kMiniRig.substr(kMiniRig.find("attributes")), "r.yaml"); });
+  EXPECT_LOC(d, "r.yaml", 3, 18);
+  EXPECT_MSG(d, "at most 256 morph targets");
+  std::string many = "rig: m\nattributes:\n";
+  for (int i = 0; i < 70; ++i) many += "  a" + std::to_string(i) + ": { format: float32, provides: s.v" + std::to_string(i) + " }\n";
+  auto d2 = errorOf([&] { sg::loadRigText(many, "r.yaml"); });
+  EXPECT_LOC(d2, "r.yaml", 2 + 65, 3);
+  EXPECT_MSG(d2, "more than 64 attributes");
+  auto d3 = errorOf([&] { sg::loadRigText("rig: m\ndeformers:\n  bones: 99999999999999999999\n" + kMiniRig.substr(kMiniRig.find("attributes")), "r.yaml"); });
+  EXPECT_LOC(d3, "r.yaml", 3, 10);
+  EXPECT_MSG(d3, "must be an integer");
+}
+
+TEST(Hostile, InputFilesMustBeRegularAndBounded) {
+  auto dir = freshDir("files");
+  auto d = errorOf([&] { sg::loadRigFile(dir.string()); });
+  EXPECT_EQ(d.loc.file, dir.string());
+  EXPECT_MSG(d, "is a directory");
+  auto d2 = errorOf([&] { sg::loadRigFile("/dev/zero"); });
+  EXPECT_MSG(d2, "is a device");
+  // A FIFO without a writer: opening it must not block (the test would hang).
+  std::string fifo = (dir / "rig.fifo").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  auto d3 = errorOf([&] { sg::loadRigFile(fifo); });
+  EXPECT_MSG(d3, "is a FIFO");
+  // Oversize (sparse, so the test writes nothing much).
+  std::string big = (dir / "big.yaml").string();
+  { std::ofstream(big) << "rig: x\n"; }
+  std::filesystem::resize_file(big, sg::kMaxInputBytes + 1);
+  auto d4 = errorOf([&] { sg::loadRigFile(big); });
+  EXPECT_MSG(d4, "larger than the 16777216 byte limit");
+  // The diagnostic printer re-reads lines with the same checks: a FIFO is not quoted, and
+  // rendering returns (no block).
+  sg::Diagnostic onFifo{sg::Severity::Error, sg::SourceLoc{fifo, 3, 1}, "m"};
+  EXPECT_EQ(sg::renderDiagnostic(onFifo), fifo + ":3:1: error: m");
+  sg::Diagnostic onZero{sg::Severity::Error, sg::SourceLoc{"/dev/zero", 1, 1}, "m"};
+  EXPECT_EQ(sg::renderDiagnostic(onZero), "/dev/zero:1:1: error: m");
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Hostile, DiagnosticsShowControlBytesEscaped) {
+  sg::Diagnostic d{sg::Severity::Error, sg::SourceLoc{"a\x1b[2Jb.yaml", 1, 2}, "name 'x\ry'\nsecond line"};
+  EXPECT_EQ(sg::formatDiagnostic(d), "a\\x1b[2Jb.yaml:1:2: error: name 'x\\x0dy'\nsecond line");
+}
+
+TEST(Hostile, CheckedIntegerArithmetic) {
+  auto at = sg::SourceLoc{"e.yaml", 2, 5};
+  auto fails = [&](const std::string& text, const std::string& phrase, int col) {
+    auto d = errorOf([&] { sg::Expr::parse(text, at).eval(paramEnv({{"big", INT64_MAX}, {"one", 1}})); });
+    SCOPED_TRACE(text);
+    EXPECT_LOC(d, "e.yaml", 2, 5 + col);
+    EXPECT_MSG(d, phrase) << text;
+  };
+  fails("big + one", "integer overflow in expression (9223372036854775807 + 1)", 4);
+  fails("0 - big - 2", "integer overflow", 8);
+  fails("big * 2", "integer overflow", 4);
+  fails("(0 - big - 1) / -1", "integer overflow in expression (-9223372036854775808 / -1)", 14);
+  fails("-(0 - big - 1)", "(-INT64_MIN)", 0);
+  // INT64_MIN % -1 is 0 mathematically (and SIGFPE on x86 if computed directly).
+  EXPECT_EQ(ev("(0 - big - 1) % -1", paramEnv({{"big", INT64_MAX}})), 0);
+  EXPECT_EQ(ev("big - 1 + one", paramEnv({{"big", INT64_MAX}, {"one", 1}})), INT64_MAX);
+  EXPECT_EQ(ev("0 - big - 1", paramEnv({{"big", INT64_MAX}})), INT64_MIN);
+}
+
+TEST(Hostile, ExpressionDepthAndLengthAreLimited) {
+  auto at = sg::SourceLoc{"e.yaml", 1, 1};
+  for (const std::string& text : {std::string(2000, '(') + "1" + std::string(2000, ')'), std::string(4000, '!') + "0",
+                                  std::string(4000, '-') + "1"}) {
+    auto d = errorOf([&] { sg::Expr::parse(text, at); });
+    EXPECT_MSG(d, "nested deeper than 64 levels");
+  }
+  std::string chain = "1";
+  for (int i = 0; i < 100; ++i) chain += "+1";
+  EXPECT_MSG(errorOf([&] { sg::Expr::parse(chain, at); }), "nested deeper than 64 levels");
+  auto d = errorOf([&] { sg::Expr::parse(std::string(5000, ' ') + "1", at); });
+  EXPECT_MSG(d, "5001 characters long");
+  // Just inside the limits still works.
+  EXPECT_EQ(ev(std::string(60, '(') + "7" + std::string(60, ')')), 7);
+  std::string ok = "1";
+  for (int i = 0; i < 60; ++i) ok += "+1";
+  EXPECT_EQ(ev(ok), 61);
+}
+
+TEST(Hostile, SnippetControlBytesAreRefusedAtLoad) {
+  // \x01..\x02 is how the generator marks fact references internally; in a snippet it
+  // used to be taken for one (an out-of-bounds write).
+  sg::RuleSet set;
+  const std::string rules = "semantics:\n  a.b: vec3\nrules:\n  - name: r\n    produces: a.b\n    cost: 1\n    glsl: |\n"
+                            "      ${out} = vec3(\x01" "99999\x02);\n";
+  auto d = errorOf([&] { sg::loadRulesText(set, rules, "s.yaml"); });
+  EXPECT_LOC(d, "s.yaml", 8, 7 + 14);
+  EXPECT_MSG(d, "control character 0x01 in a GLSL snippet");
+}
+
+TEST(Hostile, NestedForUnrollIsBounded) {
+  auto d = errorOf([&] {
+    sg::expandSnippet(tmpl({"@for i in 4096", "@for j in 4096", "@for k in 4096", "x;", "@end", "@end", "@end"}), snippetCtx());
+  });
+  EXPECT_LOC(d, "t.yaml", 13, 7);  // the line that would be emitted the 16385th time
+  EXPECT_MSG(d, "more than 16384 lines");
+  auto d2 = errorOf([&] { sg::expandSnippet(tmpl({"@for i in 200", "@for j in 200", "x;", "@end", "@end"}), snippetCtx()); });
+  EXPECT_LOC(d2, "t.yaml", 12, 7);
+  EXPECT_MSG(d2, "more than 16384 lines");
+  // An empty body still counts iterations, so empty nested loops cannot spin for hours.
+  auto d3 = errorOf([&] {
+    sg::expandSnippet(tmpl({"@for i in 4096", "@for j in 4096", "@for k in 4096", "@end", "@end", "@end"}), snippetCtx());
+  });
+  EXPECT_LOC(d3, "t.yaml", 12, 7);  // the innermost loop
+  EXPECT_MSG(d3, "unroll more than 1048576 iterations");
+}
+
+TEST(Hostile, AbsurdCostIsRefused) {
+  sg::RuleSet set;
+  const std::string rules = "semantics:\n  vertex.position: vec3\n  clip.position: vec4\nrules:\n  - name: r\n"
+                            "    produces: clip.position\n    needs: vertex.position\n    cost: 1000000000000\n"
+                            "    glsl: \"${out} = vec4(${vertex.position}, 1.0);\"\n";
+  sg::loadRulesText(set, rules, "s.yaml");
+  sg::Rig rig = sg::loadRigText(kMiniRig, "r.yaml");
+  auto d = errorOf([&] { sg::buildProblem(rig, set, {}); });
+  EXPECT_LOC(d, "s.yaml", 5, 11);
+  EXPECT_MSG(d, "above the limit of 1000000000");
+}
+
+TEST(Hostile, FragmentLongLineIsScannedLinearly) {
+  sg::RuleSet rules = sg::loadRules({kSrc + "/rules/standard.yaml"});
+  // ~30 KB on one line made std::regex recurse until the stack overflowed.
+  const std::string src = "#version 450\nlayout(location = 0) in " + std::string(30000, ' ') + "vec3 world_normal; // " +
+                          std::string(30000, 'x') + "\nlayout(location = 1) in vec3 bogus_input;\n"
+                          "layout(location = 0) out vec4 c;\nvoid main() { c = vec4(world_normal + bogus_input, 1); }\n";
+  sg::FragmentInterface fi = sg::reflectFragmentSource(src, "long.frag");
+  ASSERT_EQ(fi.inputs.size(), 2u);
+  EXPECT_EQ(fi.inputs[0].loc.line, 2);
+  EXPECT_EQ(fi.inputs[0].loc.col, 25 + 30000 + 5);
+  auto d = errorOf([&] { sg::bindVaryings(fi, rules, {}); });
+  EXPECT_LOC(d, "long.frag", 3, 30);
+  EXPECT_MSG(d, "'bogus_input' does not name a semantic");
+}
+
+TEST(Hostile, FragmentDeclarationScannerSkipsCommentsAndFindsSplitDeclarations) {
+  const std::string src = "#version 450\n// in vec3 world_normal;\n/* in vec3 world_normal; */ layout(location = 0)\n"
+                          "  in\n  vec3 world_normal;\nlayout(location = 0) out vec4 c;\nvoid main() { c = vec4(world_normal, 1); }\n";
+  sg::FragmentInterface fi = sg::reflectFragmentSource(src, "split.frag");
+  ASSERT_EQ(fi.inputs.size(), 1u);
+  EXPECT_EQ(fi.inputs[0].loc.line, 5);
+  EXPECT_EQ(fi.inputs[0].loc.col, 8);
+}
+
+TEST(Hostile, FragmentInputsCannotUseGeneratedNames) {
+  sg::RuleSet rules = sg::loadRules({kSrc + "/rules/standard.yaml"});
+  for (const std::string name : {"t_world_normal", "a_position", "u_bones", "ShadergenUniforms"}) {
+    const std::string src = "#version 450\nlayout(location = 0) in vec3 " + name +
+                            ";\nlayout(location = 0) out vec4 c;\nvoid main() { c = vec4(" + name + ", 1); }\n";
+    sg::FragmentInterface fi = sg::reflectFragmentSource(src, "n.frag");
+    auto d = errorOf([&] { sg::bindVaryings(fi, rules, {{name, {"world.normal"}}}); });
+    SCOPED_TRACE(name);
+    EXPECT_LOC(d, "n.frag", 2, 30);
+    EXPECT_MSG(d, "rename it") << name;
+  }
+}
+
+TEST(Hostile, MapMustNameAnInput) {
+  sg::RuleSet rules = sg::loadRules({kSrc + "/rules/standard.yaml"});
+  const std::string src = "#version 450\nlayout(location = 0) in vec3 world_normal;\nlayout(location = 0) out vec4 c;\n"
+                          "void main() { c = vec4(world_normal, 1); }\n";
+  sg::FragmentInterface fi = sg::reflectFragmentSource(src, "m.frag");
+  auto d = errorOf([&] { sg::bindVaryings(fi, rules, {{"WorldNormal", {"world.normal"}}}); });
+  EXPECT_EQ(d.loc.file, "m.frag");
+  EXPECT_MSG(d, "no input 'WorldNormal' (its inputs: world_normal)");
+}
+
+TEST(Hostile, FragmentCompileErrorsGetColumns) {
+  const std::string src = "#version 450\nlayout(location = 0) out vec4 c;\nvoid main() {\n  c = vec4(no_such_thing);\n}\n";
+  auto d = errorOf([&] { sg::reflectFragmentSource(src, "e.frag"); });
+  EXPECT_LOC(d, "e.frag", 4, 12);
+  EXPECT_MSG(d, "no_such_thing");
+  // A 30 KB identifier in the message: parsed without std::regex (no deep recursion).
+  const std::string longName(30000, 'q');
+  const std::string src2 = "#version 450\nlayout(location = 0) out vec4 c;\nvoid main() { c = vec4(" + longName + "); }\n";
+  auto d2 = errorOf([&] { sg::reflectFragmentSource(src2, "l.frag"); });
+  EXPECT_EQ(d2.loc.file, "l.frag");
+  EXPECT_EQ(d2.loc.line, 3);
 }
 
 }  // namespace

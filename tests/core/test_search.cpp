@@ -17,9 +17,12 @@
 
 #include "search/astar.h"
 #include "search/heuristic.h"
+#include "search/ip_oracle.h"
+#include "search/regression.h"
 #include "search/plan.h"
 #include "search/problem.h"
 #include "search/state.h"
+#include "search_test_util.h"
 
 namespace sg {
 namespace {
@@ -79,6 +82,7 @@ class Builder {
 };
 
 const char* const kHeuristics[] = {"blind", "hmax", "lmcut"};
+const char* const kRegressionHeuristics[] = {"blind", "hmax", "landmarks", "lmcut"};
 
 std::optional<Plan> solve(const Problem& p, const std::string& heuristic, SearchStats* stats = nullptr) {
   auto h = makeHeuristic(heuristic, p);
@@ -95,44 +99,6 @@ std::vector<std::string> planNames(const Problem& p, const Plan& plan) {
 bool planHas(const Problem& p, const Plan& plan, const std::string& name) {
   auto names = planNames(p, plan);
   return std::find(names.begin(), names.end(), name) != names.end();
-}
-
-// Validates a plan: each action applicable in order from init, goals reached, cost is
-// the sum of the actions' costs, no action repeated, and every action's product is new
-// and needed (a goal or a precondition of a later action) — the tidy-plan contract.
-::testing::AssertionResult planIsValid(const Problem& p, const Plan& plan) {
-  std::vector<bool> have(p.facts.size(), false);
-  for (int f : p.init) have[f] = true;
-  int64_t sum = 0;
-  std::set<int> used;
-  for (size_t i = 0; i < plan.actions.size(); ++i) {
-    int ai = plan.actions[i];
-    if (ai < 0 || ai >= static_cast<int>(p.actions.size()))
-      return ::testing::AssertionFailure() << "action index out of range: " << ai;
-    if (!used.insert(ai).second) return ::testing::AssertionFailure() << "action repeated: " << ai;
-    const Action& a = p.actions[ai];
-    for (int f : a.pre)
-      if (!have[f])
-        return ::testing::AssertionFailure() << "step " << i << " (" << a.name << ") precondition "
-                                             << p.facts[f].name << " missing";
-    if (have[a.add])
-      return ::testing::AssertionFailure() << "step " << i << " (" << a.name << ") re-produces "
-                                           << p.facts[a.add].name;
-    bool needed = std::find(p.goals.begin(), p.goals.end(), a.add) != p.goals.end();
-    for (size_t j = i + 1; j < plan.actions.size() && !needed; ++j) {
-      const auto& later = p.actions[plan.actions[j]].pre;
-      needed = std::find(later.begin(), later.end(), a.add) != later.end();
-    }
-    if (!needed)
-      return ::testing::AssertionFailure() << "step " << i << " (" << a.name << ") produces an unneeded fact";
-    have[a.add] = true;
-    sum += a.cost;
-  }
-  for (int g : p.goals)
-    if (!have[g]) return ::testing::AssertionFailure() << "goal " << p.facts[g].name << " not reached";
-  if (sum != plan.cost)
-    return ::testing::AssertionFailure() << "plan.cost " << plan.cost << " != sum of action costs " << sum;
-  return ::testing::AssertionSuccess();
 }
 
 // ---------------------------------------------------------------------------
@@ -560,7 +526,7 @@ std::vector<RandomCase> randomCases(uint32_t seed, int count) {
 }
 
 TEST(SearchRandom, MatchesExhaustiveSolver) {
-  int solvable = 0, unsolvable = 0, trivial = 0, compared = 0;
+  int solvable = 0, unsolvable = 0, trivial = 0, compared = 0, cyclic = 0;
   for (uint32_t seed : {1u, 2u, 3u, 4u}) {
     auto cases = randomCases(seed, 100);
     for (size_t i = 0; i < cases.size(); ++i) {
@@ -583,9 +549,35 @@ TEST(SearchRandom, MatchesExhaustiveSolver) {
         EXPECT_TRUE(planIsValid(p, *plan));
         EXPECT_LE(st.initialH, opt);
       }
+      // The other engines on the same instance: the integer program (the oracle of the
+      // larger tests, checked here against exhaustive enumeration, cycles included) and
+      // regression A* wherever the relevant rule graph is acyclic.
+      auto ip = integerProgramSearch(p);
+      ASSERT_EQ(ip.has_value(), opt != kNoSolution);
+      if (ip) {
+        EXPECT_EQ(ip->cost, opt);
+        EXPECT_TRUE(planIsValid(p, *ip));
+      }
+      if (!regressionApplies(p)) {
+        ++cyclic;
+        EXPECT_THROW(regressionSearch(p, "lmcut"), std::invalid_argument);
+        continue;
+      }
+      for (const char* h : kRegressionHeuristics) {
+        SCOPED_TRACE(std::string("regression ") + h);
+        SearchStats st;
+        auto plan = regressionSearch(p, h, &st);
+        ASSERT_EQ(plan.has_value(), opt != kNoSolution);
+        if (!plan) continue;
+        EXPECT_EQ(plan->cost, opt);
+        EXPECT_TRUE(planIsValid(p, *plan));
+        EXPECT_LE(st.initialH, opt);
+      }
     }
   }
-  // The generator must exercise every outcome.
+  // The generator must exercise every outcome, and both rule-graph shapes.
+  EXPECT_GE(cyclic, 40);
+  EXPECT_LE(cyclic, 300);
   EXPECT_GE(solvable + unsolvable + trivial, 300);
   EXPECT_GE(solvable, 100);
   EXPECT_GE(unsolvable, 20);
@@ -593,13 +585,14 @@ TEST(SearchRandom, MatchesExhaustiveSolver) {
   RecordProperty("solvable", solvable);
   RecordProperty("unsolvable", unsolvable);
   RecordProperty("trivial", trivial);
-  std::printf("random instances: %d solvable (cost>0), %d cost 0, %d unsolvable\n", solvable, trivial, unsolvable);
+  std::printf("random instances: %d solvable (cost>0), %d cost 0, %d unsolvable, %d cyclic\n", solvable, trivial,
+              unsolvable, cyclic);
 }
 
 // Denser instances: more actions per fact (more alternatives and sharing).
 TEST(SearchRandom, DenseAlternativesMatchExhaustive) {
   std::mt19937 rng(99);
-  int solvable = 0;
+  int solvable = 0, acyclic = 0;
   for (int i = 0; i < 120; ++i) {
     Problem p = randomProblem(rng, 8, 16, 3);
     int64_t opt = Exhaustive(p).optimum(maskOf(p.init));
@@ -616,8 +609,19 @@ TEST(SearchRandom, DenseAlternativesMatchExhaustive) {
       EXPECT_EQ(plan->cost, opt);
       EXPECT_TRUE(planIsValid(p, *plan));
     }
+    auto ip = integerProgramSearch(p);
+    ASSERT_EQ(ip.has_value(), opt != kNoSolution);
+    if (ip) EXPECT_EQ(ip->cost, opt);
+    if (!regressionApplies(p)) continue;
+    ++acyclic;
+    for (const char* h : kRegressionHeuristics) {
+      auto plan = regressionSearch(p, h);
+      ASSERT_EQ(plan.has_value(), opt != kNoSolution) << h;
+      if (plan) EXPECT_EQ(plan->cost, opt) << h;
+    }
   }
   EXPECT_GE(solvable, 40);
+  EXPECT_GE(acyclic, 10);
 }
 
 // ---------------------------------------------------------------------------

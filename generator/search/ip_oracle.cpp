@@ -1,0 +1,204 @@
+#include "search/ip_oracle.h"
+
+#include <glpk.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <memory>
+
+#include "search/budget.h"
+
+namespace sg {
+namespace {
+
+// Strongly connected components (Tarjan, iterative) of the graph precondition -> product.
+std::vector<int> components(int n, const std::vector<std::vector<int>>& succ) {
+  std::vector<int> comp(n, -1), low(n), num(n, -1), stack;
+  std::vector<bool> onStack(n, false);
+  int counter = 0, comps = 0;
+  std::vector<std::pair<int, size_t>> call;
+  for (int s = 0; s < n; ++s) {
+    if (num[s] >= 0) continue;
+    call.emplace_back(s, 0);
+    while (!call.empty()) {
+      auto& [v, i] = call.back();
+      if (i == 0) {
+        num[v] = low[v] = counter++;
+        stack.push_back(v);
+        onStack[v] = true;
+      }
+      if (i < succ[v].size()) {
+        int w = succ[v][i++];
+        if (num[w] < 0) call.emplace_back(w, 0);
+        else if (onStack[w]) low[v] = std::min(low[v], num[w]);
+        continue;
+      }
+      if (low[v] == num[v]) {
+        for (int w = -1; w != v;) {
+          w = stack.back();
+          stack.pop_back();
+          onStack[w] = false;
+          comp[w] = comps;
+        }
+        ++comps;
+      }
+      int done = v;
+      call.pop_back();
+      if (!call.empty()) low[call.back().first] = std::min(low[call.back().first], low[done]);
+    }
+  }
+  return comp;
+}
+
+}  // namespace
+
+std::optional<Plan> integerProgramSearch(const Problem& p, SearchStats* stats, const SearchLimits& limits) {
+  SearchStats local;
+  SearchStats& st = stats ? *stats : local;
+  st = SearchStats{};
+  st.engine = "ip";
+  SearchBudget budget(limits);
+  auto finish = [&](std::optional<Plan> plan) {
+    st.finalCost = plan ? plan->cost : -1;
+    st.totalSeconds = budget.seconds();
+    return plan;
+  };
+  std::vector<bool> reach = reachableFacts(p), relevant = relevantActions(p);
+  for (int g : p.goals)
+    if (!reach[g]) return finish(std::nullopt);
+  const int nf = static_cast<int>(p.facts.size());
+  std::vector<bool> isInit(nf, false);
+  for (int f : p.init) isInit[f] = true;
+  std::vector<int> acts;
+  for (size_t a = 0; a < p.actions.size(); ++a) {
+    const Action& act = p.actions[a];
+    if (relevant[a] && !std::binary_search(act.pre.begin(), act.pre.end(), act.add)) acts.push_back(static_cast<int>(a));
+  }
+  st.relevantActions = static_cast<int64_t>(acts.size());
+  // Columns: x per action (1..), then y per needed non-init fact, then t per fact in a cycle.
+  std::vector<int> yCol(nf, 0), tCol(nf, 0);
+  std::vector<std::vector<int>> succ(nf);
+  int cols = static_cast<int>(acts.size());
+  auto needY = [&](int f) {
+    if (!isInit[f] && yCol[f] == 0) yCol[f] = ++cols;
+  };
+  for (int g : p.goals) needY(g);
+  for (int a : acts) {
+    needY(p.actions[a].add);
+    for (int q : p.actions[a].pre) {
+      needY(q);
+      if (!isInit[q]) succ[q].push_back(p.actions[a].add);
+    }
+  }
+  if (cols == 0) return finish(Plan{});  // every goal provided (GLPK rejects empty programs)
+  std::vector<int> comp = components(nf, succ);
+  std::vector<int> compSize(nf + 1, 0);
+  for (int f = 0; f < nf; ++f) ++compSize[comp[f]];
+  auto inCycle = [&](int q, int add) { return comp[q] == comp[add] && compSize[comp[q]] > 1; };
+
+  // GLPK keeps global state: free it all after each solve (this also resets its peak
+  // memory counter, which the stats report per solve).
+  struct Env {
+    glp_prob* prob = glp_create_prob();
+    ~Env() {
+      glp_delete_prob(prob);
+      glp_free_env();
+    }
+  } env;
+  glp_prob* P = env.prob;
+  glp_set_obj_dir(P, GLP_MIN);
+  glp_add_cols(P, cols);
+  for (size_t i = 0; i < acts.size(); ++i) {
+    glp_set_col_kind(P, static_cast<int>(i) + 1, GLP_BV);
+    glp_set_obj_coef(P, static_cast<int>(i) + 1, static_cast<double>(p.actions[acts[i]].cost));
+  }
+  for (int f = 0; f < nf; ++f)
+    if (yCol[f]) glp_set_col_kind(P, yCol[f], GLP_BV);
+  for (int g : p.goals)
+    if (yCol[g]) glp_set_col_bnds(P, yCol[g], GLP_FX, 1, 1);
+  std::vector<int> ia{0}, ja{0};
+  std::vector<double> ar{0};
+  int rows = 0;
+  auto row = [&](double lo, std::initializer_list<std::pair<int, double>> terms) {
+    glp_add_rows(P, 1);
+    glp_set_row_bnds(P, ++rows, GLP_LO, lo, 0);
+    for (auto [c, v] : terms) {
+      ia.push_back(rows);
+      ja.push_back(c);
+      ar.push_back(v);
+    }
+  };
+  // Achiever rows: sum x - y >= 0, one row per needed fact.
+  std::vector<std::vector<int>> achievers(nf);
+  for (size_t i = 0; i < acts.size(); ++i) achievers[p.actions[acts[i]].add].push_back(static_cast<int>(i) + 1);
+  for (int f = 0; f < nf; ++f) {
+    if (!yCol[f]) continue;
+    glp_add_rows(P, 1);
+    glp_set_row_bnds(P, ++rows, GLP_LO, 0, 0);
+    for (int c : achievers[f]) {
+      ia.push_back(rows);
+      ja.push_back(c);
+      ar.push_back(1);
+    }
+    ia.push_back(rows);
+    ja.push_back(yCol[f]);
+    ar.push_back(-1);
+  }
+  for (size_t i = 0; i < acts.size(); ++i) {
+    const Action& act = p.actions[acts[i]];
+    int x = static_cast<int>(i) + 1;
+    for (int q : act.pre) {
+      if (isInit[q]) continue;
+      row(0, {{yCol[q], 1}, {x, -1}});
+      if (!inCycle(q, act.add)) continue;
+      for (int f : {q, act.add})
+        if (!tCol[f]) {
+          tCol[f] = ++cols;
+          glp_add_cols(P, 1);
+          glp_set_col_kind(P, cols, GLP_CV);
+          glp_set_col_bnds(P, cols, GLP_DB, 0, compSize[comp[f]] - 1);
+        }
+      double big = compSize[comp[q]];
+      row(1 - big, {{tCol[act.add], 1}, {tCol[q], -1}, {x, -big}});  // t_add - t_q >= 1 - M(1 - x)
+    }
+  }
+  glp_load_matrix(P, static_cast<int>(ia.size()) - 1, ia.data(), ja.data(), ar.data());
+
+  glp_iocp parm;
+  glp_init_iocp(&parm);
+  parm.presolve = GLP_ON;
+  parm.msg_lev = GLP_MSG_OFF;
+  if (limits.maxSeconds > 0) parm.tm_lim = static_cast<int>(std::ceil(limits.maxSeconds * 1000));
+  glp_term_out(GLP_OFF);
+  int ret = glp_intopt(P, &parm);
+  int count = 0, cpeak = 0;
+  size_t total = 0, tpeak = 0;
+  glp_mem_usage(&count, &cpeak, &total, &tpeak);
+  st.peakBytes = static_cast<int64_t>(tpeak);
+  if (ret == GLP_ETMLIM)
+    throw SearchLimitError(fmt::format("integer program gave up: time limit of {} s reached (--search-time-limit)",
+                                       limits.maxSeconds));
+  if (ret == GLP_ENOPFS || ret == GLP_ENODFS || glp_mip_status(P) == GLP_NOFEAS) return finish(std::nullopt);
+  if (ret != 0 || glp_mip_status(P) != GLP_OPT)
+    throw std::runtime_error(fmt::format("GLPK failed on the plan integer program (glp_intopt returned {})", ret));
+  // Chosen actions, applied in a forward closure (their own order), then tidied.
+  std::vector<int> chosen, order;
+  for (size_t i = 0; i < acts.size(); ++i)
+    if (glp_mip_col_val(P, static_cast<int>(i) + 1) > 0.5) chosen.push_back(acts[i]);
+  std::vector<bool> have(nf, false), used(chosen.size(), false);
+  for (int f : p.init) have[f] = true;
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (size_t i = 0; i < chosen.size(); ++i) {
+      const Action& act = p.actions[chosen[i]];
+      if (used[i] || have[act.add] || !std::all_of(act.pre.begin(), act.pre.end(), [&](int q) { return have[q]; }))
+        continue;
+      used[i] = have[act.add] = changed = true;
+      order.push_back(chosen[i]);
+    }
+  }
+  return finish(tidyPlan(p, order));
+}
+
+}  // namespace sg

@@ -1,0 +1,33 @@
+#include "search/search.h"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+#include "search/heuristic.h"
+#include "search/ip_oracle.h"
+#include "search/regression.h"
+
+namespace sg {
+
+std::optional<Plan> findPlan(const Problem& p, const SearchOptions& opts, SearchStats* stats) {
+  const std::string& e = opts.engine;
+  if (e == "ip") return integerProgramSearch(p, stats, opts.limits);
+  if (e == "regression" || (e == "auto" && regressionApplies(p)))
+    return regressionSearch(p, opts.heuristic, stats, opts.limits);
+  if (e != "auto" && e != "forward") throw std::invalid_argument("unknown search engine '" + e + "'");
+  auto h = makeHeuristic(opts.heuristic, p);
+  if (!h) throw std::invalid_argument("unknown heuristic '" + opts.heuristic + "' for forward search");
+  return astarSearch(p, *h, stats, opts.limits);
+}
+
+std::string describeStats(const SearchStats& st) {
+  std::string who = st.heuristic.empty() ? st.engine : fmt::format("{} A*, {}", st.engine, st.heuristic);
+  return fmt::format(
+      "search ({}): {} expanded, {} generated, {} reopened, {} relevant rules\n"
+      "  initial h {} vs cost {}; heuristic {:.3f} ms of {:.3f} ms; {:.1f} KiB\n",
+      who, st.expanded, st.generated, st.reopened, st.relevantActions, st.initialH, st.finalCost,
+      st.heuristicSeconds * 1e3, st.totalSeconds * 1e3, static_cast<double>(st.peakBytes) / 1024);
+}
+
+}  // namespace sg

@@ -1,0 +1,4 @@
+#version 450
+in vec3 object_normal;
+layout(location = 0) out vec4 color;
+void main() { color = vec4(object_normal, 1.0); }

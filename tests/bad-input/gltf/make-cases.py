@@ -1,0 +1,221 @@
+#!/usr/bin/env python3
+"""Writes the glTF cases of the bad-input corpus (tests/bad-input/gltf/<case>/).
+
+Each case is a small hostile model plus `run` (shadergen arguments) and `expect` (exit status,
+then strings stderr must contain). Rerun after changing a case here; the files are committed
+so that the corpus needs no Python.
+"""
+import base64
+import json
+import os
+import shutil
+import struct
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+TRI = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0)
+
+
+def data_uri(b):
+    return "data:application/octet-stream;base64," + base64.b64encode(b).decode()
+
+
+def model(accessors, views=None, blob=TRI, extra=None, uri=None, byte_length=None):
+    """A glTF dict with one buffer (data URI unless `uri`), one triangle mesh on node 0."""
+    m = {
+        "asset": {"version": "2.0"},
+        "buffers": [{"byteLength": len(blob) if byte_length is None else byte_length,
+                     "uri": data_uri(blob) if uri is None else uri}],
+        "bufferViews": views if views is not None else [{"buffer": 0, "byteLength": len(blob)}],
+        "accessors": accessors,
+        "meshes": [{"name": "tri", "primitives": [{"attributes": {"POSITION": 0}}]}],
+        "nodes": [{"mesh": 0}],
+    }
+    m.update(extra or {})
+    return m
+
+
+POS = {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"}
+
+
+def pos(**kw):
+    a = dict(POS)
+    a.update(kw)
+    return a
+
+
+def glb(js, bin_bytes, bin_len_field=None, total_field=None, magic=b"glTF", version=2):
+    j = json.dumps(js).encode()
+    j += b" " * (-len(j) % 4)
+    out = magic + struct.pack("<II", version, 0) + struct.pack("<I", len(j)) + b"JSON" + j
+    if bin_bytes is not None:
+        out += struct.pack("<I", len(bin_bytes) if bin_len_field is None else bin_len_field) + b"BIN\0" + bin_bytes
+    total = len(out) if total_field is None else total_field
+    return out[:8] + struct.pack("<I", total) + out[12:]
+
+
+cases = {}
+
+
+def case(name, files, run, status, *messages, setup=None):
+    cases[name] = (files, run, status, messages, setup)
+
+
+def rig_import(path):
+    return f"rig import {path} -o @O/rig.yaml"
+
+
+def text(m):
+    return json.dumps(m, indent=1).encode()
+
+
+# --- bounds arithmetic -------------------------------------------------------------------
+case("accessor-offset-wraps", {"m.gltf": text(model([pos(byteOffset=18446744073709551600)]))},
+     rig_import("@D/m.gltf"), 1, "@D/m.gltf: error:", "reads bytes 18446744073709551600..+36 of buffer view 0, which has 36 bytes")
+case("view-offset-wraps",
+     {"m.gltf": text(model([POS], views=[{"buffer": 0, "byteOffset": 18446744073709551615, "byteLength": 36}]))},
+     rig_import("@D/m.gltf"), 1, "@D/m.gltf: error:", "lies outside buffer 0 (36 bytes)")
+case("view-past-buffer", {"m.gltf": text(model([POS], views=[{"buffer": 0, "byteOffset": 8, "byteLength": 36}]))},
+     rig_import("@D/m.gltf"), 1, "buffer view 0 (bytes 8..+36) lies outside buffer 0 (36 bytes)")
+case("count-billion", {"m.gltf": text(model([pos(count=1000000000)]))},
+     rig_import("@D/m.gltf"), 1, "has 1000000000 elements; the limit is 16777216")
+case("count-past-view", {"m.gltf": text(model([pos(count=16000000)]))},
+     rig_import("@D/m.gltf"), 1, "reads bytes 0..+192000000 of buffer view 0, which has 36 bytes")
+zero_fill = model([{"componentType": 5126, "count": 16000000, "type": "VEC3"}])
+case("count-zero-fill", {"m.gltf": text(zero_fill)}, rig_import("@D/m.gltf"), 1,
+     "decoding 16000000 elements would take the decoded data past this model's limit of 64.")
+case("stride-below-element", {"m.gltf": text(model([POS], views=[{"buffer": 0, "byteLength": 36, "byteStride": 4}]))},
+     rig_import("@D/m.gltf"), 1, "has byteStride 4, less than the 12-byte element")
+case("view-missing", {"m.gltf": text(model([pos(bufferView=7)]))}, rig_import("@D/m.gltf"), 1,
+     "refers to buffer view 7, which does not exist")
+case("accessor-missing", {"m.gltf": text(model([POS], extra={
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 3}}]}]}))}, rig_import("@D/m.gltf"), 1,
+     "attribute POSITION refers to accessor 3, which does not exist")
+
+SPARSE_BLOB = TRI + struct.pack("<HH", 0, 1) + struct.pack("<6f", 1, 1, 1, 2, 2, 2)
+SPARSE_VIEWS = [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 4},
+                {"buffer": 0, "byteOffset": 40, "byteLength": 24}]
+
+
+def sparse(count, idx_offset=0, idx_type=5123):
+    return model([pos(sparse={"count": count,
+                              "indices": {"bufferView": 1, "componentType": idx_type, "byteOffset": idx_offset},
+                              "values": {"bufferView": 2}})], views=SPARSE_VIEWS, blob=SPARSE_BLOB)
+
+
+case("sparse-count-negative", {"m.gltf": text(sparse(-2147483648))}, rig_import("@D/m.gltf"), 1,
+     "sparse count -2147483648 is not between 0 and the accessor's count 3")
+case("sparse-count-above-count", {"m.gltf": text(sparse(4))}, rig_import("@D/m.gltf"), 1,
+     "sparse count 4 is not between 0 and the accessor's count 3")
+case("sparse-indices-offset", {"m.gltf": text(sparse(2, idx_offset=2147483647))}, rig_import("@D/m.gltf"), 1,
+     "sparse indices reads bytes 2147483647..+4 of buffer view 1")
+case("sparse-index-out-of-range", {"m.gltf": text(model(
+    [pos(sparse={"count": 1, "indices": {"bufferView": 1, "componentType": 5123},
+                 "values": {"bufferView": 2}})], views=SPARSE_VIEWS,
+    blob=TRI + struct.pack("<HH", 9, 0) + struct.pack("<6f", 1, 1, 1, 2, 2, 2)))}, rig_import("@D/m.gltf"), 1,
+     "sparse index 9 is out of range (count 3)")
+case("sparse-index-type-float", {"m.gltf": text(sparse(1, idx_type=5126))}, rig_import("@D/m.gltf"), 1,
+     "sparse indices must be unsigned byte, short or int")
+case("position-nan", {"m.gltf": text(model([POS], blob=struct.pack("<9f", 0, 0, 0, float("nan"), 0, 0, 0, 1, 0)))},
+     rig_import("@D/m.gltf"), 1, "holds a non-finite value")
+
+# --- JSON ----------------------------------------------------------------------------------
+deep = b'{"asset":{"version":"2.0"},\n"extras":' + b"[" * 5000 + b"]" * 5000 + b"}"
+case("json-deep-nesting", {"m.gltf": deep}, rig_import("@D/m.gltf"), 1,
+     "@D/m.gltf:2:73: error: JSON nested deeper than 64 levels")
+case("json-syntax", {"m.gltf": b'{"asset":{"version":"2.0"},\n "meshes":[1,,2]}'}, rig_import("@D/m.gltf"), 1,
+     "@D/m.gltf:2:14: error: invalid JSON: syntax error")
+case("json-truncated", {"m.gltf": text(model([POS]))[:200]}, rig_import("@D/m.gltf"), 1, "error: invalid JSON")
+case("json-not-object", {"m.gltf": b"[1, 2, 3]"}, rig_import("@D/m.gltf"), 1, "cannot load the glTF model")
+
+# --- node hierarchy --------------------------------------------------------------------------
+chain = [{"children": [i + 1]} for i in range(20000)] + [{"mesh": 0, "children": [0]}]
+case("node-cycle-long", {"m.gltf": json.dumps(model([POS], extra={"nodes": chain})).encode()}, rig_import("@D/m.gltf"), 1,
+     "is part of a cycle in the node hierarchy")
+case("node-two-parents", {"m.gltf": text(model([POS], extra={"nodes": [{"children": [2]}, {"children": [2]}, {"mesh": 0}]}))},
+     rig_import("@D/m.gltf"), 1, "node 2 has two parents")
+case("node-child-missing", {"m.gltf": text(model([POS], extra={"nodes": [{"children": [-5]}, {"mesh": 0}]}))},
+     rig_import("@D/m.gltf"), 1, "has a child -5 that does not exist")
+case("scene-node-missing", {"m.gltf": text(model([POS], extra={"scenes": [{"nodes": [40]}]}))},
+     rig_import("@D/m.gltf"), 1, "the scene refers to node 40, which does not exist")
+
+# --- files --------------------------------------------------------------------------------
+case("uri-parent-folder", {"model/m.gltf": text(model([POS], uri="../secret.bin")), "secret.bin": TRI},
+     rig_import("@D/model/m.gltf"), 1, "secret.bin' lies outside the model's folder '@D/model'")
+case("uri-encoded-parent", {"model/m.gltf": text(model([POS], uri="%2E%2E/secret.bin")), "secret.bin": TRI},
+     rig_import("@D/model/m.gltf"), 1, "lies outside the model's folder '@D/model'")
+case("uri-symlink-out", {"model/m.gltf": text(model([POS], uri="link.bin")), "secret.bin": TRI,
+                         "model/link.bin": ("symlink", "../secret.bin")},
+     rig_import("@D/model/m.gltf"), 1, "link.bin' lies outside the model's folder '@D/model'")
+case("uri-absolute", {"m.gltf": text(model([POS], uri="/etc/passwd"))}, rig_import("@D/m.gltf"), 1,
+     "@D/m.gltf: error: cannot load the glTF model: File not found : /etc/passwd")
+case("uri-size-mismatch", {"m.gltf": text(model([POS], byte_length=4000000000))}, rig_import("@D/m.gltf"), 1,
+     "Failed to decode 'uri'")
+case("model-is-fifo", {}, rig_import("@T/fifo.gltf"), 1, "fifo.gltf: error: cannot read the glTF model: not a regular file",
+     setup='mkfifo "$1/fifo.gltf"\n')
+case("model-is-dev-zero", {}, rig_import("@T/zero.glb"), 1, "zero.glb: error: cannot read the glTF model: not a regular file",
+     setup='ln -s /dev/zero "$1/zero.glb"\n')
+case("model-is-directory", {}, rig_import("@T/dir.gltf"), 1, "dir.gltf: error: cannot read the glTF model: not a regular file",
+     setup='mkdir "$1/dir.gltf"\n')
+case("model-too-large", {}, rig_import("@T/huge.glb"), 1, "larger than the limit of 1024.0 MiB",
+     setup='truncate -s 2G "$1/huge.glb"\n')
+
+# --- GLB -----------------------------------------------------------------------------------
+GLB_JSON = model([POS], extra={"buffers": [{"byteLength": 36}]})
+case("glb-bin-chunk-overrun", {"m.glb": glb(GLB_JSON, TRI, bin_len_field=44)}, rig_import("@D/m.glb"), 1,
+     "the GLB's BIN chunk at byte")
+case("glb-length-lie", {"m.glb": glb(GLB_JSON, TRI, total_field=1 << 31)}, rig_import("@D/m.glb"), 1,
+     "the GLB header claims 2147483648 bytes but the file has")
+case("glb-json-chunk-overrun", {"m.glb": glb(GLB_JSON, TRI)[:12] + struct.pack("<I", 0xFFFFFFF0) + glb(GLB_JSON, TRI)[16:]},
+     rig_import("@D/m.glb"), 1, "the GLB's first chunk must be JSON")
+case("glb-bad-magic", {"m.glb": glb(GLB_JSON, TRI, magic=b"gLTF")}, rig_import("@D/m.glb"), 1, "no 'glTF' header")
+case("glb-version-1", {"m.glb": glb(GLB_JSON, TRI, version=1)}, rig_import("@D/m.glb"), 1, "GLB version 1 is not supported")
+deep_glb = b'{"x":' + b"[" * 70 + b"]" * 70 + b"}"
+deep_glb += b" " * (-len(deep_glb) % 4)
+case("glb-deep-json", {"m.glb": b"glTF" + struct.pack("<III", 2, 20 + len(deep_glb), len(deep_glb)) + b"JSON" + deep_glb},
+     rig_import("@D/m.glb"), 1, "JSON nested deeper than 64 levels in the GLB's JSON chunk (line 1, column 69)")
+
+# --- selection and the generate path ---------------------------------------------------------
+case("mesh-index-missing", {"m.gltf": text(model([POS]))}, rig_import("@D/m.gltf#5/0"), 1, "there is no mesh 5")
+case("selection-malformed", {"m.gltf": text(model([POS]))}, rig_import("@D/m.gltf#x/0"), 1,
+     "does not select a primitive")
+anim = model([POS, {"bufferView": 1, "componentType": 5126, "count": 2, "type": "SCALAR"},
+              {"componentType": 5126, "count": 0, "type": "SCALAR"}],
+             views=[{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 8}],
+             blob=TRI + struct.pack("<2f", 0, 1),
+             extra={"animations": [{"samplers": [{"input": 1, "output": 2}],
+                                    "channels": [{"sampler": 0, "target": {"node": 0, "path": "weights"}}]}]})
+case("animation-weights-empty", {"m.gltf": text(anim)}, rig_import("@D/m.gltf"), 1,
+     "0 output values do not divide into 2 keyframes")
+case("generate-with-hostile-rig", {"m.gltf": text(model([pos(byteOffset=18446744073709551600)]))},
+     "generate --rig @D/m.gltf#0/0 -f examples/dawn/face.frag -r rules/standard.yaml -o @O/face", 1,
+     "@D/m.gltf: error:", "reads bytes 18446744073709551600")
+
+
+def main():
+    for name in sorted(os.listdir(HERE)):
+        if os.path.isdir(os.path.join(HERE, name)) and name not in cases:
+            shutil.rmtree(os.path.join(HERE, name))
+    for name, (files, run, status, messages, setup) in cases.items():
+        d = os.path.join(HERE, name)
+        shutil.rmtree(d, ignore_errors=True)
+        os.makedirs(d)
+        for rel, content in files.items():
+            p = os.path.join(d, rel)
+            os.makedirs(os.path.dirname(p), exist_ok=True)
+            if isinstance(content, tuple):
+                os.symlink(content[1], p)
+            else:
+                with open(p, "wb") as f:
+                    f.write(content)
+        with open(os.path.join(d, "run"), "w") as f:
+            f.write(run + "\n")
+        with open(os.path.join(d, "expect"), "w") as f:
+            f.write("\n".join([str(status), *messages]) + "\n")
+        if setup:
+            with open(os.path.join(d, "setup"), "w") as f:
+                f.write(setup)
+    print(f"{len(cases)} cases", file=sys.stderr)
+
+
+main()
