@@ -8,7 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/generate.h"
+#include "search/astar.h"
+#include "search/instance.h"
+#include "search/plan.h"
 
 namespace sg {
 

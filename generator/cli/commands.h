@@ -21,6 +21,7 @@ const char* shadergenVersionString();
 struct GenerateArgs {
   GenerateOptions opts;
   std::vector<std::string> maps;  // "Name=sem[,sem...]"
+  std::vector<std::string> sets;  // "param=value" (rig deformer parameters)
   std::string targetEnv = "vulkan1.0";
   void add(CLI::App& cmd);
   GenerateOptions resolve() const;  // parses --map and --target-env (throws CLI::ValidationError)
@@ -39,6 +40,7 @@ void registerValidate(CLI::App& app, CliState& state);
 void registerCheck(CLI::App& app, CliState& state);    // cmd_check.cpp
 void registerExplain(CLI::App& app, CliState& state);  // cmd_explain.cpp: explain + graph
 void registerRig(CLI::App& app, CliState& state);      // cmd_rig.cpp: rig import
+void registerBuild(CLI::App& app, CliState& state);    // cmd_build.cpp: variant manifests
 void registerBake(CLI::App& app, CliState& state);     // cmd_bake.cpp: bake occlusion
 
 }  // namespace sg
