@@ -620,7 +620,7 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
       hasOcclusion = true;
       rig.attributes.push_back(makeAttribute("occlusion", VertexFormat::Float32x1, {{"vertex.occlusion", ""}}, file));
       carried("_OCCLUSION", "occlusion", VertexFormat::Float32x1);
-      data.streams["vertex.occlusion"] = toStream(readAttr("_OCCLUSION"), 0, 1);
+      data.streams["vertex.occlusion"] = reader.stream(readAttr("_OCCLUSION"), 0, 1, where + " attribute _OCCLUSION");
     } else {
       skip("_OCCLUSION", "occlusion is a float SCALAR (as shadergen bake occlusion writes it)");
     }
@@ -802,7 +802,7 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
                                a.normalized ? "normalized " : "", componentTypeName(a.componentType), typeName(a.type)));
       if (a.count != data.vertexCount)
         fail(file, fmt::format("{} has {} elements but POSITION has {}", what, a.count, data.vertexCount));
-      data.streams[key] = toStream(reader.read(it->second, what), 0, 1);
+      data.streams[key] = reader.stream(reader.read(it->second, what), 0, 1, what);
     }
     rig.attributes.push_back(
         makeAttribute("occlusion_morph", VertexFormat::Float32x1, {{"morph.occlusion", ""}}, file, true));

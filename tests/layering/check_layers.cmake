@@ -14,6 +14,7 @@ set(layers
   variants   # manifests, the content cache, batch builds
   api        # the public shadergen::core facade
   validate   # lavapipe runs against the GLM reference
+  bake       # occlusion baking (reads glTF scenes through validate)
   cli)       # the command line
 set(external runtime)  # separate library (no generator dependency), usable from validate up
 if(NOT GENERATOR_DIR)
