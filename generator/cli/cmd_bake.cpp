@@ -58,7 +58,6 @@ struct BakeOcclusionCommand {
         std::cerr << fmt::format("\r\033[K[{}/{}] {}: {}%", pass, passes, what, total ? done * 100 / total : 100)
                   << std::flush;
       };
-    refuseClobbering({output}, {{model, "the glTF model"}});  // before the (long) bake
     auto start = std::chrono::steady_clock::now();
     bake::GltfBakeResult r = bake::bakeGltfOcclusion(model, o);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
