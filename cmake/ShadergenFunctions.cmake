@@ -143,4 +143,76 @@ function(shadergen_add_vertex_shader target)
   set(SHADERGEN_${_NAME}_REFLECTION "${_stem}.json" PARENT_SCOPE)
 endfunction()
 
+# shadergen_add_shader_variants(): every variant of a manifest (docs/variants.md) built at
+# build time by one `shadergen build` run, and attached to a target.
+#
+#   shadergen_add_shader_variants(<target>
+#     MANIFEST <file>            # the variant manifest (YAML)
+#     [OUTPUT_DIR <dir>]         # default: ${CMAKE_CURRENT_BINARY_DIR}/shadergen/<target>/<manifest name>
+#     [RULES <file>...]          # rules files read before the manifest's (e.g. ${SHADERGEN_RULES_DIR}/standard.yaml)
+#     [JOBS <n>]                 # worker threads (default: every hardware thread)
+#     [DEPENDS <file>...])       # extra dependencies
+#
+# The custom command's output is <dir>/index.json (every variant with its plan cost and
+# output files, relative to <dir>); its DEPFILE lists the manifest and every file any
+# variant read, so editing one of them reruns the build. The build's content cache
+# (<dir>/.shadergen-cache) then regenerates only the variants whose inputs changed, and
+# outputs whose bytes did not change are not rewritten. The target gets the compile
+# definition SHADERGEN_<NAME>_INDEX="<dir>/index.json" (NAME: the manifest's file name up
+# to the first '.', upper-cased, non-alphanumerics as '_'), also set in the caller's scope.
+function(shadergen_add_shader_variants target)
+  cmake_parse_arguments(PARSE_ARGV 1 SG "" "MANIFEST;OUTPUT_DIR;JOBS" "RULES;DEPENDS")
+  if(SG_UNPARSED_ARGUMENTS)
+    message(FATAL_ERROR "shadergen_add_shader_variants(${target}): unknown arguments: ${SG_UNPARSED_ARGUMENTS}")
+  endif()
+  if(NOT TARGET ${target})
+    message(FATAL_ERROR "shadergen_add_shader_variants: '${target}' is not a target")
+  endif()
+  if(NOT SG_MANIFEST)
+    message(FATAL_ERROR "shadergen_add_shader_variants(${target}): MANIFEST is required")
+  endif()
+  if(NOT TARGET shadergen::shadergen)
+    message(FATAL_ERROR "shadergen_add_shader_variants: no shadergen::shadergen target (use find_package(shadergen) or add_subdirectory(<shadergen source>))")
+  endif()
+  get_target_property(_sg_exe shadergen::shadergen ALIASED_TARGET)
+  if(NOT _sg_exe)
+    set(_sg_exe shadergen::shadergen)
+  endif()
+  get_filename_component(_manifest "${SG_MANIFEST}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+  get_filename_component(_name "${_manifest}" NAME)
+  string(REGEX REPLACE "\\..*$" "" _name "${_name}")
+  string(MAKE_C_IDENTIFIER "${_name}" _ident)
+  string(TOUPPER "${_ident}" _NAME)
+  set(_dir "${SG_OUTPUT_DIR}")
+  if(NOT _dir)
+    set(_dir "${CMAKE_CURRENT_BINARY_DIR}/shadergen/${target}/${_name}")
+  endif()
+  get_filename_component(_dir "${_dir}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_BINARY_DIR}")
+  set(_extra "")
+  foreach(d IN LISTS SG_DEPENDS)
+    get_filename_component(_d "${d}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+    list(APPEND _extra "${_d}")
+  endforeach()
+  set(_args build "${_manifest}" -o "${_dir}" -q)
+  foreach(r IN LISTS SG_RULES)
+    get_filename_component(_r "${r}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+    list(APPEND _args -r "${_r}")
+  endforeach()
+  if(SG_JOBS)
+    list(APPEND _args -j "${SG_JOBS}")
+  endif()
+  add_custom_command(
+    OUTPUT "${_dir}/index.json"
+    COMMAND ${_sg_exe} ${_args}
+    DEPENDS "${_manifest}" ${_extra} ${_sg_exe}
+    DEPFILE "${_dir}/index.json.d"
+    WORKING_DIRECTORY "${CMAKE_CURRENT_BINARY_DIR}"
+    COMMENT "shadergen: building the shader variants of ${_name} for ${target}"
+    VERBATIM)
+  target_sources(${target} PRIVATE "${_dir}/index.json")
+  set_source_files_properties("${_dir}/index.json" PROPERTIES GENERATED TRUE)
+  target_compile_definitions(${target} PRIVATE "SHADERGEN_${_NAME}_INDEX=\"${_dir}/index.json\"")
+  set(SHADERGEN_${_NAME}_INDEX "${_dir}/index.json" PARENT_SCOPE)
+endfunction()
+
 cmake_policy(POP)

@@ -14,6 +14,7 @@
 #include "common/yaml_util.h"
 #include "interface/fragment_interface.h"
 #include "rig/rig.h"
+#include "rules/instantiate.h"
 #include "rules/rules.h"
 #include "search/astar.h"
 #include "search/problem.h"
@@ -68,20 +69,6 @@ std::map<std::string, RuleKeys> locateRuleKeys(const RuleSet& rules) {
   return out;
 }
 
-size_t editDistance(const std::string& a, const std::string& b) {
-  std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) prev[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    cur[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j)
-      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
-    std::swap(prev, cur);
-  }
-  return prev[b.size()];
-}
-
-std::string splitBase(const std::string& fact) { return fact.substr(0, fact.find('[')); }
-
 class Checker {
  public:
   explicit Checker(const CheckOptions& opts) : opts_(opts) {}
@@ -124,18 +111,7 @@ class Checker {
     return it == keys_.end() ? none : it->second;
   }
 
-  std::string didYouMean(const std::string& name) const {
-    std::string best;
-    size_t bestD = std::max<size_t>(2, name.size() / 4) + 1;
-    for (const auto& d : rules_.semantics) {
-      size_t dist = editDistance(name, d.name);
-      if (dist < bestD) {
-        bestD = dist;
-        best = d.name;
-      }
-    }
-    return best.empty() ? "" : fmt::format(" (did you mean '{}'?)", best);
-  }
+  std::string didYouMean(const std::string& name) const { return didYouMeanSemantic(rules_, name); }
 
   // ---- names, references and shapes -------------------------------------------------
   void checkRuleNames(int r) {
@@ -144,28 +120,7 @@ class Checker {
       error(std::move(loc), std::move(msg));
       structural_[r] = true;
     };
-    const SemanticDecl* prod = rules_.findSemantic(rule.produces);
-    if (!prod)
-      bad(rule.producesLoc, fmt::format("rule '{}' produces unknown semantic '{}'{}", rule.name, rule.produces,
-                                        didYouMean(rule.produces)));
-    else if (!prod->count.empty())
-      bad(rule.producesLoc, fmt::format("rule '{}' produces '{}', which is an indexed family; rules produce single "
-                                        "semantics",
-                                        rule.name, rule.produces));
-    for (const auto& ref : rule.needs) {
-      const SemanticDecl* d = rules_.findSemantic(ref.name);
-      if (!d) {
-        bad(ref.loc, fmt::format("rule '{}' needs unknown semantic '{}'{}", rule.name, ref.name, didYouMean(ref.name)));
-        continue;
-      }
-      bool family = !d->count.empty();
-      if (family && ref.index.empty())
-        bad(ref.loc, fmt::format("'{}' is an indexed family: write '{}[*]' or '{}[i]'", ref.name, ref.name, ref.name));
-      else if (!family && !ref.index.empty())
-        bad(ref.loc, fmt::format("'{}' is not an indexed family (it has no 'count')", ref.name));
-      if (ref.name == rule.produces)
-        bad(ref.loc, fmt::format("rule '{}' needs its own product '{}': it can never fire", rule.name, rule.produces));
-    }
+    for (auto& d : ruleReferenceErrors(rules_, r)) bad(d.loc, d.message);  // the instantiation's own checks
     // has() of a semantic nobody declared is always false: almost certainly a typo.
     if (!rule.when.empty()) {
       static const std::regex hasRe(R"(has\s*\(\s*([A-Za-z_][A-Za-z0-9_.]*)\s*\))");
@@ -534,7 +489,7 @@ class Checker {
         for (const auto& m : missing) list += (list.empty() ? "'" : ", '") + m + "'";
         SourceLoc at = rule.loc;
         for (const auto& ref : rule.needs)
-          if (ref.name == splitBase(p.facts[f].name)) {
+          if (ref.name == splitIndexed(p.facts[f].name).first) {
             at = ref.loc;
             break;
           }

@@ -8,7 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/generate.h"
+#include "search/astar.h"
+#include "search/instance.h"
+#include "search/plan.h"
+#include "search/search.h"
 
 namespace sg {
 

@@ -4,7 +4,9 @@
 #pragma once
 #include <string>
 
-#include "pipeline/generate.h"
+#include "search/astar.h"
+#include "search/instance.h"
+#include "search/plan.h"
 
 namespace sg {
 

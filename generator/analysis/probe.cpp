@@ -7,11 +7,10 @@
 #include "common/input_file.h"
 #include "rig/rig.h"
 #include "rules/snippet.h"
+#include "search/problem.h"
 
 namespace sg {
 namespace {
-
-std::string indexed(const std::string& name, int64_t i) { return fmt::format("{}[{}]", name, i); }
 
 // GLSL identifier for a semantic instance: "morph.position[3]" -> "morph_position_3".
 std::string mangle(const std::string& fact) {
@@ -35,48 +34,19 @@ std::set<std::string> leafSemantics(const RuleSet& rules) {
   return leaves;
 }
 
-void evalShapes(ProbeRig& pr, const RuleSet& rules, bool strictArrays) {
-  ExprEnv env;
-  env.lookup = [&pr](const std::string& n, int64_t& v) {
-    auto it = pr.params.find(n);
-    if (it == pr.params.end()) return false;
-    v = it->second;
-    return true;
-  };
-  env.has = [](const std::string&) { return false; };  // as at instantiation: counts come first
-  for (const auto& d : rules.semantics) {
-    if (!d.count.empty()) {
-      int64_t n = d.count.eval(env);
-      if (n < 0 || n > 256) throw InputError(d.loc, fmt::format("semantic '{}' has count {} (allowed 0..256)", d.name, n));
-      pr.families[d.name] = n;
-    }
-    if (!d.arrayParam.empty()) {
-      auto it = pr.params.find(d.arrayParam);
-      if (it == pr.params.end()) {
-        if (strictArrays)
-          throw InputError(d.loc, fmt::format("semantic '{}' is sized by '{}', which rig '{}' does not define", d.name,
-                                              d.arrayParam, pr.name));
-        pr.arrays[d.name] = 4;
-      } else {
-        pr.arrays[d.name] = std::max<int64_t>(1, it->second);
-      }
-    }
-  }
-}
-
 ProbeRig makeDefault(const RuleSet& rules, const std::string& name, std::map<std::string, int64_t> params,
                      bool provideLeaves) {
   ProbeRig pr;
   pr.name = name;
   pr.params = std::move(params);
   pr.isDefault = true;
-  evalShapes(pr, rules, false);
+  evalFamilies(pr, rules, false);
   if (provideLeaves)
     for (const auto& s : leafSemantics(rules)) {
       auto f = pr.families.find(s);
       if (f == pr.families.end()) pr.provided.insert(s);
       else
-        for (int64_t i = 0; i < f->second; ++i) pr.provided.insert(indexed(s, i));
+        for (int64_t i = 0; i < f->second; ++i) pr.provided.insert(indexedName(s, i));
     }
   return pr;
 }
@@ -85,20 +55,16 @@ ProbeRig makeDefault(const RuleSet& rules, const std::string& name, std::map<std
 
 ProbeRig probeRigFromRig(const Rig& rig, const RuleSet& rules) {
   ProbeRig pr;
-  pr.name = rig.name;
-  pr.params = rig.params;
-  evalShapes(pr, rules, true);
+  static_cast<RigShape&>(pr) = shapeOfRig(rig, rules);
   for (const auto& a : rig.attributes) {
     int targets = a.perMorphTarget ? rig.morphTargets() : 1;
     for (int t = 0; t < targets; ++t)
       for (const auto& part : a.provides) {
-        std::string fact = a.perMorphTarget ? indexed(part.semantic, t) : part.semantic;
-        pr.provided.insert(fact);
+        std::string fact = a.perMorphTarget ? indexedName(part.semantic, t) : part.semantic;
         std::string input = a.perMorphTarget ? fmt::format("a_{}{}", a.name, t) : "a_" + a.name;
         pr.streams[fact] = ProbeRig::Stream{input, a.shaderType, part.swizzle};
       }
   }
-  for (const auto& u : rig.uniforms) pr.provided.insert(u.semantic);
   return pr;
 }
 
@@ -115,85 +81,19 @@ std::vector<ProbeRig> defaultProbeRigs(const RuleSet& rules) {
   return out;
 }
 
-ExprEnv probeEnv(const ProbeRig& rig) {
-  ExprEnv env;
-  const ProbeRig* pr = &rig;
-  env.lookup = [pr](const std::string& n, int64_t& v) {
-    auto it = pr->params.find(n);
-    if (it == pr->params.end()) return false;
-    v = it->second;
-    return true;
-  };
-  env.has = [pr](const std::string& s) { return pr->provided.count(s) || pr->provided.count(indexed(s, 0)); };
-  return env;
-}
+ExprEnv probeEnv(const ProbeRig& rig) { return shapeEnv(rig); }
 
 SnippetProbe buildSnippetProbe(const RuleSet& rules, int r, const ProbeRig& rig) {
   const Rule& rule = rules.rules[static_cast<size_t>(r)];
-  const SemanticDecl* product = rules.findSemantic(rule.produces);
-  if (!product)
-    throw InputError(rule.producesLoc, fmt::format("rule '{}' produces unknown semantic '{}'", rule.name, rule.produces));
-  if (!product->count.empty())
-    throw InputError(rule.producesLoc, fmt::format("rule '{}' produces '{}', which is an indexed family; rules "
-                                                   "produce single semantics",
-                                                   rule.name, rule.produces));
-  ExprEnv env = probeEnv(rig);
-
-  // The needed semantic instances, in a stable order.
-  std::map<std::string, const SemanticDecl*> needs;
-  for (const auto& ref : rule.needs) {
-    const SemanticDecl* d = rules.findSemantic(ref.name);
-    if (!d) throw InputError(ref.loc, fmt::format("needs unknown semantic '{}' (not declared in the rules)", ref.name));
-    bool family = !d->count.empty();
-    int64_t n = family ? rig.families.at(d->name) : 0;
-    if (ref.index.empty()) {
-      if (family)
-        throw InputError(ref.loc, fmt::format("'{}' is an indexed family: write '{}[*]' or '{}[i]'", ref.name,
-                                              ref.name, ref.name));
-      needs[ref.name] = d;
-    } else if (!family) {
-      throw InputError(ref.loc, fmt::format("'{}' is not an indexed family", ref.name));
-    } else if (ref.index == "*") {
-      for (int64_t i = 0; i < n; ++i) needs[indexed(ref.name, i)] = d;
-    } else {
-      SourceLoc at = ref.loc;
-      if (at.col > 0) at.col += static_cast<int>(ref.name.size()) + 1;
-      int64_t i = Expr::parse(ref.index, at).eval(env);
-      if (i < 0 || i >= n)
-        throw InputError(ref.loc, fmt::format("needs '{}[{}]': index {} is out of range ({} has {} instances for {})",
-                                              ref.name, i, i, ref.name, n, rig.name));
-      needs[indexed(ref.name, i)] = d;
-    }
-  }
-  if (needs.count(rule.produces))
-    throw InputError(rule.producesLoc, fmt::format("rule '{}' needs its own product '{}'", rule.name, rule.produces));
-
   const std::string outName = "t_" + mangle(rule.produces);
-  SnippetContext ctx;
-  ctx.rigEnv = env;
-  ctx.outText = outName;
-  ctx.semantic = [&](const std::string& name, int64_t idx, const SourceLoc& at, std::string& text) {
-    const SemanticDecl* d = rules.findSemantic(name);
-    if (!d) {
-      if (idx >= 0) return false;
-      throw InputError(at, fmt::format("rule '{}' uses unknown semantic '{}'", rule.name, name));
-    }
-    bool family = !d->count.empty();
-    if (family && idx < 0) throw InputError(at, fmt::format("'{}' is an indexed family: write ${{{}[i]}}", name, name));
-    std::string full = family ? indexed(name, idx) : name;
-    if (full == rule.produces) {
-      text = outName;
-      return true;
-    }
-    if (!needs.count(full))
-      throw InputError(at, fmt::format("rule '{}' uses '{}' but does not list it in 'needs'", rule.name, full));
+  // Streams read the attribute (and swizzle) as the emitted shader does; the rest are uniforms.
+  RuleInstance inst = instantiateRule(rules, r, rig, outName, [&](const std::string& full) {
     if (auto st = rig.streams.find(full); st != rig.streams.end())
-      text = st->second.swizzle.empty() ? st->second.input : st->second.input + "." + st->second.swizzle;
-    else
-      text = "p_" + mangle(full);
-    return true;
-  };
-  std::vector<ExpandedLine> lines = expandSnippet(rule.glsl, ctx);
+      return st->second.swizzle.empty() ? st->second.input : st->second.input + "." + st->second.swizzle;
+    return "p_" + mangle(full);
+  });
+  const SemanticDecl* product = rules.findSemantic(rule.produces);
+  std::vector<ExpandedLine>& lines = inst.code;
 
   SnippetProbe probe;
   probe.productType = std::string(glslName(product->type));
@@ -206,7 +106,8 @@ SnippetProbe buildSnippetProbe(const RuleSet& rules, int r, const ProbeRig& rig)
   s += fmt::format("// Probe of rule '{}' instantiated for {}.\n", rule.name, rig.name);
   std::map<std::string, Type> inputs;  // vertex inputs read (attribute streams)
   std::string members;                  // uniform block members
-  for (const auto& [fact, d] : needs) {
+  for (const auto& fact : inst.needs) {
+    const SemanticDecl* d = rules.findSemantic(splitIndexed(fact).first);
     if (auto st = rig.streams.find(fact); st != rig.streams.end()) {
       inputs.emplace(st->second.input, st->second.type);
       continue;

@@ -11,20 +11,16 @@
 
 #include "common/diagnostics.h"
 #include "common/glsl_compile.h"
+#include "rules/instantiate.h"
 #include "rules/rules.h"
 
 namespace sg {
 
 struct Rig;
 
-// What a snippet is instantiated against: rig parameters, which semantic instances
-// the rig provides (for has()), and the instance count of each indexed family.
-struct ProbeRig {
-  std::string name;  // "dawn-face", or a description of a default rig
-  std::map<std::string, int64_t> params;
-  std::set<std::string> provided;           // "vertex.position", "morph.position[3]", ...
-  std::map<std::string, int64_t> families;  // "morph.position" -> 5
-  std::map<std::string, int64_t> arrays;    // uniform arrays: "skin.bones" -> 98
+// What a snippet is instantiated against: the rig's shape (rules/instantiate.h), and
+// how its attributes are read.
+struct ProbeRig : RigShape {
   // Semantics a real rig stores in (part of) a vertex attribute: the probe declares the
   // attribute as a vertex input and reads the swizzle, as the emitted shader does (so
   // vec4(normal, occlusion) from one float4 attribute costs nothing). Others are uniforms.

@@ -58,6 +58,7 @@ struct BakeOcclusionCommand {
         std::cerr << fmt::format("\r\033[K[{}/{}] {}: {}%", pass, passes, what, total ? done * 100 / total : 100)
                   << std::flush;
       };
+    refuseClobbering({output}, {{model, "the glTF model"}});  // before the (long) bake
     auto start = std::chrono::steady_clock::now();
     bake::GltfBakeResult r = bake::bakeGltfOcclusion(model, o);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -102,13 +103,14 @@ void registerBake(CLI::App& app, CliState& state) {
                   "cosine: blocked fraction of cosine-weighted sky light (ambient occlusion)")
       ->check(CLI::IsMember({"uniform", "cosine"}));
   occ->add_option("--max-distance", cmd->maxDistance, "Hits farther than this do not block (default: unlimited)")
-      ->check(CLI::PositiveNumber);
+      ->check(finiteNumber(true));
   occ->add_option("--offset", cmd->offset,
                   "Ray origins move this far along the normal (default: 1e-5 of the scene's diagonal)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finiteNumber(false));
   occ->add_option("--seed", cmd->seed, "Random seed (default 1); the result does not depend on --threads");
   occ->add_option("--threads", cmd->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
-  occ->add_option("--time", cmd->time, "Pose at this animation time in seconds (default: bind pose)");
+  occ->add_option("--time", cmd->time, "Pose at this animation time in seconds (default: bind pose)")
+      ->check(finiteNumber(false));
   occ->add_option("--animation", cmd->animation, "With --time: animation name or index (default: the first)");
   occ->add_flag("-q,--quiet", cmd->quiet, "No progress, summary or warnings");
   occ->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });

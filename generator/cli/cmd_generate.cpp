@@ -18,7 +18,7 @@ void GenerateArgs::add(CLI::App& cmd) {
   cmd.add_option("--fragment,-f", opts.fragmentPath, "Fragment shader whose inputs must be fed (GLSL 450)")->required();
   cmd.add_option("--rules,-r", opts.rulesPaths, "Rules file(s) (YAML)")->required();
   cmd.add_option("--map", maps, "Map a fragment input to semantics: Name=sem or Name=s1,s2,... (packs)");
-  cmd.add_option("--heuristic", opts.heuristic, "A* heuristic: lmcut (default), hmax, blind")
+  cmd.add_option("--heuristic", opts.heuristic, "A* heuristic (either engine): lmcut (default), hmax, blind")
       ->check(CLI::IsMember({"lmcut", "hmax", "blind"}));
   cmd.add_option("--search", opts.searchEngine,
                  "Search engine: auto (default: regression A* on acyclic rule graphs, else forward A*), "
@@ -26,7 +26,7 @@ void GenerateArgs::add(CLI::App& cmd) {
       ->check(CLI::IsMember({"auto", "regression", "forward", "ip"}));
   cmd.add_option("--search-time-limit", opts.searchLimits.maxSeconds,
                  "Give up (error) when one search runs longer than this many seconds (0 = no limit)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finiteNumber(false));
   cmd.add_option("--max-expansions", opts.searchLimits.maxExpansions,
                  "Give up (error) after this many A* expansions")
       ->check(CLI::PositiveNumber);
@@ -34,6 +34,7 @@ void GenerateArgs::add(CLI::App& cmd) {
       ->check(CLI::IsMember({"vulkan", "vulkan1.0", "vulkan1.1", "vulkan1.2", "vulkan1.3"}));
   cmd.add_option("--templates", opts.templateDir, "Directory with vertex.glsl templates");
   cmd.add_option("--ban", opts.bannedRules, "Exclude a rule from the search (force an alternative)");
+  cmd.add_option("--set", sets, "Set a rig deformer parameter: NAME=VALUE (level-of-detail rigs: morph_targets=2)");
 }
 
 GenerateOptions GenerateArgs::resolve() const {
@@ -53,6 +54,19 @@ GenerateOptions GenerateArgs::resolve() const {
       start = c + 1;
     }
     o.overrides.push_back(ov);
+  }
+  for (const auto& kv : sets) {
+    auto eq = kv.find('=');
+    size_t used = 0;
+    long long value = -1;
+    try {
+      if (eq != std::string::npos) value = std::stoll(kv.substr(eq + 1), &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (eq == std::string::npos || eq == 0 || used == 0 || eq + 1 + used != kv.size() || value < 0)
+      throw CLI::ValidationError("--set", "expected NAME=VALUE with a non-negative integer VALUE, got '" + kv + "'");
+    o.rigParams[kv.substr(0, eq)] = value;
   }
   return o;
 }

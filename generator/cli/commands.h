@@ -21,6 +21,7 @@ const char* shadergenVersionString();
 struct GenerateArgs {
   GenerateOptions opts;
   std::vector<std::string> maps;  // "Name=sem[,sem...]"
+  std::vector<std::string> sets;  // "param=value" (rig deformer parameters)
   std::string targetEnv = "vulkan1.0";
   void add(CLI::App& cmd);
   GenerateOptions resolve() const;  // parses --map and --target-env (throws CLI::ValidationError)
@@ -29,12 +30,17 @@ struct GenerateArgs {
 // Every file `in` was loaded from (plus `extra`), named for refuseClobbering (output_files.h).
 std::vector<InputFile> inputFiles(const LoadedInputs& in, const std::vector<std::string>& extra = {});
 
+// CLI11's NonNegativeNumber/PositiveNumber let "nan" and "inf" through (every comparison
+// with NaN is false); this refuses them: "must be a finite number >= 0, got 'nan'".
+CLI::Validator finiteNumber(bool positive);
+
 void registerCommands(CLI::App& app, CliState& state);
 void registerGenerate(CLI::App& app, CliState& state);
 void registerValidate(CLI::App& app, CliState& state);
 void registerCheck(CLI::App& app, CliState& state);    // cmd_check.cpp
 void registerExplain(CLI::App& app, CliState& state);  // cmd_explain.cpp: explain + graph
 void registerRig(CLI::App& app, CliState& state);      // cmd_rig.cpp: rig import
+void registerBuild(CLI::App& app, CliState& state);    // cmd_build.cpp: variant manifests
 void registerBake(CLI::App& app, CliState& state);     // cmd_bake.cpp: bake occlusion
 
 }  // namespace sg

@@ -1,12 +1,19 @@
 #include "common/glsl_compile.h"
 
+#include <fmt/format.h>
+#include <glslang/Include/PoolAlloc.h>
+#include <glslang/Include/Types.h>
 #include <glslang/Public/ResourceLimits.h>
 #include <glslang/Public/ShaderLang.h>
 #include <glslang/SPIRV/GlslangToSpv.h>
+#include <spirv-tools/libspirv.hpp>
+#include <spirv-tools/optimizer.hpp>
 
-#include <mutex>
 #include <algorithm>
+#include <map>
+#include <mutex>
 #include <sstream>
+#include <stdexcept>
 
 namespace sg {
 
@@ -29,9 +36,218 @@ const char* targetEnvName(TargetEnv e) {
   return "vulkan1.0";
 }
 
+namespace {
+
+// Process-wide glslang initialisation (thread-safe; glslang parses concurrently once done).
 void ensureGlslangInitialized() {
   static std::once_flag once;
   std::call_once(once, [] { glslang::InitializeProcess(); });
+}
+
+constexpr auto kMessages = static_cast<EShMessages>(EShMsgSpvRules | EShMsgVulkanRules);
+
+// Each Vulkan version with the SPIR-V version it guarantees (as glslc does).
+struct EnvVersions {
+  glslang::EShTargetClientVersion client;
+  glslang::EShTargetLanguageVersion spirv;
+  spv_target_env tools;
+};
+
+EnvVersions versionsOf(TargetEnv e) {
+  switch (e) {
+    case TargetEnv::Vulkan1_0: break;
+    case TargetEnv::Vulkan1_1: return {glslang::EShTargetVulkan_1_1, glslang::EShTargetSpv_1_3, SPV_ENV_VULKAN_1_1};
+    case TargetEnv::Vulkan1_2: return {glslang::EShTargetVulkan_1_2, glslang::EShTargetSpv_1_5, SPV_ENV_VULKAN_1_2};
+    case TargetEnv::Vulkan1_3: return {glslang::EShTargetVulkan_1_3, glslang::EShTargetSpv_1_6, SPV_ENV_VULKAN_1_3};
+  }
+  return {glslang::EShTargetVulkan_1_0, glslang::EShTargetSpv_1_0, SPV_ENV_VULKAN_1_0};
+}
+
+// glslang allocates from a per-thread pool that TShader::parse and TProgram::link replace
+// with the object's own and never restore: once that object is destroyed, the thread's
+// pool dangles and the next type-to-string or reflection call crashes. Every call into
+// glslang here runs inside a PoolScope with a pool the wrapper owns.
+class PoolScope {
+ public:
+  explicit PoolScope(glslang::TPoolAllocator& pool) : previous_(&glslang::GetThreadPoolAllocator()) {
+    glslang::SetThreadPoolAllocator(&pool);
+  }
+  ~PoolScope() { glslang::SetThreadPoolAllocator(previous_); }
+  PoolScope(const PoolScope&) = delete;
+  PoolScope& operator=(const PoolScope&) = delete;
+
+ private:
+  glslang::TPoolAllocator* previous_;
+};
+
+EShLanguage languageOf(Stage s) { return s == Stage::Vertex ? EShLangVertex : EShLangFragment; }
+
+std::optional<Type> typeOf(const glslang::TType& t) {
+  if (t.isArray() || t.isStruct()) return std::nullopt;
+  if (t.isMatrix()) {
+    if (t.getBasicType() != glslang::EbtFloat || t.getMatrixCols() != t.getMatrixRows()) return std::nullopt;
+    if (t.getMatrixCols() == 3) return Type::Mat3;
+    if (t.getMatrixCols() == 4) return Type::Mat4;
+    return std::nullopt;
+  }
+  int n = t.getVectorSize();
+  switch (t.getBasicType()) {
+    case glslang::EbtFloat: return vectorType(ScalarKind::Float, n);
+    case glslang::EbtInt: return vectorType(ScalarKind::Int, n);
+    case glslang::EbtUint: return vectorType(ScalarKind::UInt, n);
+    default: return std::nullopt;
+  }
+}
+
+}  // namespace
+
+struct GlslShader::Impl {
+  glslang::TPoolAllocator scratch;  // declared first: outlives the glslang objects below
+  GlslUnit unit;
+  TargetEnv env = TargetEnv::Vulkan1_0;
+  EShLanguage lang = EShLangVertex;
+  std::unique_ptr<glslang::TShader> shader;
+  std::unique_ptr<glslang::TProgram> program;  // this stage linked alone
+  std::vector<Diagnostic> diagnostics;
+  bool ok = false;
+  bool reflected = false;
+
+  // glslang builds a program's reflection once: ask for everything any caller reads.
+  glslang::TProgram& reflection() {
+    if (!reflected)
+      program->buildReflection(EShReflectionAllIOVariables | EShReflectionIntermediateIO |
+                               EShReflectionAllBlockVariables);
+    reflected = true;
+    return *program;
+  }
+};
+
+GlslShader::GlslShader(const GlslUnit& unit, TargetEnv env) : impl_(std::make_unique<Impl>()) {
+  ensureGlslangInitialized();
+  Impl& m = *impl_;
+  PoolScope scope(m.scratch);
+  m.unit = unit;
+  m.env = env;
+  m.lang = languageOf(unit.stage);
+  m.shader = std::make_unique<glslang::TShader>(m.lang);
+  // Unnamed: glslang then reports string numbers, which `#line L S` directives set and
+  // parseGlslangLog maps to files (a name would stick across #line).
+  const char* src = m.unit.text.c_str();
+  m.shader->setStrings(&src, 1);
+  EnvVersions v = versionsOf(env);
+  m.shader->setEnvInput(glslang::EShSourceGlsl, m.lang, glslang::EShClientVulkan, 100);
+  m.shader->setEnvClient(glslang::EShClientVulkan, v.client);
+  m.shader->setEnvTarget(glslang::EShTargetSpv, v.spirv);
+  bool parsed = m.shader->parse(GetDefaultResources(), 450, ECoreProfile, false, false, kMessages);
+  m.diagnostics = parseGlslangLog(m.shader->getInfoLog(), m.unit);
+  if (!parsed) return;
+  m.program = std::make_unique<glslang::TProgram>();
+  m.program->addShader(m.shader.get());
+  if (!m.program->link(kMessages)) {
+    auto more = parseGlslangLog(m.program->getInfoLog(), m.unit);
+    m.diagnostics.insert(m.diagnostics.end(), more.begin(), more.end());
+    return;
+  }
+  m.ok = true;
+}
+
+GlslShader::~GlslShader() = default;
+GlslShader::GlslShader(GlslShader&&) noexcept = default;
+GlslShader& GlslShader::operator=(GlslShader&&) noexcept = default;
+
+bool GlslShader::ok() const { return impl_->ok; }
+const std::vector<Diagnostic>& GlslShader::diagnostics() const { return impl_->diagnostics; }
+const GlslUnit& GlslShader::unit() const { return impl_->unit; }
+TargetEnv GlslShader::env() const { return impl_->env; }
+
+std::vector<uint32_t> GlslShader::spirv() const {
+  if (!impl_->ok) throw std::logic_error("GlslShader::spirv() of a shader that did not compile");
+  PoolScope scope(impl_->scratch);
+  std::vector<uint32_t> words;
+  glslang::SpvOptions opts;
+  opts.disableOptimizer = true;
+  opts.validate = false;
+  glslang::GlslangToSpv(*impl_->program->getIntermediate(impl_->lang), words, &opts);
+  return words;
+}
+
+namespace {
+
+std::vector<StageVariable> stageVariables(glslang::TProgram& prog, bool outputs) {
+  std::vector<StageVariable> out;
+  int n = outputs ? prog.getNumPipeOutputs() : prog.getNumPipeInputs();
+  for (int i = 0; i < n; ++i) {
+    const glslang::TObjectReflection& r = outputs ? prog.getPipeOutput(i) : prog.getPipeInput(i);
+    StageVariable v;
+    v.name = r.name;
+    const glslang::TType* t = r.getType();
+    if (t) {
+      v.type = typeOf(*t);
+      v.typeText = t->getCompleteString();
+      const auto& q = t->getQualifier();
+      if (q.hasLocation()) v.location = static_cast<int>(q.layoutLocation);
+      v.flat = q.flat;
+      v.block = t->getBasicType() == glslang::EbtBlock;
+    }
+    v.block = v.block || r.name.find('.') != std::string::npos;
+    out.push_back(std::move(v));
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<StageVariable> GlslShader::inputs() const {
+  if (!impl_->ok) return {};
+  PoolScope scope(impl_->scratch);
+  return stageVariables(impl_->reflection(), false);
+}
+
+std::vector<StageVariable> GlslShader::outputs() const {
+  if (!impl_->ok) return {};
+  PoolScope scope(impl_->scratch);
+  return stageVariables(impl_->reflection(), true);
+}
+
+std::vector<UniformBlock> GlslShader::uniformBlocks() const {
+  std::vector<UniformBlock> out;
+  if (!impl_->ok) return out;
+  PoolScope scope(impl_->scratch);
+  glslang::TProgram& p = impl_->reflection();
+  for (int i = 0; i < p.getNumUniformBlocks(); ++i)
+    out.push_back(UniformBlock{p.getUniformBlock(i).name, static_cast<uint32_t>(p.getUniformBlock(i).size)});
+  return out;
+}
+
+std::vector<UniformMember> GlslShader::uniformMembers() const {
+  std::vector<UniformMember> out;
+  if (!impl_->ok) return out;
+  PoolScope scope(impl_->scratch);
+  glslang::TProgram& p = impl_->reflection();
+  for (int i = 0; i < p.getNumUniformVariables(); ++i) {
+    const glslang::TObjectReflection& u = p.getUniform(i);
+    UniformMember l;
+    l.name = u.name.substr(0, u.name.find('['));
+    l.offset = static_cast<uint32_t>(u.offset);
+    l.arrayStride = static_cast<uint32_t>(std::max(0, u.arrayStride));
+    const glslang::TType* t = u.getType();
+    l.matrixStride = t && t->isMatrix() ? 16u : 0u;
+    l.size = t && t->isMatrix() ? 16u * static_cast<uint32_t>(t->getMatrixCols())
+                                : 4u * static_cast<uint32_t>(t ? std::max(1, t->getVectorSize()) : 1);
+    out.push_back(l);
+  }
+  return out;
+}
+
+std::string GlslShader::linkWith(const GlslShader& next) const {
+  if (!impl_->ok || !next.impl_->ok) return "a stage failed to compile";
+  PoolScope scope(impl_->scratch);
+  glslang::TProgram program;
+  program.addShader(impl_->shader.get());
+  program.addShader(next.impl_->shader.get());
+  if (program.link(kMessages)) return "";
+  std::string log = program.getInfoLog();
+  return log.empty() ? "link failed" : log;
 }
 
 namespace {
@@ -91,41 +307,55 @@ std::vector<Diagnostic> parseGlslangLog(const std::string& log, const GlslUnit& 
 }
 
 CompileResult compileGlsl(const GlslUnit& unit, TargetEnv env) {
-  ensureGlslangInitialized();
+  GlslShader s(unit, env);
   CompileResult res;
-  EShLanguage lang = unit.stage == Stage::Vertex ? EShLangVertex : EShLangFragment;
-  glslang::TShader shader(lang);
-  const char* src = unit.text.c_str();
-  const char* names = unit.fileName.c_str();
-  shader.setStringsWithLengthsAndNames(&src, nullptr, &names, 1);
-  glslang::EShTargetClientVersion client = glslang::EShTargetVulkan_1_0;
-  glslang::EShTargetLanguageVersion spv = glslang::EShTargetSpv_1_0;
-  switch (env) {
-    case TargetEnv::Vulkan1_0: break;
-    case TargetEnv::Vulkan1_1: client = glslang::EShTargetVulkan_1_1; spv = glslang::EShTargetSpv_1_3; break;
-    case TargetEnv::Vulkan1_2: client = glslang::EShTargetVulkan_1_2; spv = glslang::EShTargetSpv_1_5; break;
-    case TargetEnv::Vulkan1_3: client = glslang::EShTargetVulkan_1_3; spv = glslang::EShTargetSpv_1_6; break;
-  }
-  shader.setEnvInput(glslang::EShSourceGlsl, lang, glslang::EShClientVulkan, 100);
-  shader.setEnvClient(glslang::EShClientVulkan, client);
-  shader.setEnvTarget(glslang::EShTargetSpv, spv);
-  auto messages = static_cast<EShMessages>(EShMsgSpvRules | EShMsgVulkanRules);
-  bool ok = shader.parse(GetDefaultResources(), 450, ECoreProfile, false, false, messages);
-  res.diagnostics = parseGlslangLog(shader.getInfoLog(), unit);
-  if (!ok) return res;
-  glslang::TProgram program;
-  program.addShader(&shader);
-  if (!program.link(messages)) {
-    auto more = parseGlslangLog(program.getInfoLog(), unit);
-    res.diagnostics.insert(res.diagnostics.end(), more.begin(), more.end());
-    return res;
-  }
-  glslang::SpvOptions opts;
-  opts.disableOptimizer = true;
-  opts.validate = false;
-  glslang::GlslangToSpv(*program.getIntermediate(lang), res.spirv, &opts);
+  res.diagnostics = s.diagnostics();
+  if (!s.ok()) return res;
+  res.spirv = s.spirv();
   res.ok = true;
   return res;
+}
+
+void throwDiagnostics(std::vector<Diagnostic> diags, const std::string& fallbackFile, const char* what) {
+  if (diags.empty()) throw InputError(SourceLoc{fallbackFile, 0, 0}, what);
+  // Errors first.
+  std::stable_partition(diags.begin(), diags.end(), [](const Diagnostic& d) { return d.severity == Severity::Error; });
+  InputError e(diags.front());
+  e.related.assign(diags.begin() + 1, diags.end());
+  throw e;
+}
+
+std::string validateSpirv(const std::vector<uint32_t>& words, TargetEnv env) {
+  spvtools::SpirvTools tools(versionsOf(env).tools);
+  std::string messages;
+  tools.SetMessageConsumer([&](spv_message_level_t, const char*, const spv_position_t& pos, const char* msg) {
+    messages += fmt::format("spirv-val: instruction {}: {}\n", pos.index, msg);
+  });
+  if (tools.Validate(words)) return "";
+  return messages.empty() ? "spirv-val: invalid module" : messages;
+}
+
+std::vector<uint32_t> optimizeSpirv(const std::vector<uint32_t>& words, TargetEnv env) {
+  spvtools::Optimizer opt(versionsOf(env).tools);
+  std::string messages;
+  opt.SetMessageConsumer([&](spv_message_level_t level, const char*, const spv_position_t&, const char* msg) {
+    if (level <= SPV_MSG_ERROR) messages += std::string(msg) + "\n";
+  });
+  opt.RegisterPerformancePasses();
+  std::vector<uint32_t> out;
+  if (!opt.Run(words.data(), words.size(), &out)) throw std::runtime_error("spirv-opt failed: " + messages);
+  return out;
+}
+
+size_t countInstructions(const std::vector<uint32_t>& words) {
+  size_t n = 0;
+  for (size_t i = 5; i < words.size();) {
+    uint32_t len = words[i] >> 16;
+    if (len == 0) break;
+    i += len;
+    ++n;
+  }
+  return n;
 }
 
 }  // namespace sg

@@ -1,12 +1,20 @@
-// In-process glslang: GLSL 450 (Vulkan) → SPIR-V, with compiler messages turned
-// into located diagnostics. `#line L S` directives in the source map message
+// The one glslang / SPIRV-Tools wrapper. Every stage that compiles, reflects, links,
+// validates or optimises shader code goes through here; nothing else sets up glslang or
+// SPIRV-Tools (analysis/cost.cpp only reads opcode numbers from the SPIR-V headers).
+// A shader is parsed once (GlslShader); that parse serves code generation, reflection
+// and cross-stage linking. The target environment sets both
+// the Vulkan client version and the SPIR-V version (vulkan1.1 → SPIR-V 1.3, ...).
+// Messages become located diagnostics: `#line L S` directives in the source map
 // locations back to sourceFiles[S - 1] (S = 0 is the GLSL file itself).
 #pragma once
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/diagnostics.h"
+#include "common/types.h"
 
 namespace sg {
 
@@ -23,19 +31,82 @@ struct GlslUnit {
   std::vector<std::string> sourceFiles;  // reported for source string S >= 1
 };
 
+// A user input or output of one stage, as reflected from the parse.
+struct StageVariable {
+  std::string name;
+  std::optional<Type> type;  // none for arrays, structs and other unsupported types
+  std::string typeText;      // glslang's spelling of the type (for messages)
+  int location = -1;         // -1: no layout(location)
+  bool flat = false;
+  bool block = false;        // member of an interface block
+};
+
+// A member of a uniform block, laid out as the compiler laid it out (std140).
+struct UniformMember {
+  std::string name;          // without array brackets
+  uint32_t offset = 0;
+  uint32_t arrayStride = 0;  // 0 if not an array
+  uint32_t matrixStride = 0; // 16 for std140 matrices, 0 otherwise
+  uint32_t size = 0;         // bytes of one element
+};
+
+struct UniformBlock {
+  std::string name;
+  uint32_t size = 0;
+};
+
+// One stage parsed (and linked alone) once. Movable, not copyable; not shared
+// between threads (each thread parses its own).
+class GlslShader {
+ public:
+  GlslShader(const GlslUnit& unit, TargetEnv env);
+  ~GlslShader();
+  GlslShader(GlslShader&&) noexcept;
+  GlslShader& operator=(GlslShader&&) noexcept;
+
+  bool ok() const;  // parsed and linked without errors
+  const std::vector<Diagnostic>& diagnostics() const;  // errors and warnings, located
+  const GlslUnit& unit() const;
+  TargetEnv env() const;
+
+  std::vector<uint32_t> spirv() const;  // unoptimised SPIR-V (requires ok())
+  std::vector<StageVariable> inputs() const;
+  std::vector<StageVariable> outputs() const;
+  std::vector<UniformBlock> uniformBlocks() const;
+  std::vector<UniformMember> uniformMembers() const;
+
+  // glslang's cross-stage link of this stage with `next` (both ok()). Returns "" when
+  // they link, else glslang's log.
+  std::string linkWith(const GlslShader& next) const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
 struct CompileResult {
   bool ok = false;
   std::vector<uint32_t> spirv;
   std::vector<Diagnostic> diagnostics;  // errors and warnings, located
 };
 
-// Compiles one stage to SPIR-V (no optimisation).
+// Compiles one stage to SPIR-V (no optimisation): GlslShader, then spirv().
 CompileResult compileGlsl(const GlslUnit& unit, TargetEnv env);
 
 // Parses glslang's info log ("ERROR: S:L: msg") into diagnostics.
 std::vector<Diagnostic> parseGlslangLog(const std::string& log, const GlslUnit& unit);
 
-// Process-wide glslang initialisation (idempotent, thread-safe).
-void ensureGlslangInitialized();
+// Throws the first error of `diags` (others attached as related); `what` if none.
+[[noreturn]] void throwDiagnostics(std::vector<Diagnostic> diags, const std::string& fallbackFile, const char* what);
+
+// SPIRV-Tools validator; returns "" when valid, else the validator's message.
+std::string validateSpirv(const std::vector<uint32_t>& words, TargetEnv env);
+
+// spirv-opt -O (performance passes). Throws std::runtime_error on optimiser failure.
+std::vector<uint32_t> optimizeSpirv(const std::vector<uint32_t>& words, TargetEnv env);
+
+// Number of instructions in a module (header excluded).
+size_t countInstructions(const std::vector<uint32_t>& words);
 
 }  // namespace sg

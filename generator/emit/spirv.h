@@ -1,5 +1,5 @@
-// SPIR-V stage: compile emitted GLSL with glslang, validate with SPIRV-Tools,
-// optionally optimise, and check the vertex/fragment interface links.
+// SPIR-V stage: compile emitted GLSL (parsed once, through common/glsl_compile.h), read
+// the uniform layout from that parse, and check the vertex/fragment interface links.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -24,22 +24,23 @@ struct SpirvModule {
   std::vector<UniformLayout> uniforms;  // glslang's reflection of the compiled shader
 };
 
+// The vertex shader as parsed once: its SPIR-V and layout, and the parse itself (for the
+// link check).
+struct CompiledVertexShader {
+  SpirvModule module;
+  GlslShader parsed;
+};
+
 // Compiles `glsl`; errors become InputErrors located through its #line map.
+CompiledVertexShader compileVertex(const EmittedGlsl& glsl, const std::string& glslFileName, TargetEnv env);
 SpirvModule compileVertexShader(const EmittedGlsl& glsl, const std::string& glslFileName, TargetEnv env);
-
-// SPIRV-Tools validator; returns "" when valid, else the validator's message.
-std::string validateSpirv(const std::vector<uint32_t>& words, TargetEnv env);
-
-// spirv-opt -O (performance passes). Throws std::runtime_error on optimiser failure.
-std::vector<uint32_t> optimizeSpirv(const std::vector<uint32_t>& words, TargetEnv env);
 
 // Links the vertex shader with the fragment shader in glslang (cross-stage checks) and
 // checks every fragment input has a vertex output of the same location and type.
-// Throws InputError naming the mismatch.
+// Throws InputError (at the fragment file) naming the mismatch.
+void checkLink(const GlslShader& vertex, const GlslShader& fragment);
+// Same, parsing both from text.
 void checkLink(const EmittedGlsl& vertex, const std::string& fragmentSource, const std::string& fragmentFile,
                TargetEnv env);
-
-// Number of instructions in a module (header excluded).
-size_t countInstructions(const std::vector<uint32_t>& words);
 
 }  // namespace sg

@@ -1,9 +1,6 @@
 #include "interface/fragment_interface.h"
 
 #include <fmt/format.h>
-#include <glslang/Include/Types.h>
-#include <glslang/Public/ResourceLimits.h>
-#include <glslang/Public/ShaderLang.h>
 
 #include <algorithm>
 #include <string_view>
@@ -14,17 +11,6 @@
 
 namespace sg {
 namespace {
-
-std::optional<Type> typeOf(const glslang::TType& t) {
-  if (t.isArray() || t.isStruct() || t.isMatrix()) return std::nullopt;
-  int n = t.getVectorSize();
-  switch (t.getBasicType()) {
-    case glslang::EbtFloat: return vectorType(ScalarKind::Float, n);
-    case glslang::EbtInt: return vectorType(ScalarKind::Int, n);
-    case glslang::EbtUint: return vectorType(ScalarKind::UInt, n);
-    default: return std::nullopt;
-  }
-}
 
 // Where `name` is declared as an input: glslang's reflection carries no source location.
 // A linear scan over tokens (comments and preprocessor lines skipped): the statement
@@ -129,54 +115,35 @@ const char* reservedNameUse(const std::string& name) {
   return nullptr;
 }
 
-FragmentInterface reflectFragmentFile(const std::string& path) { return reflectFragmentSource(readInputFile(path), path); }
+FragmentInterface reflectFragmentFile(const std::string& path, TargetEnv env) {
+  return reflectFragmentSource(readInputFile(path), path, env);
+}
 
-FragmentInterface reflectFragmentSource(const std::string& source, const std::string& fileName) {
-  ensureGlslangInitialized();
+FragmentInterface reflectFragmentSource(const std::string& source, const std::string& fileName, TargetEnv env) {
   FragmentInterface fi;
   fi.file = fileName;
   fi.source = source;
-  GlslUnit unit{Stage::Fragment, source, fileName, {}};
-  glslang::TShader shader(EShLangFragment);
-  const char* src = source.c_str();
-  shader.setStrings(&src, 1);
-  shader.setEnvInput(glslang::EShSourceGlsl, EShLangFragment, glslang::EShClientVulkan, 100);
-  shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_0);
-  shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_0);
-  auto messages = static_cast<EShMessages>(EShMsgSpvRules | EShMsgVulkanRules);
-  auto fail = [&](const std::string& log) {
-    auto diags = parseGlslangLog(log, unit);
+  GlslShader shader(GlslUnit{Stage::Fragment, source, fileName, {}}, env);
+  if (!shader.ok()) {
+    std::vector<Diagnostic> diags = shader.diagnostics();
     for (auto& d : diags) addColumn(d, source);
-    if (diags.empty()) throw InputError(SourceLoc{fileName, 0, 0}, "the fragment shader does not compile");
-    InputError e(diags.front());
-    e.related.assign(diags.begin() + 1, diags.end());
-    throw e;
-  };
-  if (!shader.parse(GetDefaultResources(), 450, ECoreProfile, false, false, messages)) fail(shader.getInfoLog());
-  glslang::TProgram program;
-  program.addShader(&shader);
-  if (!program.link(messages)) fail(program.getInfoLog());
-  program.buildReflection(EShReflectionAllIOVariables | EShReflectionIntermediateIO);
-  for (int i = 0; i < program.getNumPipeInputs(); ++i) {
-    const glslang::TObjectReflection& r = program.getPipeInput(i);
+    throwDiagnostics(std::move(diags), fileName, "the fragment shader does not compile");
+  }
+  for (const StageVariable& r : shader.inputs()) {
     if (r.name.rfind("gl_", 0) == 0) continue;  // gl_FragCoord etc. are not vertex outputs
-    const glslang::TType* t = r.getType();
     FragmentInput in;
     in.name = r.name;
     in.loc = findDeclaration(source, fileName, r.name);
-    if (!t) throw InputError(in.loc, fmt::format("cannot reflect fragment input '{}'", r.name));
-    if (t->getBasicType() == glslang::EbtBlock || r.name.find('.') != std::string::npos)
+    if (r.block)
       throw InputError(in.loc, fmt::format("fragment input '{}' is in an interface block; declare plain 'in' variables", r.name));
-    auto ty = typeOf(*t);
-    if (!ty)
+    if (!r.type || isMatrix(*r.type))
       throw InputError(in.loc, fmt::format("fragment input '{}' has type '{}'; only scalars and vectors are supported",
-                                           r.name, t->getCompleteString()));
-    in.type = *ty;
-    const auto& q = t->getQualifier();
-    if (!q.hasLocation())
+                                           r.name, r.typeText));
+    in.type = *r.type;
+    if (r.location < 0)
       throw InputError(in.loc, fmt::format("fragment input '{}' has no layout(location = N)", r.name));
-    in.location = static_cast<int>(q.layoutLocation);
-    in.flat = q.flat;
+    in.location = r.location;
+    in.flat = r.flat;
     fi.inputs.push_back(std::move(in));
   }
   std::sort(fi.inputs.begin(), fi.inputs.end(),

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "common/diagnostics.h"
+#include "common/glsl_compile.h"
 #include "common/types.h"
 
 namespace sg {
@@ -28,8 +29,9 @@ struct FragmentInterface {
 
 // Compiles the fragment shader with glslang and reflects its inputs. Throws InputError
 // (compile errors at file:line, inputs without locations, input blocks, unsupported types).
-FragmentInterface reflectFragmentFile(const std::string& path);
-FragmentInterface reflectFragmentSource(const std::string& source, const std::string& fileName);
+FragmentInterface reflectFragmentFile(const std::string& path, TargetEnv env = TargetEnv::Vulkan1_0);
+FragmentInterface reflectFragmentSource(const std::string& source, const std::string& fileName,
+                                        TargetEnv env = TargetEnv::Vulkan1_0);
 
 // A vertex output to produce: one semantic, or several packed into a vector.
 struct Varying {

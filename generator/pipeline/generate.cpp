@@ -3,89 +3,95 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <functional>
-#include <set>
+#include <stdexcept>
 
 #include "analysis/cost.h"
 #include "analysis/explain.h"
 #include "analysis/probe.h"
-#include "emit/templates.h"
 #include "rig/gltf_import.h"
+#include "rig/rig_lod.h"
 
 namespace sg {
 
 const char* shadergenVersion() { return SHADERGEN_VERSION; }
 
-LoadedInputs loadInputs(const GenerateOptions& opts) {
+// ---- stages -----------------------------------------------------------------------------
+
+Rig loadRigStage(const std::string& path) { return loadRig(path); }
+
+RuleSet loadRulesStage(const std::vector<std::string>& paths) { return loadRules(paths); }
+
+FragmentInterface loadFragmentStage(const std::string& path, TargetEnv env) { return reflectFragmentFile(path, env); }
+
+TemplateSet loadTemplatesStage(const std::string& dir) {
+  return TemplateSet::load(dir.empty() ? defaultTemplateDir() : dir);
+}
+
+LoadedInputs instantiateStage(Rig rig, RuleSet rules, FragmentInterface fragment,
+                              const std::vector<VaryingOverride>& overrides) {
   LoadedInputs in;
-  in.rig = loadRig(opts.rigPath);  // YAML, or a glTF model "model.glb#mesh/primitive"
-  in.rules = loadRules(opts.rulesPaths);
-  in.fragment = reflectFragmentFile(opts.fragmentPath);
-  in.varyings = bindVaryings(in.fragment, in.rules, opts.overrides);
-  for (const auto& b : opts.bannedRules)  // a misspelt --ban would otherwise change nothing silently
-    if (std::none_of(in.rules.rules.begin(), in.rules.rules.end(), [&](const Rule& r) { return r.name == b; }))
-      throw InputError(SourceLoc{}, fmt::format("--ban {}: no rule of that name in the rules files", b));
+  in.rig = std::move(rig);
+  in.rules = std::move(rules);
+  in.fragment = std::move(fragment);
+  in.varyings = bindVaryings(in.fragment, in.rules, overrides);
   resolveAutoCosts(in.rules, in.rig);  // `cost: auto`: measured for this rig
   in.problem = buildProblem(in.rig, in.rules, in.varyings);
   return in;
 }
 
-std::string explainUnreachable(const Problem& p, const RuleSet& rules) {
-  // Minimal sets of missing rig inputs per unreachable goal (analysis/explain.h).
-  return formatUnreachable(p, analyzeUnreachable(p, rules, {}));
-}
-
-GenerateResult generate(const GenerateOptions& opts) { return generateFrom(loadInputs(opts), opts); }
-
-GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts) {
-  GenerateResult res;
-  if (!opts.bannedRules.empty()) in.problem = withoutRules(in.problem, opts.bannedRules);
-  if (!makeHeuristic(opts.heuristic, in.problem))
+Plan searchStage(const LoadedInputs& in, const SearchOptions& opts, SearchStats* stats) {
+  const Problem& p = in.problem;
+  if (!makeHeuristic(opts.heuristic, p))
     throw InputError(SourceLoc{}, fmt::format("unknown heuristic '{}' (blind, hmax, lmcut)", opts.heuristic));
   std::optional<Plan> plan;
   try {
-    plan = findPlan(in.problem, SearchOptions{opts.searchEngine, opts.heuristic, opts.searchLimits}, &res.stats);
+    plan = findPlan(p, opts, stats);
   } catch (const std::invalid_argument& e) {  // unknown engine, or regression on a cyclic rule graph
     throw InputError(SourceLoc{}, e.what());
   }
-  if (!plan) {
-    std::string why = formatUnreachable(in.problem, analyzeUnreachable(in.problem, in.rules, in.varyings));
-    // Point at the first fragment input whose request cannot be met.
-    SourceLoc at{in.fragment.file, 0, 0};
-    std::vector<bool> reach = reachableFacts(in.problem);
-    for (const auto& v : in.varyings)
-      for (const auto& s : v.semantics) {
-        int f = in.problem.findFact(s);
-        if (f >= 0 && !reach[f] && at.line == 0) at = v.loc.line ? v.loc : at;
-      }
-    if (!why.empty() && why.back() == '\n') why.pop_back();
-    throw InputError(at, fmt::format("the request cannot be met for rig '{}':\n{}", in.rig.name, why));
-  }
-  res.plan = *plan;
+  if (plan) return *plan;
+  std::string why = formatUnreachable(p, analyzeUnreachable(p, in.rules, in.varyings));
+  // Point at the first fragment input whose request cannot be met.
+  SourceLoc at{in.fragment.file, 0, 0};
+  std::vector<bool> reach = reachableFacts(p);
+  for (const auto& v : in.varyings)
+    for (const auto& s : v.semantics) {
+      int f = p.findFact(s);
+      if (f >= 0 && !reach[f] && at.line == 0) at = v.loc.line ? v.loc : at;
+    }
+  if (!why.empty() && why.back() == '\n') why.pop_back();
+  throw InputError(at, fmt::format("the request cannot be met for rig '{}':\n{}", in.rig.name, why));
+}
 
-  TemplateSet templates = TemplateSet::load(opts.templateDir.empty() ? defaultTemplateDir() : opts.templateDir);
-  EmitOptions eo;
-  eo.capture = opts.capture;
-  eo.heuristic = opts.heuristic;
-  eo.version = shadergenVersion();
-  res.glsl = emitGlsl(in.rig, in.problem, res.plan, in.varyings, templates, in.fragment.file, eo);
+EmittedGlsl emitStage(const LoadedInputs& in, const Plan& plan, const TemplateSet& templates,
+                      const EmitOptions& opts) {
+  return emitGlsl(in.rig, in.problem, plan, in.varyings, templates, in.fragment.file, opts);
+}
+
+CompiledVertexShader compileStage(const LoadedInputs& in, const Plan& plan, const EmittedGlsl& glsl,
+                                  const std::string& glslName, TargetEnv env) {
   try {
-    res.spirv = compileVertexShader(res.glsl, opts.outputName, opts.targetEnv);
+    return compileVertex(glsl, glslName, env);
   } catch (const InputError& e) {
     // glslang reports lines only: point the columns at the snippet text in the rules file.
     std::vector<SourceLoc> snippetLines;
-    for (int a : res.plan.actions)
+    for (int a : plan.actions)
       for (const auto& l : in.problem.actions[a].code) snippetLines.push_back(l.loc);
     throw refineSnippetError(e, snippetLines);
   }
-  if (std::string err = validateSpirv(res.spirv.words, opts.targetEnv); !err.empty())
-    throw InputError(SourceLoc{opts.outputName, 0, 0}, "generated SPIR-V fails validation: " + err);
-  if (res.spirv.uniformBlockSize > opts.maxUniformBlockBytes) {
+}
+
+std::vector<uint32_t> checkStage(const LoadedInputs& in, const EmittedGlsl& glsl, const CompiledVertexShader& vertex,
+                                 const ShaderCheckOptions& opts) {
+  std::vector<uint32_t> words = vertex.module.words;
+  if (std::string err = validateSpirv(words, opts.env); !err.empty())
+    throw InputError(SourceLoc{opts.glslName, 0, 0}, "generated SPIR-V fails validation: " + err);
+  if (vertex.module.uniformBlockSize > opts.maxUniformBlockBytes) {
     // Point at the largest uniform the plan reads (a bone palette, usually).
     SourceLoc at{in.rig.file, 0, 0};
     std::string list;
     int64_t largest = -1;
-    for (const auto& u : res.glsl.uniforms) {
+    for (const auto& u : glsl.uniforms) {
       const RigUniform& ru = in.rig.uniforms[u.uniform];
       int64_t bytes = int64_t{componentCount(ru.type)} * 4 * std::max(1, ru.arraySize);
       list += fmt::format("{}{} {}{}", list.empty() ? "" : ", ", glslName(ru.type), ru.name,
@@ -97,18 +103,62 @@ GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts) {
     }
     throw InputError(at, fmt::format("the uniform block is {} bytes (std140: {}), larger than the {} bytes of "
                                      "maxUniformBufferRange that every Vulkan device supports",
-                                     res.spirv.uniformBlockSize, list, opts.maxUniformBlockBytes));
+                                     vertex.module.uniformBlockSize, list, opts.maxUniformBlockBytes));
   }
-  checkLink(res.glsl, in.fragment.source, in.fragment.file, opts.targetEnv);
+  checkLink(vertex.parsed, GlslShader(GlslUnit{Stage::Fragment, in.fragment.source, in.fragment.file, {}}, opts.env));
   if (opts.optimize) {
-    res.spirv.words = optimizeSpirv(res.spirv.words, opts.targetEnv);
-    if (std::string err = validateSpirv(res.spirv.words, opts.targetEnv); !err.empty())
-      throw InputError(SourceLoc{opts.outputName, 0, 0}, "optimised SPIR-V fails validation: " + err);
+    words = optimizeSpirv(words, opts.env);
+    if (std::string err = validateSpirv(words, opts.env); !err.empty())
+      throw InputError(SourceLoc{opts.glslName, 0, 0}, "optimised SPIR-V fails validation: " + err);
   }
-  res.inputsRead.push_back(in.rig.file);
-  res.inputsRead.push_back(in.fragment.file);
-  for (const auto& f : in.rules.files) res.inputsRead.push_back(f);
-  res.inputsRead.push_back(templates.file());
+  return words;
+}
+
+std::vector<std::string> inputsRead(const LoadedInputs& in, const TemplateSet& templates) {
+  std::vector<std::string> files{in.rig.file, in.fragment.file};
+  files.insert(files.end(), in.rules.files.begin(), in.rules.files.end());
+  files.push_back(templates.file());
+  return files;
+}
+
+// ---- the stages in order ------------------------------------------------------------------
+
+LoadedInputs loadInputs(const GenerateOptions& opts) {
+  Rig rig = loadRigStage(opts.rigPath);
+  if (!opts.rigParams.empty()) rig = rigWithParameters(rig, opts.rigParams, SourceLoc{});
+  LoadedInputs in = instantiateStage(std::move(rig), loadRulesStage(opts.rulesPaths),
+                                     loadFragmentStage(opts.fragmentPath, opts.targetEnv), opts.overrides);
+  for (const auto& b : opts.bannedRules)  // a misspelt --ban would otherwise change nothing silently
+    if (std::none_of(in.rules.rules.begin(), in.rules.rules.end(), [&](const Rule& r) { return r.name == b; }))
+      throw InputError(SourceLoc{}, fmt::format("--ban {}: no rule of that name in the rules files", b));
+  return in;
+}
+
+std::string explainUnreachable(const Problem& p, const RuleSet& rules) {
+  // Minimal sets of missing rig inputs per unreachable goal (analysis/explain.h).
+  return formatUnreachable(p, analyzeUnreachable(p, rules, {}));
+}
+
+GenerateResult generate(const GenerateOptions& opts) { return generateFrom(loadInputs(opts), opts); }
+
+GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts) {
+  return generateWith(std::move(in), loadTemplatesStage(opts.templateDir), opts);
+}
+
+GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const GenerateOptions& opts) {
+  GenerateResult res;
+  if (!opts.bannedRules.empty()) in.problem = withoutRules(in.problem, opts.bannedRules);
+  res.plan = searchStage(in, SearchOptions{opts.searchEngine, opts.heuristic, opts.searchLimits}, &res.stats);
+  EmitOptions eo;
+  eo.capture = opts.capture;
+  eo.heuristic = opts.heuristic;
+  eo.version = shadergenVersion();
+  res.glsl = emitStage(in, res.plan, templates, eo);
+  CompiledVertexShader compiled = compileStage(in, res.plan, res.glsl, opts.outputName, opts.targetEnv);
+  res.spirv = compiled.module;
+  res.spirv.words =
+      checkStage(in, res.glsl, compiled, ShaderCheckOptions{opts.outputName, opts.targetEnv, opts.optimize, opts.maxUniformBlockBytes});
+  res.inputsRead = inputsRead(in, templates);
   res.in = std::move(in);
   return res;
 }

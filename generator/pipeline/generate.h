@@ -1,6 +1,8 @@
-// The whole generator as one call: load → problem → A* → emit → SPIR-V → checks.
-// The CLI, the validator and the tests all go through here.
+// The whole generator as one call: the stages of pipeline/stages.h in order
+// (load → instantiate → search → emit → compile → check).
 #pragma once
+#include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,9 +14,11 @@
 #include "rig/rig.h"
 #include "rules/rules.h"
 #include "search/astar.h"
+#include "search/instance.h"
 #include "search/search.h"
 #include "search/plan.h"
 #include "search/problem.h"
+#include "pipeline/stages.h"
 
 namespace sg {
 
@@ -25,6 +29,7 @@ struct GenerateOptions {
   std::string fragmentPath;
   std::vector<std::string> rulesPaths;
   std::vector<VaryingOverride> overrides;
+  std::map<std::string, int64_t> rigParams;  // deformer parameters set on the rig (--set)
   std::vector<std::string> bannedRules;  // force alternatives (cross-check, explain)
   std::string heuristic = "lmcut";
   std::string searchEngine = "auto";  // auto, regression, forward, ip (search/search.h)
@@ -37,15 +42,6 @@ struct GenerateOptions {
   // The uniform block must fit the device's maxUniformBufferRange; 16384 bytes is what
   // every Vulkan device guarantees (docs/limits.md). A known device may raise it.
   uint32_t maxUniformBlockBytes = kVulkanMinUniformBufferRange;
-};
-
-// Everything loaded (kept so later stages and explain/validate reuse it).
-struct LoadedInputs {
-  Rig rig;
-  RuleSet rules;
-  FragmentInterface fragment;
-  std::vector<Varying> varyings;
-  Problem problem;
 };
 
 struct GenerateResult {
@@ -65,6 +61,8 @@ LoadedInputs loadInputs(const GenerateOptions& opts);
 GenerateResult generate(const GenerateOptions& opts);
 // Same, from already loaded inputs (cross-check runs reuse one load).
 GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts);
+// Same, with templates already loaded (batch builds load them once).
+GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const GenerateOptions& opts);
 
 // For an unsolvable problem: why each unreachable goal cannot be produced.
 std::string explainUnreachable(const Problem& p, const RuleSet& rules);

@@ -631,7 +631,11 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   for (const auto& [name, idx] : prim.attributes) {
     for (const char* prefix : {"JOINTS_", "WEIGHTS_"}) {
       if (name.rfind(prefix, 0) != 0) continue;
-      int s = std::atoi(name.c_str() + std::strlen(prefix));
+      // The set number, saturated (atoi overflows on "JOINTS_99999999999", and 4·(s+1) below
+      // must not); a name without digits ("JOINTS_x") counts as set 0, like atoi did.
+      int s = 0;
+      for (const char* p = name.c_str() + std::strlen(prefix); *p >= '0' && *p <= '9'; ++p)
+        s = std::min(s * 10 + (*p - '0'), 1000000);
       if (s >= kMaxInfluenceSets) {
         int infl = 0;
         while (prim.attributes.count(fmt::format("JOINTS_{}", infl / 4))) infl += 4;
@@ -897,6 +901,7 @@ bool readBounded(const std::string& path, std::string& out, std::string& why) {
 struct BufferFiles {
   std::filesystem::path root;  // canonical model folder; empty: no buffer files at all
   std::string refused;         // the first refusal, reported instead of "File not found"
+  size_t bytesRead = 0;        // all buffer files together stay under kMaxGltfFileBytes too
 };
 
 bool insideRoot(BufferFiles& ctx, const std::string& path) {
@@ -918,10 +923,16 @@ bool bufferFileExists(const std::string& path, void* user) {
 }
 std::string keepPath(const std::string& path, void*) { return path; }
 bool readBufferFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
-  if (!insideRoot(*static_cast<BufferFiles*>(user), path)) return false;
+  auto& ctx = *static_cast<BufferFiles*>(user);
+  if (!insideRoot(ctx, path)) return false;
   std::string bytes, why;
   if (!readBounded(path, bytes, why)) {
     if (err) *err += why;
+    return false;
+  }
+  ctx.bytesRead += bytes.size();
+  if (ctx.bytesRead > kMaxGltfFileBytes) {
+    if (err) *err += fmt::format("the buffer files together are larger than the limit of {}", mib(kMaxGltfFileBytes));
     return false;
   }
   out->assign(bytes.begin(), bytes.end());

@@ -1,4 +1,5 @@
-// Instantiates rules against a rig (docs/rules-format.md, "Instantiation").
+// The search problem of a rig: facts, the rig's inputs, and the rules instantiated
+// through rules/instantiate.h (docs/rules-format.md, "Instantiation").
 #include "search/problem.h"
 
 #include <fmt/format.h>
@@ -11,7 +12,7 @@
 #include "interface/fragment_interface.h"
 #include "rig/rig.h"
 #include "rules/rules.h"
-#include "rules/snippet.h"
+#include "rules/instantiate.h"
 
 namespace sg {
 
@@ -35,20 +36,11 @@ int Problem::findFact(const std::string& name) const {
 
 namespace {
 
-std::string indexed(const std::string& name, int64_t i) { return fmt::format("{}[{}]", name, i); }
-
-
+// Facts for every declared semantic instance, the rig's attributes and uniforms bound to
+// them, then one action per applicable rule (rules/instantiate.h does the resolving).
 class Builder {
  public:
-  Builder(const Rig& rig, const RuleSet& rules) : rig_(rig), rules_(rules) {
-    env_.lookup = [this](const std::string& n, int64_t& v) {
-      auto it = rig_.params.find(n);
-      if (it == rig_.params.end()) return false;
-      v = it->second;
-      return true;
-    };
-    env_.has = [this](const std::string& s) { return provided_.count(s) || provided_.count(indexed(s, 0)); };
-  }
+  Builder(const Rig& rig, const RuleSet& rules) : rig_(rig), rules_(rules), shape_(shapeOfRig(rig, rules)) {}
 
   Problem build(const std::vector<Varying>& varyings) {
     declareFacts();
@@ -71,22 +63,15 @@ class Builder {
     for (const auto& d : rules_.semantics) {
       Fact f;
       f.type = d.type;
-      if (!d.arrayParam.empty()) {
-        if (!rig_.params.count(d.arrayParam))
-          throw InputError(d.loc, fmt::format("semantic '{}' is sized by '{}', which rig '{}' does not define", d.name,
-                                              d.arrayParam, rig_.name));
-        f.arraySize = static_cast<int>(rig_.param(d.arrayParam));
-      }
-      if (d.count.empty()) {
+      if (auto a = shape_.arrays.find(d.name); a != shape_.arrays.end()) f.arraySize = static_cast<int>(rig_.param(d.arrayParam));
+      auto fam = shape_.families.find(d.name);
+      if (fam == shape_.families.end()) {
         f.name = d.name;
         add(f);
         continue;
       }
-      int64_t n = d.count.eval(env_);
-      if (n < 0 || n > 256) throw InputError(d.loc, fmt::format("semantic '{}' has count {} (allowed 0..256)", d.name, n));
-      families_[d.name] = n;
-      for (int64_t i = 0; i < n; ++i) {
-        f.name = indexed(d.name, i);
+      for (int64_t i = 0; i < fam->second; ++i) {
+        f.name = indexedName(d.name, i);
         add(f);
       }
     }
@@ -101,10 +86,11 @@ class Builder {
     auto it = index_.find(name);
     if (it != index_.end()) return it->second;
     auto [base, i] = splitIndexed(name);
-    if (families_.count(base))
+    if (auto fam = shape_.families.find(base); fam != shape_.families.end())
       throw InputError(at, fmt::format("{} '{}': index {} is out of range (the rig has {} instances)", who, name, i,
-                                       families_[base]));
-    throw InputError(at, fmt::format("{} unknown semantic '{}' (not declared in the rules)", who, name));
+                                       fam->second));
+    throw InputError(at, fmt::format("{} unknown semantic '{}' (not declared in the rules){}", who, name,
+                                     didYouMeanSemantic(rules_, name)));
   }
 
   void provide(int f, Fact::Source src, int rigIndex, int target, const std::string& swizzle, Type have,
@@ -117,7 +103,6 @@ class Builder {
     fact.rigIndex = rigIndex;
     fact.target = target;
     fact.swizzle = swizzle;
-    provided_.insert(fact.name);
     p_.init.push_back(f);
   }
 
@@ -127,7 +112,7 @@ class Builder {
       int targets = attr.perMorphTarget ? rig_.morphTargets() : 1;
       for (int t = 0; t < targets; ++t)
         for (const auto& part : attr.provides) {
-          std::string name = attr.perMorphTarget ? indexed(part.semantic, t) : part.semantic;
+          std::string name = attr.perMorphTarget ? indexedName(part.semantic, t) : part.semantic;
           int n = part.swizzle.empty() ? componentCount(attr.shaderType) : static_cast<int>(part.swizzle.size());
           std::optional<Type> have = vectorType(scalarKind(attr.shaderType), n);
           if (!have)  // e.g. "xy" of a uint8x4: there is no uvec2 type
@@ -154,75 +139,22 @@ class Builder {
 
   void instantiate(int r) {
     const Rule& rule = rules_.rules[r];
-    if (!rule.when.empty() && rule.when.eval(env_) == 0) {
+    if (!ruleApplies(rule, shape_)) {
       p_.skippedRules.emplace_back(r, fmt::format("when '{}' is false for rig '{}'", rule.when.text(), rig_.name));
       return;
     }
     Action act;
     act.name = rule.name;
     act.rule = r;
-    if (families_.count(rule.produces))
-      throw InputError(rule.producesLoc, fmt::format("rule '{}' produces '{}', which is an indexed family; rules "
-                                                     "produce single semantics",
-                                                     rule.name, rule.produces));
-    act.add = factOrFail(rule.produces, rule.producesLoc, fmt::format("rule '{}' produces", rule.name).c_str());
-    std::set<int> pre;
-    for (const auto& ref : rule.needs) {
-      bool family = families_.count(ref.name) != 0;
-      if (ref.index.empty()) {
-        if (family)
-          throw InputError(ref.loc, fmt::format("'{}' is an indexed family: write '{}[*]' or '{}[i]'", ref.name,
-                                                ref.name, ref.name));
-        pre.insert(factOrFail(ref.name, ref.loc, "needs"));
-      } else if (!family) {
-        throw InputError(ref.loc, fmt::format("'{}' is not an indexed family", ref.name));
-      } else if (ref.index == "*") {
-        for (int64_t i = 0; i < families_[ref.name]; ++i) pre.insert(index_[indexed(ref.name, i)]);
-      } else {
-        SourceLoc at = ref.loc;
-        if (at.col > 0) at.col += static_cast<int>(ref.name.size()) + 1;
-        int64_t i = Expr::parse(ref.index, at).eval(env_);
-        pre.insert(factOrFail(indexed(ref.name, i), ref.loc, "needs"));
-      }
-    }
-    if (pre.count(act.add))
-      throw InputError(rule.producesLoc, fmt::format("rule '{}' needs its own product '{}'", rule.name, rule.produces));
-    act.pre.assign(pre.begin(), pre.end());
+    auto product = index_.find(rule.produces);
+    RuleInstance inst = instantiateRule(rules_, r, shape_, product == index_.end() ? "" : factRef(product->second),
+                                        [&](const std::string& instance) { return factRef(index_.at(instance)); });
+    act.add = product->second;  // instantiateRule checked the product is a declared single semantic
+    for (const auto& n : inst.needs) act.pre.push_back(index_.at(n));
+    std::sort(act.pre.begin(), act.pre.end());
     // `cost: auto` is measured before instantiation (analysis/cost.h resolveAutoCosts).
-    if (rule.costAuto && rule.cost.empty())
-      throw InputError(rule.loc, fmt::format("rule '{}': 'cost: auto' must be resolved before instantiation "
-                                             "(resolveAutoCosts measures its snippet)",
-                                             rule.name));
-    act.cost = rule.cost.eval(env_);
-    if (act.cost < 0) throw InputError(rule.loc, fmt::format("rule '{}' has negative cost {}", rule.name, act.cost));
-    // Above this, sums of costs could reach the search's "infinite" and plans would be lost.
-    if (act.cost > kMaxRuleCost)
-      throw InputError(rule.loc, fmt::format("rule '{}' has cost {}, above the limit of {}", rule.name, act.cost,
-                                             kMaxRuleCost));
-
-    SnippetContext ctx;
-    ctx.rigEnv = env_;
-    ctx.outText = factRef(act.add);
-    ctx.semantic = [&](const std::string& name, int64_t idx, const SourceLoc& at, std::string& text) {
-      bool family = families_.count(name) != 0;
-      if (!family && !index_.count(name)) {
-        if (idx >= 0) return false;
-        throw InputError(at, fmt::format("rule '{}' uses unknown semantic '{}'", rule.name, name));
-      }
-      if (family && idx < 0)
-        throw InputError(at, fmt::format("'{}' is an indexed family: write ${{{}[i]}}", name, name));
-      std::string full = family ? indexed(name, idx) : name;
-      int f = factOrFail(full, at, "snippet uses");
-      if (f == act.add) {
-        text = factRef(f);
-        return true;
-      }
-      if (!pre.count(f))
-        throw InputError(at, fmt::format("rule '{}' uses '{}' but does not list it in 'needs'", rule.name, full));
-      text = factRef(f);
-      return true;
-    };
-    for (auto& l : expandSnippet(rule.glsl, ctx)) act.code.push_back(CodeLine{std::move(l.text), l.loc});
+    act.cost = ruleCost(rule, shape_);
+    for (auto& l : inst.code) act.code.push_back(CodeLine{std::move(l.text), l.loc});
     if (p_.facts[act.add].source != Fact::Source::Computed) {
       p_.skippedRules.emplace_back(r, fmt::format("'{}' is provided by the rig", rule.produces));
       return;
@@ -232,11 +164,9 @@ class Builder {
 
   const Rig& rig_;
   const RuleSet& rules_;
-  ExprEnv env_;
+  RigShape shape_;
   Problem p_;
   std::map<std::string, int> index_;
-  std::map<std::string, int64_t> families_;
-  std::set<std::string> provided_;
 };
 
 }  // namespace

@@ -277,6 +277,65 @@ search)
   ;;
 
 
+build)
+  # `shadergen build`: one process, cache across runs (and between two concurrent builds),
+  # unchanged outputs untouched, byte-identical to `generate --set`, located errors.
+  cp "$E/face.rig.yaml" face.rig.yaml
+  cat >m.yaml <<EOF
+output: out
+rules: $E/rules.yaml
+rigs:
+  face: face.rig.yaml
+passes:
+  color: $E/face.frag
+  depth: $E/depth.frag
+  shadow: shadow.frag
+axes:
+  influences: [4, 1]
+EOF
+  printf '#version 450\nlayout(location = 0) out float D;\nvoid main() { D = gl_FragCoord.z; }\n' >shadow.frag
+  expect 0 "build" -- "$SG" build m.yaml
+  grep -q "6 variants: 6 generated, 0 from the cache, 0 failed" last.out && ok "cold: 6 generated" || fail "cold summary: $(cat last.out)"
+  [ -f out/index.json ] && [ -f out/face-color-influences4.vert ] && [ -f out/face-depth-influences1.json ] &&
+    [ -f out/face-color-influences1.d ] && ok "index, GLSL, reflection and depfiles written" || fail "outputs missing: $(ls out)"
+  spv=$(ls out/spirv/*.spv | wc -l)
+  [ "$spv" -eq 4 ] && ok "4 SPIR-V modules for 6 variants (shadow = depth, kept once)" || fail "$spv SPIR-V files"
+  no_temps out
+  before=$(stat -c %Y.%y out/face-color-influences4.vert)
+  sleep 1
+  expect 0 "warm build" -- "$SG" build m.yaml
+  grep -q "6 variants: 0 generated, 6 from the cache" last.out && ok "warm: all from the cache" || fail "warm summary: $(cat last.out)"
+  [ "$(stat -c %Y.%y out/face-color-influences4.vert)" = "$before" ] && ok "unchanged output not rewritten" ||
+    fail "unchanged output rewritten"
+  expect 0 "generate --set influences=1" -- "$SG" generate --rig face.rig.yaml -f "$E/face.frag" -r "$E/rules.yaml" \
+    --set influences=1 -o sep/face-color-influences1 --emit glsl,spv,reflection -q
+  spvpath=$(grep -A20 '"name": "face-color-influences1"' out/index.json | grep -o 'spirv/[0-9a-f]*\.spv' | head -1)
+  cmp -s sep/face-color-influences1.spv "out/$spvpath" && cmp -s sep/face-color-influences1.json out/face-color-influences1.json &&
+    cmp -s sep/face-color-influences1.vert out/face-color-influences1.vert &&
+    ok "build output == generate --set output (GLSL, SPIR-V, reflection)" || fail "build and generate differ ($spvpath)"
+  # Two builds at once sharing one cache directory: both succeed, same bytes.
+  "$SG" build m.yaml -o c1 --cache-dir shared -q & p1=$!
+  "$SG" build m.yaml -o c2 --cache-dir shared -q & p2=$!
+  wait $p1 && wait $p2 && ok "two concurrent builds sharing a cache succeed" || fail "concurrent builds failed"
+  diff -r -x .shadergen-cache -x "*.d" c1 c2 >/dev/null && ok "concurrent builds wrote the same bytes" ||
+    fail "concurrent outputs differ"
+  no_temps shared
+  # Progress only on request when stderr is not a terminal.
+  CI=1 "$SG" build m.yaml -o c3 2>err.txt >/dev/null
+  [ ! -s err.txt ] && ok "quiet stderr in CI" || fail "stderr in CI: $(cat err.txt)"
+  "$SG" build m.yaml -o c3 --progress 2>err.txt >/dev/null
+  grep -q "\[6/6\]" err.txt && ok "--progress shows [6/6]" || fail "no progress: $(cat err.txt)"
+  # Errors: located, exit 1, no index.
+  printf 'rules: r.yaml\nrigs:\n  face: face.rig.yaml\npasses:\n  color: c.frag\naxes:\n  rig: [face, bdy]\n' >bad.yaml
+  expect 1 "unknown rig in an axis" -- "$SG" build bad.yaml
+  grep -q "bad.yaml:7:3: error: axis 'rig': no rig named 'bdy'" last.err && ok "located manifest error" ||
+    fail "manifest error: $(cat last.err)"
+  sed 's/influences: \[4, 1\]/influences: [4, 9]/' m.yaml >nine.yaml
+  expect 1 "a variant that cannot be made" -- "$SG" build nine.yaml -o bad-out
+  grep -q "error: variant 'face-color-influences9' failed" last.err && ok "failed variant named" || fail "$(cat last.err)"
+  [ ! -e bad-out/index.json ] && ok "no index after a failure" || fail "index written despite a failure"
+  ;;
+
 *)
   echo "unknown case $case_name" >&2
   exit 2

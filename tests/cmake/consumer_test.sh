@@ -47,6 +47,17 @@ grep -q '^face: gl_Position\[0\] gpu' "$T/run.log" && grep -q '^face: .*: match$
   grep -q '^prop: .*: match$' "$T/run.log" && ok "GPU gl_Position matches the CPU for both shaders" || fail "no match lines"
 [ "$(tail -n 1 "$T/run.log")" = "OK" ] && ok "consumer prints OK" || fail "consumer did not print OK"
 
+# The engine program: shadergen::core at load time makes the build's variants byte for byte.
+"$OUT/shadergen_engine" >"$T/engine.log" 2>&1
+rc=$?
+cat "$T/engine.log"
+[ $rc -eq 0 ] && [ "$(tail -n 1 "$T/engine.log")" = "OK" ] && [ "$(grep -c 'same SPIR-V as the build' "$T/engine.log")" = 2 ] &&
+  ok "shadergen::core remakes two variants byte for byte" || fail "engine program (exit $rc)"
+VARIANTS=$OUT/shadergen/shadergen_engine/variants
+n=$(grep -c '"name":' "$VARIANTS/index.json")
+[ "$n" = 16 ] && ok "variants index lists 16 variants" || fail "variants index lists $n variants"
+entries() { find "$VARIANTS/.shadergen-cache" -type f | wc -l; }
+
 # 3. Incremental builds.
 GEN=$OUT/shadergen/shadergen_consumer
 mtime() { stat -c %Y.%y "$1"; }
@@ -109,6 +120,19 @@ expect_regen touch-main "" "touch main.cpp"
 noop "at the end"
 
 "$OUT/shadergen_consumer" | tail -n 1 | grep -qx OK && ok "consumer still OK after the rebuilds" || fail "consumer after rebuilds"
+
+# Editing one rig's bytes regenerates that rig's variants only (4 body variants: 4 new
+# cache entries), leaves the face's outputs untouched, and the next build is a no-op.
+tick; before_entries=$(entries) before_facevar=$(mtime "$VARIANTS/face-color-m5-i4.vert")
+echo "# edited" >>"$CONSUMER/body.rig.yaml"
+"$NINJA" -C "$OUT" >"$T/edit-body.log" 2>&1 || fail "build after editing body.rig.yaml"
+grep -q 'building the shader variants' "$T/edit-body.log" && ok "editing body.rig.yaml reruns the variant build" ||
+  fail "variant build not rerun after editing body.rig.yaml"
+[ "$(( $(entries) - before_entries ))" = 4 ] && ok "exactly the 4 body variants regenerated" ||
+  fail "$(( $(entries) - before_entries )) variants regenerated, expected 4"
+[ "$(mtime "$VARIANTS/face-color-m5-i4.vert")" = "$before_facevar" ] && ok "face variant outputs untouched" ||
+  fail "face variant output rewritten"
+noop "after editing body.rig.yaml"
 
 if [ "$fails" -ne 0 ]; then
   echo "$fails check(s) failed" >&2

@@ -2,9 +2,8 @@
 // every vertex, with the validation layer on and silent.
 #include "runtime/vk_harness.h"
 
-#include <glslang/Public/ResourceLimits.h>
-#include <glslang/Public/ShaderLang.h>
-#include <glslang/SPIRV/GlslangToSpv.h>
+#include "common/glsl_compile.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -23,23 +22,13 @@ using sg::rt::RunResult;
 using sg::rt::VertexStream;
 
 std::vector<uint32_t> compileVertexShader(const std::string& source) {
-  static const bool initialized = glslang::InitializeProcess();
-  (void)initialized;
-  glslang::TShader shader(EShLangVertex);
-  const char* text = source.c_str();
-  shader.setStrings(&text, 1);
-  shader.setEnvInput(glslang::EShSourceGlsl, EShLangVertex, glslang::EShClientVulkan, 100);
-  shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_0);
-  shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_0);
-  const auto messages = static_cast<EShMessages>(EShMsgSpvRules | EShMsgVulkanRules);
-  if (!shader.parse(GetDefaultResources(), 100, false, messages))
-    throw std::runtime_error(std::string("GLSL compile failed:\n") + shader.getInfoLog());
-  glslang::TProgram program;
-  program.addShader(&shader);
-  if (!program.link(messages)) throw std::runtime_error(std::string("GLSL link failed:\n") + program.getInfoLog());
-  std::vector<uint32_t> spirv;
-  glslang::GlslangToSpv(*program.getIntermediate(EShLangVertex), spirv);
-  return spirv;
+  sg::CompileResult r = sg::compileGlsl(sg::GlslUnit{sg::Stage::Vertex, source, "test.vert", {}}, sg::TargetEnv::Vulkan1_0);
+  if (!r.ok) {
+    std::string log;
+    for (const auto& d : r.diagnostics) log += sg::renderDiagnostic(d) + "\n";
+    throw std::runtime_error("GLSL compile failed:\n" + log);
+  }
+  return r.spirv;
 }
 
 constexpr int kBones = 8;

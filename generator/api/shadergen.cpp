@@ -1,0 +1,62 @@
+#include "api/shadergen.h"
+
+#include <fmt/format.h>
+
+#include "emit/reflection.h"
+#include "pipeline/generate.h"
+
+namespace shadergen {
+namespace {
+
+Diagnostic convert(const sg::Diagnostic& d) {
+  Diagnostic o;
+  o.file = d.loc.file;
+  o.line = d.loc.line;
+  o.column = d.loc.col;
+  o.severity = d.severity == sg::Severity::Error ? "error" : d.severity == sg::Severity::Warning ? "warning" : "note";
+  o.message = d.message;
+  return o;
+}
+
+}  // namespace
+
+std::string Diagnostic::text() const {
+  std::string where = file;
+  if (line > 0) where += fmt::format(":{}", line);
+  if (line > 0 && column > 0) where += fmt::format(":{}", column);
+  return fmt::format("{}{}{}: {}", where, where.empty() ? "" : ": ", severity, message);
+}
+
+Result generate(const Options& options) {
+  Result r;
+  try {
+    sg::GenerateOptions o;
+    o.rigPath = options.rig;
+    o.fragmentPath = options.fragment;
+    o.rulesPaths = options.rules;
+    o.rigParams = options.rigParameters;
+    for (const auto& [name, sems] : options.maps) o.overrides.push_back(sg::VaryingOverride{name, sems});
+    if (!sg::parseTargetEnv(options.targetEnv, o.targetEnv))
+      throw sg::InputError(sg::SourceLoc{}, fmt::format("unknown target environment '{}' (vulkan1.0 .. vulkan1.3)",
+                                                        options.targetEnv));
+    o.optimize = options.optimize;
+    o.templateDir = options.templates;
+    sg::GenerateResult g = sg::generate(o);
+    r.glsl = g.glsl.text;
+    r.spirv = g.spirv.words;
+    r.reflection = sg::reflectionJson(g.in.rig, g.glsl, g.spirv);
+    r.cost = g.plan.cost;
+    for (int a : g.plan.actions) r.rules.push_back(g.in.problem.actions[a].name);
+    r.ok = true;
+  } catch (const sg::InputError& e) {
+    r.diagnostics.push_back(convert(e.diagnostic()));
+    for (const auto& d : e.related) r.diagnostics.push_back(convert(d));
+  } catch (const std::exception& e) {
+    r.diagnostics.push_back(Diagnostic{"", 0, 0, "error", e.what()});
+  }
+  return r;
+}
+
+const char* version() { return sg::shadergenVersion(); }
+
+}  // namespace shadergen

@@ -1,0 +1,52 @@
+// shadergen::core — the generator as a library, for an engine that makes its vertex
+// shaders at load time. Standard-library types only; installed as <shadergen/shadergen.h>
+// and linked as shadergen::core (find_package(shadergen)). Example: examples/engine/.
+//
+//   shadergen::Options o;
+//   o.rig = "face.rig.yaml";  o.fragment = "face.frag";  o.rules = {rulesDir + "/standard.yaml"};
+//   shadergen::Result r = shadergen::generate(o);
+//   if (!r.ok) for (auto& d : r.diagnostics) std::cerr << d.text() << "\n";
+//   else upload(r.spirv);
+#pragma once
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace shadergen {
+
+struct Options {
+  std::string rig;                   // rig YAML, or a glTF model "model.glb#mesh/primitive"
+  std::string fragment;              // the fragment shader to feed (GLSL 450)
+  std::vector<std::string> rules;    // rules files
+  std::map<std::string, int64_t> rigParameters;  // deformer parameters to set (LODs)
+  std::map<std::string, std::vector<std::string>> maps;  // fragment input -> semantics
+  std::string targetEnv = "vulkan1.0";  // .. "vulkan1.3"
+  bool optimize = false;             // spirv-opt -O
+  std::string templates;             // "" = the templates installed with shadergen
+};
+
+struct Diagnostic {
+  std::string file;
+  int line = 0, column = 0;
+  std::string severity;  // "error", "warning", "note"
+  std::string message;
+  std::string text() const;  // "file:line:col: error: message"
+};
+
+struct Result {
+  bool ok = false;
+  std::string glsl;                   // the vertex shader (Vulkan GLSL 450)
+  std::vector<uint32_t> spirv;        // validated SPIR-V
+  std::string reflection;             // JSON: vertex inputs, uniform layout, outputs
+  int64_t cost = 0;                   // plan cost (vertex-program instruction slots)
+  std::vector<std::string> rules;     // the plan's rules, in order
+  std::vector<Diagnostic> diagnostics;  // why it failed (when !ok)
+};
+
+// Never throws for bad input: failures come back as diagnostics.
+Result generate(const Options& options);
+
+const char* version();
+
+}  // namespace shadergen

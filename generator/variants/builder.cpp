@@ -1,0 +1,368 @@
+#include "variants/builder.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "emit/reflection.h"
+#include "pipeline/generate.h"
+#include "rig/rig_lod.h"
+#include "variants/content_hash.h"
+
+namespace sg {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Bumped whenever the entry layout or what a key covers changes.
+constexpr const char* kCacheFormat = "shadergen-variant-cache 1";
+
+// Every file a build reads, loaded once and shared (read-only) by all workers.
+struct SharedInputs {
+  RuleSet rules;
+  TemplateSet templates;
+  std::map<std::string, Rig> rigs;                     // by manifest path
+  std::map<std::string, FragmentInterface> fragments;  // by path
+  std::map<std::string, std::string> digests;          // file -> SHA-256 of its bytes (cache keys)
+};
+
+// A glTF rig path "model.glb#0/0" reads "model.glb".
+std::string fileOf(const std::string& path) {
+  auto hash = path.rfind('#');
+  if (hash == std::string::npos) return path;
+  std::string ext = fs::path(path.substr(0, hash)).extension().string();
+  return ext == ".glb" || ext == ".gltf" ? path.substr(0, hash) : path;
+}
+
+std::string readBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(SourceLoc{path, 0, 0}, "cannot read this input file");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+SharedInputs loadShared(const Manifest& m, const std::vector<Variant>& variants) {
+  SharedInputs s;
+  s.rules = loadRulesStage(m.rules);
+  s.templates = loadTemplatesStage(m.templates);
+  for (const auto& v : variants) {
+    if (!s.rigs.count(v.rig->path)) {
+      try {
+        s.rigs.emplace(v.rig->path, loadRigStage(v.rig->path));
+      } catch (const InputError& e) {
+        InputError out(e.diagnostic());
+        out.related = e.related;
+        out.related.push_back(Diagnostic{Severity::Note, v.rig->loc, fmt::format("rig '{}' is named here", v.rig->name)});
+        throw out;
+      }
+    }
+    if (!s.fragments.count(v.pass->fragment)) s.fragments.emplace(v.pass->fragment, loadFragmentStage(v.pass->fragment, m.targetEnv));
+  }
+  // Each file is hashed once; a variant's key hashes the digests of its files.
+  auto keep = [&](const std::string& path) {
+    std::string f = fileOf(path);
+    if (!s.digests.count(f)) s.digests.emplace(f, sha256Hex(readBytes(f)));
+  };
+  for (const auto& f : s.rules.files) keep(f);
+  keep(s.templates.file());
+  for (const auto& [path, rig] : s.rigs) keep(rig.file);
+  for (const auto& [path, frag] : s.fragments) keep(frag.file);
+  return s;
+}
+
+std::vector<std::string> inputsOf(const SharedInputs& s, const Variant& v) {
+  std::vector<std::string> files{fileOf(s.rigs.at(v.rig->path).file), s.fragments.at(v.pass->fragment).file};
+  files.insert(files.end(), s.rules.files.begin(), s.rules.files.end());
+  files.push_back(s.templates.file());
+  return files;
+}
+
+// Every byte that can change a variant's outputs: the tool, the options, the variant's
+// parameters and mappings, and each input file's path (outputs name them) and contents
+// (through the SHA-256 of the file).
+std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v, const std::vector<std::string>& inputs) {
+  Sha256 h;
+  h.field(kCacheFormat).field(shadergenVersion()).field(targetEnvName(m.targetEnv)).field(m.heuristic);
+  h.field(m.optimize ? "optimize" : "no-optimize");
+  h.field(v.rig->path).field(v.pass->fragment);
+  for (const auto& [k, val] : v.params) h.field(k).field(std::to_string(val));
+  h.field("maps");
+  for (const auto& ov : v.pass->maps) {
+    h.field(ov.name);
+    for (const auto& sem : ov.semantics) h.field(sem);
+  }
+  h.field("inputs");
+  for (const auto& f : inputs) h.field(f).field(s.digests.at(f));
+  return h.hex();
+}
+
+// ---- the cache: one file per key, written to a temporary and renamed into place ---------
+
+std::string entryPath(const std::string& dir, const std::string& key) {
+  return (fs::path(dir) / key.substr(0, 2) / key).string();
+}
+
+bool readEntry(const std::string& path, BuiltVariant& out) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  std::string line;
+  if (!std::getline(in, line) || line != kCacheFormat) return false;
+  if (!std::getline(in, line) || line.rfind("cost ", 0) != 0) return false;
+  try {
+    out.cost = std::stoll(line.substr(5));
+  } catch (const std::exception&) {
+    return false;
+  }
+  if (!std::getline(in, line) || line.rfind("rules", 0) != 0) return false;
+  std::istringstream rules(line.substr(5));
+  out.rules.clear();
+  for (std::string r; rules >> r;) out.rules.push_back(r);
+  for (std::string* blob : {&out.glsl, &out.spirv, &out.reflection}) {
+    if (!std::getline(in, line)) return false;
+    size_t n = 0;
+    try {
+      n = std::stoull(line.substr(line.find(' ') + 1));
+    } catch (const std::exception&) {
+      return false;
+    }
+    if (n > (64u << 20)) return false;
+    blob->assign(n, '\0');
+    if (!in.read(blob->data(), static_cast<std::streamsize>(n))) return false;
+  }
+  return in.peek() == std::char_traits<char>::eof() && out.spirv.size() % 4 == 0;
+}
+
+void writeEntry(const std::string& path, const BuiltVariant& v) {
+  std::string rules;
+  for (const auto& r : v.rules) rules += " " + r;
+  std::string text = fmt::format("{}\ncost {}\nrules{}\nglsl {}\n{}spirv {}\n{}reflection {}\n{}", kCacheFormat, v.cost,
+                                 rules, v.glsl.size(), v.glsl, v.spirv.size(), v.spirv, v.reflection.size(), v.reflection);
+  static std::atomic<unsigned> counter{0};
+  std::error_code ec;
+  fs::create_directories(fs::path(path).parent_path(), ec);
+  // Unique per process and write: two builds sharing the cache never see a partial entry.
+  std::string tmp = fmt::format("{}.tmp.{}.{}", path, static_cast<int>(getpid()), counter++);
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) return;  // a read-only cache only costs speed
+    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    if (!out) {
+      out.close();
+      fs::remove(tmp, ec);
+      return;
+    }
+  }
+  fs::rename(tmp, path, ec);
+  if (ec) fs::remove(tmp, ec);
+}
+
+// ---- one variant ------------------------------------------------------------------------
+
+void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v, BuiltVariant& out) {
+  const Rig& base = s.rigs.at(v.rig->path);
+  SourceLoc paramsAt{m.file, 0, 0};
+  for (const auto& a : m.axes)
+    if (v.params.count(a.name)) {
+      paramsAt = a.loc;
+      break;
+    }
+  Rig rig = v.params.empty() ? base : rigWithParameters(base, v.params, paramsAt);
+  LoadedInputs in = instantiateStage(std::move(rig), s.rules, s.fragments.at(v.pass->fragment), v.pass->maps);
+  GenerateOptions o;
+  o.heuristic = m.heuristic;
+  o.targetEnv = m.targetEnv;
+  o.optimize = m.optimize;
+  o.outputName = (fs::path(m.outputDir) / (v.name + ".vert")).string();
+  GenerateResult r = generateWith(std::move(in), s.templates, o);
+  out.cost = r.plan.cost;
+  for (int a : r.plan.actions) out.rules.push_back(r.in.problem.actions[a].name);
+  out.glsl = r.glsl.text;
+  out.spirv.assign(reinterpret_cast<const char*>(r.spirv.words.data()), r.spirv.words.size() * 4);
+  out.reflection = reflectionJson(r.in.rig, r.glsl, r.spirv);
+}
+
+void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts, BuiltVariant& out) {
+  const Variant& v = *out.variant;
+  out.inputs = inputsOf(s, v);
+  out.key = cacheKey(m, s, v, out.inputs);
+  std::string entry = opts.cacheDir.empty() ? "" : entryPath(opts.cacheDir, out.key);
+  BuiltVariant fromCache;
+  if (!entry.empty() && readEntry(entry, fromCache)) {
+    out.cost = fromCache.cost;
+    out.rules = std::move(fromCache.rules);
+    out.glsl = std::move(fromCache.glsl);
+    out.spirv = std::move(fromCache.spirv);
+    out.reflection = std::move(fromCache.reflection);
+    out.ok = out.cached = true;
+  } else {  // a miss, or a damaged entry (read into its own record, so nothing leaks from it)
+    try {
+      generateVariant(m, s, v, out);
+      out.ok = true;
+      if (!entry.empty()) writeEntry(entry, out);
+    } catch (const InputError& e) {
+      out.errors.push_back(e.diagnostic());
+      out.errors.insert(out.errors.end(), e.related.begin(), e.related.end());
+    } catch (const std::exception& e) {
+      out.errors.push_back(Diagnostic{Severity::Error, SourceLoc{m.file, 0, 0}, e.what()});
+    }
+  }
+  if (out.ok) out.spirvHash = sha256Hex(out.spirv);
+}
+
+// ---- the index --------------------------------------------------------------------------
+
+std::string jsonString(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) out += fmt::format("\\u{:04x}", static_cast<int>(c));
+        else out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string relativeTo(const std::string& dir, const std::string& path) {
+  return fs::path(path).lexically_relative(dir).generic_string();
+}
+
+std::string indexJson(const Manifest& m, const BuildReport& r) {
+  std::string out = "{\n";
+  out += fmt::format("  \"shadergen\": {},\n", jsonString(shadergenVersion()));
+  out += fmt::format("  \"target_env\": {},\n", jsonString(targetEnvName(m.targetEnv)));
+  out += fmt::format("  \"optimize\": {},\n", m.optimize ? "true" : "false");
+  std::string rules;
+  for (const auto& f : m.rules) rules += (rules.empty() ? "" : ", ") + jsonString(f);
+  out += fmt::format("  \"rules\": [{}],\n", rules);
+  out += fmt::format("  \"variants\": [\n");
+  for (size_t i = 0; i < r.variants.size(); ++i) {
+    const BuiltVariant& b = r.variants[i];
+    const Variant& v = *b.variant;
+    out += "    {\n";
+    out += fmt::format("      \"name\": {},\n", jsonString(v.name));
+    out += fmt::format("      \"rig\": {},\n", jsonString(v.rig->name));
+    out += fmt::format("      \"rig_file\": {},\n", jsonString(v.rig->path));
+    out += fmt::format("      \"pass\": {},\n", jsonString(v.pass->name));
+    out += fmt::format("      \"fragment_file\": {},\n", jsonString(v.pass->fragment));
+    std::string params;
+    for (const auto& [k, val] : v.params) params += fmt::format("{}{}: {}", params.empty() ? "" : ", ", jsonString(k), val);
+    out += fmt::format("      \"parameters\": {{{}}},\n", params);
+    out += fmt::format("      \"cost\": {},\n", b.cost);
+    std::string rules;
+    for (const auto& rule : b.rules) rules += (rules.empty() ? "" : ", ") + jsonString(rule);
+    out += fmt::format("      \"rules\": [{}],\n", rules);
+    out += fmt::format("      \"spirv_sha256\": {},\n", jsonString(b.spirvHash));
+    std::string outputs;
+    for (const auto& [kind, path] : b.outputs)
+      outputs += fmt::format("{}{}: {}", outputs.empty() ? "" : ", ", jsonString(kind),
+                             jsonString(relativeTo(m.outputDir, path)));
+    out += fmt::format("      \"outputs\": {{{}}}\n", outputs);
+    out += i + 1 < r.variants.size() ? "    },\n" : "    }\n";
+  }
+  out += "  ]\n}\n";
+  return out;
+}
+
+// "target1 target2: dep1 dep2" (Make/Ninja syntax; spaces, '#' and '$' escaped).
+std::string depfile(const std::vector<std::string>& targets, const std::vector<std::string>& deps) {
+  auto esc = [](const std::string& p) {
+    std::string o;
+    for (char c : p) {
+      if (c == ' ' || c == '#') o += '\\';
+      if (c == '$') o += '$';
+      o += c;
+    }
+    return o;
+  };
+  std::string out;
+  for (const auto& t : targets) out += (out.empty() ? "" : " ") + esc(t);
+  out += ":";
+  for (const auto& d : deps) out += " \\\n  " + esc(d);
+  return out + "\n";
+}
+
+}  // namespace
+
+BuildReport buildVariants(const Manifest& m, const std::vector<Variant>& variants, const BuildOptions& opts) {
+  SharedInputs shared = loadShared(m, variants);
+  BuildReport report;
+  report.variants.resize(variants.size());
+  for (size_t i = 0; i < variants.size(); ++i) report.variants[i].variant = &variants[i];
+
+  // Workers take the next variant; results land in their own slot, so the order of the
+  // outputs never depends on the scheduling.
+  std::atomic<size_t> next{0};
+  std::mutex progressLock;
+  size_t done = 0;
+  auto work = [&] {
+    for (size_t i; (i = next++) < variants.size();) {
+      buildOne(m, shared, opts, report.variants[i]);
+      if (opts.progress) {
+        std::lock_guard<std::mutex> lock(progressLock);
+        opts.progress(++done, variants.size(), variants[i].name, report.variants[i].cached);
+      }
+    }
+  };
+  unsigned jobs = opts.jobs ? opts.jobs : std::max(1u, std::thread::hardware_concurrency());
+  jobs = static_cast<unsigned>(std::min<size_t>(jobs, variants.size()));
+  std::vector<std::thread> threads;
+  for (unsigned t = 1; t < jobs; ++t) threads.emplace_back(work);
+  work();
+  for (auto& t : threads) t.join();
+
+  // Outputs, identical SPIR-V once (content-addressed), a depfile per variant, the index.
+  std::set<std::string> spirvWritten;
+  std::set<std::string> allInputs{m.file};
+  for (auto& b : report.variants) {
+    if (!b.ok) {
+      ++report.failed;
+      continue;
+    }
+    ++(b.cached ? report.cached : report.generated);
+    const Variant& v = *b.variant;
+    auto has = [&](const char* kind) { return std::find(m.emit.begin(), m.emit.end(), kind) != m.emit.end(); };
+    std::vector<std::string> targets;
+    if (has("glsl")) {
+      b.outputs["glsl"] = (fs::path(m.outputDir) / (v.name + ".vert")).string();
+      report.files.push_back({b.outputs["glsl"], b.glsl});
+      targets.push_back(b.outputs["glsl"]);
+    }
+    if (has("spv")) {
+      b.outputs["spv"] = (fs::path(m.outputDir) / "spirv" / (b.spirvHash.substr(0, 16) + ".spv")).string();
+      if (spirvWritten.insert(b.spirvHash).second) report.files.push_back({b.outputs["spv"], b.spirv});
+      else ++report.sharedSpirv;
+      targets.push_back(b.outputs["spv"]);
+    }
+    if (has("reflection")) {
+      b.outputs["reflection"] = (fs::path(m.outputDir) / (v.name + ".json")).string();
+      report.files.push_back({b.outputs["reflection"], b.reflection});
+      targets.push_back(b.outputs["reflection"]);
+    }
+    std::vector<std::string> deps{m.file};
+    deps.insert(deps.end(), b.inputs.begin(), b.inputs.end());
+    report.files.push_back({(fs::path(m.outputDir) / (v.name + ".d")).string(), depfile(targets, deps)});
+    allInputs.insert(b.inputs.begin(), b.inputs.end());
+  }
+  if (report.failed == 0) {
+    report.indexPath = (fs::path(m.outputDir) / "index.json").string();
+    report.files.push_back({report.indexPath, indexJson(m, report)});
+    report.files.push_back({report.indexPath + ".d",
+                            depfile({report.indexPath}, std::vector<std::string>(allInputs.begin(), allInputs.end()))});
+  }
+  return report;
+}
+
+}  // namespace sg

@@ -1,0 +1,244 @@
+#include "variants/manifest.h"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <set>
+
+#include "common/yaml_util.h"
+
+namespace sg {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Paths in a manifest are relative to the manifest's folder. Rig paths may carry a glTF
+// selector ("model.glb#0/0"), which stays as it is.
+std::string resolvePath(const std::string& manifestFile, const std::string& p) {
+  if (p.empty() || fs::path(p).is_absolute()) return p;
+  fs::path base = fs::path(manifestFile).parent_path();
+  return (base / p).lexically_normal().string();
+}
+
+std::vector<std::string> scalarOrList(const YamlCtx& y, const YAML::Node& n, const char* what) {
+  std::vector<std::string> out;
+  if (n.IsScalar()) {
+    out.push_back(y.scalar(n, what));
+    return out;
+  }
+  y.expectSeq(n, what);
+  for (const auto& v : n) out.push_back(y.scalar(v, what));
+  return out;
+}
+
+bool safeStem(const std::string& s) {
+  if (s.empty() || s[0] == '.' || s.size() > 200) return false;
+  for (char c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.')) return false;
+  return true;
+}
+
+}  // namespace
+
+Manifest loadManifest(const std::string& path) { return loadManifestText(readInputFile(path), path); }
+
+Manifest loadManifestText(const std::string& text, const std::string& file) {
+  Manifest m;
+  m.file = file;
+  YamlCtx y{file};
+  YAML::Node root = parseYaml(text, file);
+  y.expectMap(root, "a manifest");
+  y.checkKeys(root, {"output", "rules", "templates", "target_env", "optimize", "heuristic", "emit", "rigs", "passes",
+                     "axes", "exclude", "name"});
+  m.outputDir = resolvePath(file, root["output"] ? y.scalar(root["output"], "'output'") : "shaders");
+  if (!root["rules"]) y.fail(root, "the manifest needs 'rules' (a rules file or a list of them)");
+  for (const auto& r : scalarOrList(y, root["rules"], "'rules'")) m.rules.push_back(resolvePath(file, r));
+  if (root["templates"]) m.templates = resolvePath(file, y.scalar(root["templates"], "'templates'"));
+  if (root["target_env"]) {
+    std::string env = y.scalar(root["target_env"], "'target_env'");
+    if (!parseTargetEnv(env, m.targetEnv))
+      y.fail(root["target_env"], fmt::format("unknown target_env '{}' (vulkan1.0, vulkan1.1, vulkan1.2, vulkan1.3)", env));
+  }
+  if (root["optimize"]) m.optimize = y.boolean(root["optimize"], "'optimize'");
+  if (root["heuristic"]) {
+    m.heuristic = y.scalar(root["heuristic"], "'heuristic'");
+    if (m.heuristic != "lmcut" && m.heuristic != "hmax" && m.heuristic != "blind")
+      y.fail(root["heuristic"], fmt::format("unknown heuristic '{}' (lmcut, hmax, blind)", m.heuristic));
+  }
+  if (root["emit"]) {
+    m.emit = scalarOrList(y, root["emit"], "'emit'");
+    static const std::set<std::string> kinds{"glsl", "spv", "reflection"};
+    for (const auto& k : m.emit)
+      if (!kinds.count(k)) y.fail(root["emit"], fmt::format("unknown emit kind '{}' (glsl, spv, reflection)", k));
+    if (m.emit.empty()) y.fail(root["emit"], "'emit' is empty: nothing to write");
+  }
+
+  if (!root["rigs"]) y.fail(root, "the manifest needs 'rigs' (name: rig file)");
+  y.expectMap(root["rigs"], "'rigs'");
+  for (const auto& kv : root["rigs"]) {
+    ManifestRig r;
+    r.name = y.scalar(kv.first, "a rig name");
+    r.loc = locOf(kv.first, file);
+    r.path = resolvePath(file, y.scalar(kv.second, "a rig file"));
+    if (!safeStem(r.name)) y.fail(kv.first, fmt::format("rig name '{}' must be letters, digits, '-', '_' or '.'", r.name));
+    m.rigs.push_back(r);
+  }
+  if (!root["passes"]) y.fail(root, "the manifest needs 'passes' (name: fragment shader)");
+  y.expectMap(root["passes"], "'passes'");
+  for (const auto& kv : root["passes"]) {
+    ManifestPass p;
+    p.name = y.scalar(kv.first, "a pass name");
+    p.loc = locOf(kv.first, file);
+    if (!safeStem(p.name)) y.fail(kv.first, fmt::format("pass name '{}' must be letters, digits, '-', '_' or '.'", p.name));
+    if (kv.second.IsMap()) {
+      y.checkKeys(kv.second, {"fragment", "map"});
+      if (!kv.second["fragment"]) y.fail(kv.second, fmt::format("pass '{}' needs 'fragment'", p.name));
+      p.fragment = resolvePath(file, y.scalar(kv.second["fragment"], "'fragment'"));
+      if (kv.second["map"]) {
+        y.expectMap(kv.second["map"], "'map'");
+        for (const auto& mk : kv.second["map"]) {
+          VaryingOverride ov;
+          ov.name = y.scalar(mk.first, "a fragment input name");
+          ov.semantics = scalarOrList(y, mk.second, "a semantic or a list of semantics");
+          p.maps.push_back(ov);
+        }
+      }
+    } else {
+      p.fragment = resolvePath(file, y.scalar(kv.second, "a fragment shader"));
+    }
+    m.passes.push_back(p);
+  }
+  if (m.rigs.empty()) y.fail(root["rigs"], "'rigs' is empty");
+  if (m.passes.empty()) y.fail(root["passes"], "'passes' is empty");
+
+  std::set<std::string> axisNames;
+  if (root["axes"]) {
+    y.expectMap(root["axes"], "'axes' (axis: [values])");
+    for (const auto& kv : root["axes"]) {
+      ManifestAxis a;
+      a.name = y.scalar(kv.first, "an axis name");
+      a.loc = locOf(kv.first, file);
+      a.values = scalarOrList(y, kv.second, "axis values");
+      if (a.values.empty()) y.fail(kv.second, fmt::format("axis '{}' has no values", a.name));
+      std::set<std::string> seen;
+      for (size_t i = 0; i < a.values.size(); ++i)
+        if (!seen.insert(a.values[i]).second)
+          y.fail(kv.second[i], fmt::format("axis '{}' lists '{}' twice", a.name, a.values[i]));
+      if (!axisNames.insert(a.name).second) y.fail(kv.first, fmt::format("axis '{}' is given twice", a.name));
+      m.axes.push_back(a);
+    }
+  }
+  // Without a rig (pass) axis, every rig (pass) is made.
+  auto implicitAxis = [&](const char* name, std::vector<std::string> values, const SourceLoc& loc, size_t at) {
+    if (axisNames.count(name)) return;
+    m.axes.insert(m.axes.begin() + static_cast<long>(std::min(at, m.axes.size())), ManifestAxis{name, values, loc});
+  };
+  std::vector<std::string> rigNames, passNames;
+  for (const auto& r : m.rigs) rigNames.push_back(r.name);
+  for (const auto& p : m.passes) passNames.push_back(p.name);
+  implicitAxis("rig", rigNames, locOf(root["rigs"], file), 0);
+  implicitAxis("pass", passNames, locOf(root["passes"], file), 1);
+
+  if (root["exclude"]) {
+    y.expectSeq(root["exclude"], "'exclude' (a list of {axis: value} maps)");
+    for (const auto& e : root["exclude"]) {
+      y.expectMap(e, "an exclusion ({axis: value, ...})");
+      ManifestExclusion ex;
+      ex.loc = locOf(e, file);
+      for (const auto& kv : e) {
+        std::string axis = y.scalar(kv.first, "an axis name");
+        auto it = std::find_if(m.axes.begin(), m.axes.end(), [&](const ManifestAxis& a) { return a.name == axis; });
+        if (it == m.axes.end()) y.fail(kv.first, fmt::format("exclusion names unknown axis '{}'", axis));
+        std::string value = y.scalar(kv.second, "an axis value");
+        if (std::find(it->values.begin(), it->values.end(), value) == it->values.end())
+          y.fail(kv.second, fmt::format("axis '{}' has no value '{}'", axis, value));
+        ex.match[axis] = value;
+      }
+      m.exclude.push_back(ex);
+    }
+  }
+  if (root["name"]) {
+    m.nameFormat = y.scalar(root["name"], "'name'");
+    for (size_t i = m.nameFormat.find('{'); i != std::string::npos; i = m.nameFormat.find('{', i + 1)) {
+      size_t close = m.nameFormat.find('}', i);
+      if (close == std::string::npos) y.fail(root["name"], "unterminated '{' in 'name'");
+      std::string axis = m.nameFormat.substr(i + 1, close - i - 1);
+      if (!std::any_of(m.axes.begin(), m.axes.end(), [&](const ManifestAxis& a) { return a.name == axis; }))
+        y.fail(root["name"], fmt::format("'name' uses unknown axis '{{{}}}'", axis));
+    }
+  }
+  return m;
+}
+
+std::vector<Variant> expandVariants(const Manifest& m) {
+  std::vector<Variant> out;
+  std::map<std::string, const Variant*> byName;
+  std::vector<size_t> idx(m.axes.size(), 0);
+  if (m.axes.empty()) return out;
+  for (;;) {
+    Variant v;
+    for (size_t a = 0; a < m.axes.size(); ++a) v.axes.emplace_back(m.axes[a].name, m.axes[a].values[idx[a]]);
+    bool excluded = std::any_of(m.exclude.begin(), m.exclude.end(), [&](const ManifestExclusion& ex) {
+      for (const auto& [axis, value] : ex.match)
+        if (std::find(v.axes.begin(), v.axes.end(), std::make_pair(axis, value)) == v.axes.end()) return false;
+      return true;
+    });
+    if (!excluded) {
+      for (size_t a = 0; a < m.axes.size(); ++a) {
+        const ManifestAxis& axis = m.axes[a];
+        const std::string& value = axis.values[idx[a]];
+        if (axis.name == "rig") {
+          for (const auto& r : m.rigs)
+            if (r.name == value) v.rig = &r;
+          if (!v.rig) throw InputError(axis.loc, fmt::format("axis 'rig': no rig named '{}' in 'rigs'", value));
+        } else if (axis.name == "pass") {
+          for (const auto& p : m.passes)
+            if (p.name == value) v.pass = &p;
+          if (!v.pass) throw InputError(axis.loc, fmt::format("axis 'pass': no pass named '{}' in 'passes'", value));
+        } else {
+          size_t used = 0;
+          long long n = 0;
+          try {
+            n = std::stoll(value, &used);
+          } catch (const std::exception&) {
+            used = 0;
+          }
+          if (used != value.size() || n < 0)
+            throw InputError(axis.loc, fmt::format("axis '{}' sets a rig parameter: '{}' is not a non-negative integer",
+                                                   axis.name, value));
+          v.params[axis.name] = n;
+        }
+      }
+      if (m.nameFormat.empty()) {
+        for (const auto& [axis, value] : v.axes)
+          v.name += (v.name.empty() ? "" : "-") + (axis == "rig" || axis == "pass" ? value : axis + value);
+      } else {
+        v.name = m.nameFormat;
+        for (const auto& [axis, value] : v.axes)
+          for (size_t p; (p = v.name.find("{" + axis + "}")) != std::string::npos;)
+            v.name.replace(p, axis.size() + 2, value);
+      }
+      if (!safeStem(v.name))
+        throw InputError(m.axes.front().loc,
+                         fmt::format("variant name '{}' is not a safe file name (letters, digits, '-', '_', '.')", v.name));
+      out.push_back(std::move(v));
+    }
+    // Next combination: the last axis varies fastest.
+    size_t a = m.axes.size();
+    while (a > 0) {
+      --a;
+      if (++idx[a] < m.axes[a].values.size()) break;
+      idx[a] = 0;
+      if (a == 0) goto done;
+    }
+  }
+done:
+  for (const auto& v : out)
+    if (!byName.emplace(v.name, &v).second)
+      throw InputError(SourceLoc{m.file, 0, 0},
+                       fmt::format("two variants are both named '{}': put every axis in 'name'", v.name));
+  if (out.empty()) throw InputError(SourceLoc{m.file, 0, 0}, "the exclusions leave no variant to build");
+  return out;
+}
+
+}  // namespace sg

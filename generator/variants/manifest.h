@@ -1,0 +1,77 @@
+// A variant manifest (`shadergen build MANIFEST.yaml`, docs/variants.md): named rigs,
+// fragment shaders (passes) and rules, and variant axes whose product, minus the
+// exclusions, is the set of vertex shaders to make.
+#pragma once
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "common/diagnostics.h"
+#include "common/glsl_compile.h"
+#include "interface/fragment_interface.h"
+
+namespace sg {
+
+struct ManifestPass {
+  std::string name;
+  std::string fragment;                  // path
+  std::vector<VaryingOverride> maps;     // like --map
+  SourceLoc loc;
+};
+
+struct ManifestRig {
+  std::string name;
+  std::string path;  // YAML rig or MODEL.glb#m/p
+  SourceLoc loc;
+};
+
+// One axis: `rig` and `pass` pick named rigs and passes; any other axis sets the rig
+// deformer parameter of that name (morph_targets, influences, ...).
+struct ManifestAxis {
+  std::string name;
+  std::vector<std::string> values;
+  SourceLoc loc;
+};
+
+struct ManifestExclusion {
+  std::map<std::string, std::string> match;  // axis -> value; a variant matching all is left out
+  SourceLoc loc;
+};
+
+struct Manifest {
+  std::string file;
+  std::string outputDir;               // relative paths resolved against the manifest
+  std::vector<std::string> rules;
+  std::string templates;               // "" = the default templates
+  std::vector<ManifestRig> rigs;
+  std::vector<ManifestPass> passes;
+  std::vector<ManifestAxis> axes;      // in manifest order (the first varies slowest)
+  std::vector<ManifestExclusion> exclude;
+  std::string nameFormat;              // "{rig}-{pass}-m{morph_targets}"; default: every axis joined by '-'
+  std::vector<std::string> emit{"glsl", "spv", "reflection"};
+  TargetEnv targetEnv = TargetEnv::Vulkan1_0;
+  bool optimize = false;
+  std::string heuristic = "lmcut";
+};
+
+// One shader to make.
+struct Variant {
+  std::string name;  // unique; a safe file stem
+  const ManifestRig* rig = nullptr;
+  const ManifestPass* pass = nullptr;
+  std::map<std::string, int64_t> params;           // deformer parameters set by axes
+  std::vector<std::pair<std::string, std::string>> axes;  // axis -> value, in axis order
+};
+
+// Loads and checks a manifest; paths are made relative to the working directory.
+// Throws InputError (file:line:col) on malformed input.
+Manifest loadManifest(const std::string& path);
+Manifest loadManifestText(const std::string& text, const std::string& file);
+
+// The product of the axes minus the exclusions, in a stable order. Throws InputError for
+// duplicate variant names, unknown rigs/passes, non-integer parameter values, names that
+// are not safe file names, and an empty product.
+std::vector<Variant> expandVariants(const Manifest& m);
+
+}  // namespace sg

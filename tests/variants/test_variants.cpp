@@ -1,0 +1,251 @@
+// `shadergen build`: manifests (every error located), the variant product, outputs
+// byte-identical to one generate() per variant, the content cache across builds (only
+// changed inputs regenerate; damaged entries are misses), shared SPIR-V, determinism
+// whatever the thread count, and failures that leave the index out.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "core_test_util.h"
+#include "emit/reflection.h"
+#include "pipeline/generate.h"
+#include "variants/builder.h"
+#include "variants/content_hash.h"
+#include "variants/manifest.h"
+
+namespace fs = std::filesystem;
+using namespace sg;
+using sgtest::errorOf;
+using sgtest::freshDir;
+using sgtest::writeText;
+
+namespace {
+
+const std::string kDawn = std::string(SG_SOURCE_DIR) + "/examples/dawn/";
+
+std::string readAll(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// A small manifest over copies of the Dawn rigs (the tests edit them).
+fs::path smallManifest(const fs::path& dir, const std::string& extra = "") {
+  fs::copy_file(kDawn + "face.rig.yaml", dir / "face.rig.yaml");
+  fs::copy_file(kDawn + "body.rig.yaml", dir / "body.rig.yaml");
+  writeText(dir / "shadow.frag", "#version 450\nlayout(location = 0) out float D;\nvoid main() { D = gl_FragCoord.z; }\n");
+  writeText(dir / "m.yaml", "output: out\n"
+                            "rules: " + kDawn + "rules.yaml\n"
+                            "rigs:\n  face: face.rig.yaml\n  body: body.rig.yaml\n"
+                            "passes:\n  color: " + kDawn + "face.frag\n  depth: " + kDawn + "depth.frag\n"
+                            "  shadow: shadow.frag\n"
+                            "axes:\n  morph_targets: [2, 0]\n  influences: [4, 1]\n"
+                            "exclude:\n  - { rig: body, morph_targets: 2 }\n" + extra);
+  return dir / "m.yaml";
+}
+
+std::map<std::string, std::string> filesOf(const BuildReport& r) {
+  std::map<std::string, std::string> m;
+  for (const auto& f : r.files) m[f.path] = f.contents;
+  return m;
+}
+
+}  // namespace
+
+TEST(Sha256, KnownVectors) {
+  EXPECT_EQ(sha256Hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(sha256Hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  // 56 bytes: the padding spills into a second block.
+  EXPECT_EQ(sha256Hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+  std::string million(1000000, 'a');
+  EXPECT_EQ(sha256Hex(million), "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+  // Fed in pieces: the same digest.
+  Sha256 h;
+  for (size_t i = 0; i < million.size(); i += 777) h.update(std::string_view(million).substr(i, 777));
+  EXPECT_EQ(h.hex(), sha256Hex(million));
+}
+
+TEST(Manifest, ProductMinusExclusionsInOrder) {
+  auto dir = freshDir("m");
+  Manifest m = loadManifest(smallManifest(dir).string());
+  std::vector<Variant> v = expandVariants(m);
+  // rig(2) x pass(3) x morph(2) x influences(2) = 24, minus body x m2 (3 passes x 2) = 18.
+  ASSERT_EQ(v.size(), 18u);
+  EXPECT_EQ(v.front().name, "face-color-morph_targets2-influences4");
+  EXPECT_EQ(v[1].name, "face-color-morph_targets2-influences1");
+  EXPECT_EQ(v.back().name, "body-shadow-morph_targets0-influences1");
+  std::set<std::string> names;
+  for (const auto& x : v) {
+    names.insert(x.name);
+    EXPECT_FALSE(x.rig->name == "body" && x.params.at("morph_targets") == 2) << x.name;
+  }
+  EXPECT_EQ(names.size(), v.size());
+}
+
+TEST(Manifest, ErrorsAreLocated) {
+  auto dir = freshDir("e");
+  auto fail = [&](const std::string& text) {
+    writeText(dir / "bad.yaml", text);
+    return errorOf([&] { expandVariants(loadManifest((dir / "bad.yaml").string())); });
+  };
+  const std::string head = "rules: r.yaml\nrigs:\n  face: f.rig.yaml\npasses:\n  color: c.frag\n";
+  auto d = fail(head + "axes:\n  rig: [face, bdy]\n");
+  EXPECT_NE(d.message.find("no rig named 'bdy'"), std::string::npos) << d.message;
+  EXPECT_EQ(d.loc.line, 7);
+  d = fail(head + "outptu: x\n");
+  EXPECT_NE(d.message.find("outptu"), std::string::npos) << d.message;
+  EXPECT_EQ(d.loc.line, 6);
+  d = fail(head + "axes:\n  influences: [4, four]\n");
+  EXPECT_NE(d.message.find("'four' is not a non-negative integer"), std::string::npos) << d.message;
+  d = fail(head + "axes:\n  influences: [4, 4]\n");
+  EXPECT_NE(d.message.find("twice"), std::string::npos) << d.message;
+  d = fail(head + "axes:\n  influences: [4]\nexclude:\n  - { influences: 2 }\n");
+  EXPECT_NE(d.message.find("no value '2'"), std::string::npos) << d.message;
+  EXPECT_EQ(d.loc.line, 9);
+  d = fail(head + "axes:\n  influences: [4]\nexclude:\n  - { influences: 4 }\n");
+  EXPECT_NE(d.message.find("no variant"), std::string::npos) << d.message;
+  d = fail(head + "axes:\n  influences: [4, 1]\nname: \"{rig}\"\n");
+  EXPECT_NE(d.message.find("both named 'face'"), std::string::npos) << d.message;
+  d = fail(head + "name: \"{rig}/../x\"\n");
+  EXPECT_NE(d.message.find("not a safe file name"), std::string::npos) << d.message;
+  d = fail(head + "name: \"{lod}\"\n");
+  EXPECT_NE(d.message.find("unknown axis '{lod}'"), std::string::npos) << d.message;
+  d = fail("rigs: [a, b]\n");
+  EXPECT_EQ(d.loc.file, (dir / "bad.yaml").string());
+  EXPECT_GT(d.loc.line, 0);
+}
+
+// Every output equals what generate() makes for the same rig, parameters and pass.
+TEST(Build, OutputsAreGeneratesBytes) {
+  auto dir = freshDir("b");
+  Manifest m = loadManifest(smallManifest(dir).string());
+  std::vector<Variant> variants = expandVariants(m);
+  BuildOptions bo;
+  bo.jobs = 2;
+  BuildReport r = buildVariants(m, variants, bo);
+  ASSERT_EQ(r.failed, 0u);
+  EXPECT_EQ(r.generated, variants.size());
+  auto files = filesOf(r);
+  std::map<std::string, std::set<std::string>> pathsOfModule;  // SPIR-V bytes -> output paths
+  for (const auto& b : r.variants) {
+    const Variant& v = *b.variant;
+    GenerateOptions o;
+    o.rigPath = v.rig->path;
+    o.fragmentPath = v.pass->fragment;
+    o.rulesPaths = m.rules;
+    o.rigParams = v.params;
+    o.outputName = b.outputs.at("glsl");
+    GenerateResult g = generate(o);
+    EXPECT_EQ(files.at(b.outputs.at("glsl")), g.glsl.text) << v.name;
+    std::string spv(reinterpret_cast<const char*>(g.spirv.words.data()), g.spirv.words.size() * 4);
+    EXPECT_EQ(files.count(b.outputs.at("spv")) ? files.at(b.outputs.at("spv")) : b.spirv, spv) << v.name;
+    EXPECT_EQ(b.spirv, spv) << v.name;
+    EXPECT_EQ(files.at(b.outputs.at("reflection")), reflectionJson(g.in.rig, g.glsl, g.spirv)) << v.name;
+    EXPECT_EQ(b.cost, g.plan.cost) << v.name;
+    pathsOfModule[spv].insert(b.outputs.at("spv"));
+  }
+  // Identical SPIR-V is one file (the depth and shadow passes feed no varyings: at least
+  // those pairs), different SPIR-V different files.
+  std::set<std::string> allPaths;
+  for (const auto& [bytes, paths] : pathsOfModule) {
+    EXPECT_EQ(paths.size(), 1u);
+    allPaths.insert(paths.begin(), paths.end());
+  }
+  EXPECT_EQ(allPaths.size(), pathsOfModule.size());
+  EXPECT_EQ(r.sharedSpirv, variants.size() - pathsOfModule.size());
+  EXPECT_GE(r.sharedSpirv, 6u);
+  size_t spirvFiles = 0;
+  for (const auto& [path, bytes] : files) spirvFiles += path.find("/spirv/") != std::string::npos;
+  EXPECT_EQ(spirvFiles, pathsOfModule.size());
+  // The index and the depfiles.
+  ASSERT_FALSE(r.indexPath.empty());
+  const std::string& index = files.at(r.indexPath);
+  EXPECT_NE(index.find("\"name\": \"face-color-morph_targets2-influences4\""), std::string::npos);
+  EXPECT_NE(index.find("\"cost\": " + std::to_string(r.variants[0].cost)), std::string::npos);
+  const std::string& dep = files.at((fs::path(m.outputDir) / "face-color-morph_targets2-influences4.d").string());
+  EXPECT_NE(dep.find("face.rig.yaml"), std::string::npos);
+  EXPECT_NE(dep.find("standard.yaml"), std::string::npos);  // included by the rules file
+  EXPECT_EQ(dep.find("body.rig.yaml"), std::string::npos);
+  EXPECT_NE(files.at(r.indexPath + ".d").find("body.rig.yaml"), std::string::npos);
+}
+
+TEST(Build, CacheRegeneratesOnlyWhatChanged) {
+  auto dir = freshDir("c");
+  Manifest m = loadManifest(smallManifest(dir).string());
+  std::vector<Variant> variants = expandVariants(m);
+  BuildOptions bo;
+  bo.cacheDir = (dir / "cache").string();
+  BuildReport cold = buildVariants(m, variants, bo);
+  ASSERT_EQ(cold.generated, variants.size());
+  BuildReport warm = buildVariants(m, variants, bo);
+  EXPECT_EQ(warm.cached, variants.size());
+  EXPECT_EQ(warm.generated, 0u);
+  EXPECT_EQ(filesOf(warm), filesOf(cold));
+  // Editing the face rig (bytes, not meaning) regenerates the face's variants only.
+  { std::ofstream(dir / "face.rig.yaml", std::ios::app) << "# edited\n"; }
+  BuildReport edited = buildVariants(m, variants, bo);
+  size_t face = 0;
+  for (const auto& v : variants) face += v.rig->name == "face";
+  EXPECT_EQ(edited.generated, face);
+  EXPECT_EQ(edited.cached, variants.size() - face);
+  EXPECT_EQ(filesOf(edited), filesOf(cold));  // a comment changes no output
+  // A damaged entry is a miss, regenerated to the same bytes.
+  size_t damaged = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir / "cache"))
+    if (e.is_regular_file() && damaged++ < 3) fs::resize_file(e.path(), fs::file_size(e.path()) / 2);
+  BuildReport repaired = buildVariants(m, variants, bo);
+  EXPECT_EQ(repaired.generated + repaired.cached, variants.size());
+  EXPECT_LE(repaired.generated, 3u);  // stale entries of the unedited face may be among the damaged
+  auto same = filesOf(cold);
+  for (const auto& [path, bytes] : filesOf(repaired)) EXPECT_TRUE(same[path] == bytes) << path;
+  // A different option is a different key.
+  Manifest opt = m;
+  opt.optimize = true;
+  EXPECT_EQ(buildVariants(opt, expandVariants(opt), bo).generated, variants.size());
+}
+
+TEST(Build, SameBytesWhateverTheThreadCount) {
+  auto dir = freshDir("t");
+  Manifest m = loadManifest(smallManifest(dir).string());
+  std::vector<Variant> variants = expandVariants(m);
+  BuildOptions one, many;
+  one.jobs = 1;
+  many.jobs = 5;
+  EXPECT_EQ(filesOf(buildVariants(m, variants, one)), filesOf(buildVariants(m, variants, many)));
+}
+
+TEST(Build, AFailingVariantIsReportedAndLeavesTheIndexOut) {
+  auto dir = freshDir("f");
+  // Eight influences need a second weights/joints stream the Dawn rigs do not have.
+  Manifest m = loadManifest(smallManifest(dir, "").string());
+  m.axes.back().values.push_back("8");
+  std::vector<Variant> variants = expandVariants(m);
+  BuildReport r = buildVariants(m, variants, {});
+  size_t eight = 0;
+  for (const auto& b : r.variants) {
+    bool isEight = b.variant->params.at("influences") == 8;
+    eight += isEight;
+    EXPECT_EQ(b.ok, !isEight) << b.variant->name;
+    if (isEight) {
+      ASSERT_FALSE(b.errors.empty());
+      EXPECT_FALSE(b.errors.front().loc.file.empty()) << b.errors.front().message;
+    }
+  }
+  EXPECT_EQ(r.failed, eight);
+  EXPECT_TRUE(r.indexPath.empty());
+  for (const auto& f : r.files) EXPECT_EQ(f.path.find("index.json"), std::string::npos) << f.path;
+}
+
+TEST(Build, MissingSharedInputIsALocatedError) {
+  auto dir = freshDir("s");
+  Manifest m = loadManifest(smallManifest(dir).string());
+  fs::remove(dir / "body.rig.yaml");
+  auto d = errorOf([&] { buildVariants(m, expandVariants(m), {}); });
+  EXPECT_NE(d.loc.file.find("body.rig.yaml"), std::string::npos) << d.loc.file << ": " << d.message;
+}
