@@ -12,6 +12,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
+#include <fstream>
 #include <map>
 #include <string>
 #include <vector>
@@ -147,9 +149,44 @@ bool runs(int rules, const std::string& name) {
   return false;
 }
 
+// --write-library DIR RULES SEED: the same library as files `shadergen generate` reads
+// (lib.rules.yaml on top of the standard rules, lib.rig.yaml, lib.frag), for the whole
+// generate wall time (bench/generate_wall.sh). Every semantic is a float; the rig's
+// inputs are uniforms (a library has more of them than a vertex has attributes).
+int writeLibrary(const std::string& dir, int rules, uint64_t seed) {
+  sg::Problem p = sgtest::randomLibrary(sgtest::LibraryShape{rules, seed});
+  auto sem = [&](int f) { return "lib." + p.facts[f].name; };
+  std::ofstream r(dir + "/lib.rules.yaml"), g(dir + "/lib.rig.yaml"), fr(dir + "/lib.frag");
+  r << "# Synthetic library: " << rules << " rules, seed " << seed << " (bench/bench_search.cpp)\nsemantics:\n";
+  for (size_t f = 0; f < p.facts.size(); ++f) r << "  " << sem(static_cast<int>(f)) << ": float\n";
+  r << "varyings:\n";
+  for (size_t i = 0; i < p.goals.size(); ++i) r << "  G" << i << ": " << sem(p.goals[i]) << "\n";
+  r << "rules:\n";
+  for (const auto& a : p.actions) {
+    r << "  - name: " << a.name << "\n    produces: " << sem(a.add) << "\n    needs: [";
+    std::string expr;
+    for (size_t i = 0; i < a.pre.size(); ++i) {
+      r << (i ? ", " : "") << sem(a.pre[i]);
+      expr += (i ? " + " : "") + std::string("${") + sem(a.pre[i]) + "}";
+    }
+    r << "]\n    cost: " << a.cost << "\n    glsl: |\n      ${out} = 0.5 * (" << expr << ");\n";
+  }
+  g << "rig: library\nattributes:\n  position: { format: float32x3, provides: vertex.position }\nuniforms:\n"
+    << "  model: { type: mat4, semantic: model.matrix }\n  view_proj: { type: mat4, semantic: camera.view_projection }\n";
+  for (int f : p.init) g << "  " << p.facts[f].name << ": { type: float, semantic: " << sem(f) << " }\n";
+  fr << "#version 450\n";
+  for (size_t i = 0; i < p.goals.size(); ++i) fr << "layout(location = " << i << ") in float G" << i << ";\n";
+  fr << "layout(location = 0) out vec4 color;\nvoid main() {\n  color = vec4(0.0";
+  for (size_t i = 0; i < p.goals.size(); ++i) fr << " + G" << i;
+  fr << ");\n}\n";
+  return r && g && fr ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc == 5 && std::string(argv[1]) == "--write-library")
+    return writeLibrary(argv[2], std::atoi(argv[3]), std::strtoull(argv[4], nullptr, 10));
   for (const Solver& s : kSolvers)
     benchmark::RegisterBenchmark((std::string("BM_Dawn/") + s.name).c_str(), BM_Dawn, s)
         ->Unit(benchmark::kMicrosecond)

@@ -147,7 +147,8 @@ std::string findOnPath(const std::string& program) {
     std::string dir = all.substr(start, colon == std::string::npos ? std::string::npos : colon - start);
     if (!dir.empty()) {
       std::string full = dir + "/" + program;
-      if (::access(full.c_str(), X_OK) == 0 && !std::filesystem::is_directory(full)) return full;
+      std::error_code ec;  // a strange PATH entry must not throw
+      if (::access(full.c_str(), X_OK) == 0 && !std::filesystem::is_directory(full, ec)) return full;
     }
     if (colon == std::string::npos) break;
     start = colon + 1;

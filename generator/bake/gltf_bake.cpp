@@ -30,28 +30,6 @@ namespace {
 
 [[noreturn]] void fail(const std::string& file, const std::string& msg) { throw InputError(SourceLoc{file, 0, 0}, msg); }
 
-bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
-  return true;  // textures are carried through untouched, never decoded
-}
-
-tinygltf::Model loadModel(const std::string& file) {
-  tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(skipImage, nullptr);
-  tinygltf::Model model;
-  std::string err, warn;
-  std::string ext = std::filesystem::path(file).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) fail(file, "cannot open the glTF model (no such file)");
-  bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, file)
-                          : loader.LoadASCIIFromFile(&model, &err, &warn, file);
-  if (!ok) {
-    while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();
-    fail(file, "cannot load the glTF model: " + (err.empty() ? std::string("unknown error") : err));
-  }
-  return model;
-}
-
 // The primitive's triangles as vertex index triples: strips and fans are expanded; points
 // and lines have none (their vertices are baked, but block nothing).
 std::vector<std::array<uint32_t, 3>> primitiveTriangles(const tinygltf::Model& m, const tinygltf::Primitive& p,
@@ -74,9 +52,14 @@ std::vector<std::array<uint32_t, 3>> primitiveTriangles(const tinygltf::Model& m
     size_t stride = v.byteStride ? v.byteStride : static_cast<size_t>(size);
     if (v.buffer < 0 || static_cast<size_t>(v.buffer) >= m.buffers.size())
       fail(file, fmt::format("{}: the index buffer view refers to a missing buffer", where));
+    if (a.count > kMaxGltfElements)
+      fail(file, fmt::format("{}: {} indices exceed the limit of {}", where, a.count, kMaxGltfElements));
     const auto& buf = m.buffers[static_cast<size_t>(v.buffer)].data;
-    size_t need = a.count == 0 ? 0 : a.byteOffset + (a.count - 1) * stride + static_cast<size_t>(size);
-    if (need > v.byteLength || v.byteOffset + v.byteLength > buf.size())
+    // Overflow-free: count ≤ 2^24 and stride < 2^8 keep the product small; offsets are
+    // compared by subtraction.
+    size_t span = a.count == 0 ? 0 : (a.count - 1) * stride + static_cast<size_t>(size);
+    if (v.byteOffset > buf.size() || v.byteLength > buf.size() - v.byteOffset || a.byteOffset > v.byteLength ||
+        span > v.byteLength - a.byteOffset || stride > 255)
       fail(file, fmt::format("{}: indices read past the end of buffer view {}", where, a.bufferView));
     const unsigned char* base = buf.data() + v.byteOffset + a.byteOffset;
     idx.resize(a.count);
@@ -173,7 +156,13 @@ Posed posePrimitive(const PrimitiveData& p, const Instance& inst, int target, co
         if (jt == d.streams.end() || wt == d.streams.end()) break;
         for (size_t c = 0; c < 4; ++c) {
           double w = wt->second[v][c];
-          if (w != 0) M += w * joints[static_cast<size_t>(jt->second[v][c])];
+          size_t j = static_cast<size_t>(jt->second[v][c]);  // checked against the import's skin
+          if (j >= joints.size())
+            throw InputError(SourceLoc{d.file, 0, 0},
+                             fmt::format("node '{}' draws mesh '{}' with skin {}, which has {} joints; vertex {} uses "
+                                         "joint {}",
+                                         node->name, d.meshName, skin, joints.size(), v, j));
+          if (w != 0) M += w * joints[j];
         }
       }
     }
@@ -254,7 +243,8 @@ int appendScalarAccessor(tinygltf::Model& m, const std::vector<float>& values) {
 }  // namespace
 
 GltfBakeResult bakeGltfOcclusion(const std::string& file, const GltfBakeOptions& opts) {
-  tinygltf::Model model = loadModel(file);
+  tinygltf::Model model;
+  loadGltfModel(file, model);  // the rig import's checked loader (docs/limits.md)
   if (model.meshes.empty()) fail(file, "the model has no meshes: nothing to bake");
   GltfBakeResult result;
 
@@ -416,6 +406,11 @@ GltfBakeResult bakeGltfOcclusion(const std::string& file, const GltfBakeOptions&
     if (!img.uri.empty() && img.uri.rfind("data:", 0) != 0)
       result.notes.push_back(fmt::format("image '{}' stays an external reference ('{}'), relative to the output file",
                                          img.name, img.uri));
+
+  result.inputs.push_back(file);
+  for (const auto& b : model.buffers)
+    if (!b.uri.empty() && b.uri.rfind("data:", 0) != 0)
+      result.inputs.push_back((std::filesystem::path(file).parent_path() / b.uri).string());
 
   // Every buffer is embedded: buffer 0 in the GLB binary chunk, the others as data URIs.
   for (auto& b : model.buffers) b.uri.clear();

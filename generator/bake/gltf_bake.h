@@ -38,6 +38,7 @@ struct GltfBakeResult {
   size_t triangles = 0;  // in the base scene
   int passes = 0;        // BVH builds: 1 + one per morph target
   std::vector<std::string> notes;  // warnings (vertices without a normal, ...)
+  std::vector<std::string> inputs;  // the model and the buffer files it names (never to be overwritten)
 };
 
 // Throws InputError (file: error: ...) for unreadable models and for primitives the rig

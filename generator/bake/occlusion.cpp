@@ -154,9 +154,10 @@ double defaultOffset(const TriangleSoup& scene) {
   Vec3 lo = scene.positions[0], hi = lo;
   for (const auto& p : scene.positions)
     for (size_t c = 0; c < 3; ++c) lo[c] = std::min(lo[c], p[c]), hi[c] = std::max(hi[c], p[c]);
-  Vec3 d = sub(hi, lo);
-  double diag = std::sqrt(static_cast<double>(dot(d, d)));
-  return diag > 0 ? 1e-5 * diag : 1e-6;
+  double sq = 0;  // in double: float coordinates near 1e20 would overflow the square
+  for (size_t c = 0; c < 3; ++c) sq += (double(hi[c]) - lo[c]) * (double(hi[c]) - lo[c]);
+  double diag = std::sqrt(sq);
+  return diag > 0 && std::isfinite(diag) ? 1e-5 * diag : 1e-6;
 }
 
 Vec3 hemisphereDirection(const Vec3& n, Distribution dist, uint64_t seed, uint64_t stream, int i) {

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -39,6 +40,8 @@ struct BakeOcclusionCommand {
     if (ext != ".glb" && ext != ".gltf")
       throw CLI::ValidationError("--output", fmt::format("'{}' must end in .glb or .gltf", output));
     if (!animation.empty() && !time) throw CLI::ValidationError("--animation", "needs --time");
+    if (time && !std::isfinite(*time)) throw CLI::ValidationError("--time", "must be a finite number of seconds");
+    refuseClobbering({output}, {{model, "the glTF model"}});  // before the work; buffer files after
     bake::GltfBakeOptions o;
     o.occlusion.rays = rays;
     o.occlusion.distribution = distribution == "cosine" ? bake::Distribution::Cosine : bake::Distribution::Uniform;
@@ -55,10 +58,14 @@ struct BakeOcclusionCommand {
         std::cerr << fmt::format("\r\033[K[{}/{}] {}: {}%", pass, passes, what, total ? done * 100 / total : 100)
                   << std::flush;
       };
+    refuseClobbering({output}, {{model, "the glTF model"}});  // before the (long) bake
     auto start = std::chrono::steady_clock::now();
     bake::GltfBakeResult r = bake::bakeGltfOcclusion(model, o);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (tty) std::cerr << "\r\033[K" << std::flush;
+    std::vector<InputFile> inputs;
+    for (const auto& in : r.inputs) inputs.push_back({in, in == model ? "the glTF model" : "a buffer file of the model"});
+    refuseClobbering({output}, inputs);
     writeFilesAtomically({PendingFile{output, r.bytes}});
     if (!quiet) {
       for (const auto& n : r.notes) std::cerr << fmt::format("{}: warning: {}\n", model, n);
@@ -96,13 +103,14 @@ void registerBake(CLI::App& app, CliState& state) {
                   "cosine: blocked fraction of cosine-weighted sky light (ambient occlusion)")
       ->check(CLI::IsMember({"uniform", "cosine"}));
   occ->add_option("--max-distance", cmd->maxDistance, "Hits farther than this do not block (default: unlimited)")
-      ->check(CLI::PositiveNumber);
+      ->check(finiteNumber(true));
   occ->add_option("--offset", cmd->offset,
                   "Ray origins move this far along the normal (default: 1e-5 of the scene's diagonal)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finiteNumber(false));
   occ->add_option("--seed", cmd->seed, "Random seed (default 1); the result does not depend on --threads");
   occ->add_option("--threads", cmd->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
-  occ->add_option("--time", cmd->time, "Pose at this animation time in seconds (default: bind pose)");
+  occ->add_option("--time", cmd->time, "Pose at this animation time in seconds (default: bind pose)")
+      ->check(finiteNumber(false));
   occ->add_option("--animation", cmd->animation, "With --time: animation name or index (default: the first)");
   occ->add_flag("-q,--quiet", cmd->quiet, "No progress, summary or warnings");
   occ->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });

@@ -18,7 +18,7 @@ void GenerateArgs::add(CLI::App& cmd) {
   cmd.add_option("--fragment,-f", opts.fragmentPath, "Fragment shader whose inputs must be fed (GLSL 450)")->required();
   cmd.add_option("--rules,-r", opts.rulesPaths, "Rules file(s) (YAML)")->required();
   cmd.add_option("--map", maps, "Map a fragment input to semantics: Name=sem or Name=s1,s2,... (packs)");
-  cmd.add_option("--heuristic", opts.heuristic, "A* heuristic: lmcut (default), hmax, blind")
+  cmd.add_option("--heuristic", opts.heuristic, "A* heuristic (either engine): lmcut (default), hmax, blind")
       ->check(CLI::IsMember({"lmcut", "hmax", "blind"}));
   cmd.add_option("--search", opts.searchEngine,
                  "Search engine: auto (default: regression A* on acyclic rule graphs, else forward A*), "
@@ -26,7 +26,7 @@ void GenerateArgs::add(CLI::App& cmd) {
       ->check(CLI::IsMember({"auto", "regression", "forward", "ip"}));
   cmd.add_option("--search-time-limit", opts.searchLimits.maxSeconds,
                  "Give up (error) when one search runs longer than this many seconds (0 = no limit)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finiteNumber(false));
   cmd.add_option("--max-expansions", opts.searchLimits.maxExpansions,
                  "Give up (error) after this many A* expansions")
       ->check(CLI::PositiveNumber);

@@ -1,8 +1,6 @@
 // `shadergen validate`: generate, run on lavapipe, compare with the GLM reference.
 #include <fmt/format.h>
 
-#include <cmath>
-#include <cstdlib>
 #include <iostream>
 
 #include "cli/commands.h"
@@ -69,15 +67,7 @@ void registerValidate(CLI::App& app, CliState& state) {
       ->check(CLI::IsMember({"head", "limb", "dawn"}));
   sub->add_option("--seed", cmd->seed, "Seed of the random poses");
   sub->add_option("--poses", cmd->poses, "Number of random poses")->check(CLI::Range(1, 100));
-  // CLI11 reads "nan", "inf" and "-1" as doubles; none is a time or a tolerance.
-  CLI::Validator finiteNonNegative(
-      [](std::string& s) -> std::string {
-        char* end = nullptr;
-        double v = std::strtod(s.c_str(), &end);
-        if (s.empty() || *end != '\0' || !std::isfinite(v) || v < 0) return "must be a finite number >= 0, got '" + s + "'";
-        return "";
-      },
-      "NUMBER >= 0");
+  CLI::Validator finiteNonNegative = finiteNumber(false);  // no nan, inf or negative times and tolerances
   sub->add_option("--time", cmd->times, "glTF rig (MODEL.glb#m/p): animation time in seconds (repeatable)")
       ->check(finiteNonNegative);
   sub->add_option("--animation", cmd->animation, "glTF rig: animation name or index (default: the first)");

@@ -1,6 +1,22 @@
 #include "cli/commands.h"
 
+#include <cmath>
+#include <cstdlib>
+
+#include <fmt/format.h>
+
 namespace sg {
+
+CLI::Validator finiteNumber(bool positive) {
+  return CLI::Validator(
+      [positive](std::string& s) -> std::string {
+        char* end = nullptr;
+        double v = std::strtod(s.c_str(), &end);
+        bool ok = !s.empty() && *end == '\0' && std::isfinite(v) && (positive ? v > 0 : v >= 0);
+        return ok ? "" : fmt::format("must be a finite number {} 0, got '{}'", positive ? ">" : ">=", s);
+      },
+      positive ? "NUMBER > 0" : "NUMBER >= 0");
+}
 
 void registerCommands(CLI::App& app, CliState& state) {
   registerGenerate(app, state);

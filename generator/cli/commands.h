@@ -30,6 +30,10 @@ struct GenerateArgs {
 // Every file `in` was loaded from (plus `extra`), named for refuseClobbering (output_files.h).
 std::vector<InputFile> inputFiles(const LoadedInputs& in, const std::vector<std::string>& extra = {});
 
+// CLI11's NonNegativeNumber/PositiveNumber let "nan" and "inf" through (every comparison
+// with NaN is false); this refuses them: "must be a finite number >= 0, got 'nan'".
+CLI::Validator finiteNumber(bool positive);
+
 void registerCommands(CLI::App& app, CliState& state);
 void registerGenerate(CLI::App& app, CliState& state);
 void registerValidate(CLI::App& app, CliState& state);

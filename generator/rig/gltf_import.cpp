@@ -631,7 +631,11 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   for (const auto& [name, idx] : prim.attributes) {
     for (const char* prefix : {"JOINTS_", "WEIGHTS_"}) {
       if (name.rfind(prefix, 0) != 0) continue;
-      int s = std::atoi(name.c_str() + std::strlen(prefix));
+      // The set number, saturated (atoi overflows on "JOINTS_99999999999", and 4·(s+1) below
+      // must not); a name without digits ("JOINTS_x") counts as set 0, like atoi did.
+      int s = 0;
+      for (const char* p = name.c_str() + std::strlen(prefix); *p >= '0' && *p <= '9'; ++p)
+        s = std::min(s * 10 + (*p - '0'), 1000000);
       if (s >= kMaxInfluenceSets) {
         int infl = 0;
         while (prim.attributes.count(fmt::format("JOINTS_{}", infl / 4))) infl += 4;
@@ -741,17 +745,23 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
     const char* rigName;  // "position" in rig.morphedAttributes
     const char* semantic;
     bool baseCarried;
+    VertexFormat format = VertexFormat::Float32x3;  // of the deltas (float VEC3, or SCALAR)
   };
   std::vector<std::string> morphed;
+  bool occlusionMorphed = false;  // baked occlusion deltas (docs/bake.md), like listing 3-3's normal.w
   for (const MorphKind& k : {MorphKind{"POSITION", "position", "morph.position", true},
                              MorphKind{"NORMAL", "normal", "morph.normal", hasNormal},
-                             MorphKind{"TANGENT", "tangent", "morph.tangent", hasTangent}}) {
+                             MorphKind{"TANGENT", "tangent", "morph.tangent", hasTangent},
+                             MorphKind{"_OCCLUSION", "occlusion", "morph.occlusion", hasOcclusion,
+                                       VertexFormat::Float32x1}}) {
     if (!moved.count(k.gltf)) continue;
     if (!k.baseCarried) {
       imp.notes.push_back(fmt::format("morph target {} deltas are left out: the rig does not carry {}", k.gltf, k.gltf));
       continue;
     }
-    morphed.push_back(k.rigName);
+    const int n = formatComponents(k.format);
+    if (n == 1) occlusionMorphed = true;  // rig.morphedAttributes lists position, normal and tangent only
+    else morphed.push_back(k.rigName);
     for (int t = 0; t < targets; ++t) {
       const auto& tm = prim.targets[static_cast<size_t>(t)];
       std::string key = fmt::format("{}[{}]", k.semantic, t);
@@ -764,48 +774,21 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
       if (it->second < 0 || static_cast<size_t>(it->second) >= model.accessors.size())
         fail(file, fmt::format("{} refers to accessor {}, which does not exist", what, it->second));
       const auto& a = model.accessors[static_cast<size_t>(it->second)];
-      if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || a.type != TINYGLTF_TYPE_VEC3)
-        fail(file, fmt::format("{} is {}{} {}; only float VEC3 deltas are supported", what,
-                               a.normalized ? "normalized " : "", componentTypeName(a.componentType), typeName(a.type)));
+      int type = n == 1 ? TINYGLTF_TYPE_SCALAR : TINYGLTF_TYPE_VEC3;
+      if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || a.type != type)
+        fail(file, fmt::format("{} is {}{} {}; only float {} deltas are supported", what,
+                               a.normalized ? "normalized " : "", componentTypeName(a.componentType), typeName(a.type),
+                               typeName(type)));
       if (a.count != data.vertexCount)
         fail(file, fmt::format("{} has {} elements but POSITION has {}", what, a.count, data.vertexCount));
       AccessorData d = reader.read(it->second, what);
       if (d.sparse)
         imp.notes.push_back(fmt::format("morph target {} {} is a sparse accessor: the application must expand it to "
-                                        "a dense float32x3 stream",
-                                        t, k.gltf));
-      data.streams[key] = reader.stream(d, 0, 3, what);
+                                        "a dense {} stream",
+                                        t, k.gltf, formatName(k.format)));
+      data.streams[key] = reader.stream(d, 0, n, what);
     }
-    rig.attributes.push_back(makeAttribute(fmt::format("{}_morph", k.rigName), VertexFormat::Float32x3,
-                                           {{k.semantic, ""}}, file, true));
-  }
-  // Occlusion deltas (float SCALAR per target): morph.occlusion, like listing 3-3's normal.w.
-  bool occlusionMorphed = false;
-  if (moved.count("_OCCLUSION") && !hasOcclusion) {
-    imp.notes.push_back("morph target _OCCLUSION deltas are left out: the rig does not carry _OCCLUSION");
-  } else if (moved.count("_OCCLUSION")) {
-    occlusionMorphed = true;
-    for (int t = 0; t < targets; ++t) {
-      const auto& tm = prim.targets[static_cast<size_t>(t)];
-      std::string key = fmt::format("morph.occlusion[{}]", t);
-      auto it = tm.find("_OCCLUSION");
-      if (it == tm.end()) {
-        data.streams[key].assign(data.vertexCount, std::array<float, 4>{0, 0, 0, 0});
-        continue;
-      }
-      std::string what = fmt::format("{} morph target {} _OCCLUSION", where, t);
-      if (it->second < 0 || static_cast<size_t>(it->second) >= model.accessors.size())
-        fail(file, fmt::format("{} refers to accessor {}, which does not exist", what, it->second));
-      const auto& a = model.accessors[static_cast<size_t>(it->second)];
-      if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || a.type != TINYGLTF_TYPE_SCALAR)
-        fail(file, fmt::format("{} is {}{} {}; occlusion deltas are float SCALAR", what,
-                               a.normalized ? "normalized " : "", componentTypeName(a.componentType), typeName(a.type)));
-      if (a.count != data.vertexCount)
-        fail(file, fmt::format("{} has {} elements but POSITION has {}", what, a.count, data.vertexCount));
-      data.streams[key] = reader.stream(reader.read(it->second, what), 0, 1, what);
-    }
-    rig.attributes.push_back(
-        makeAttribute("occlusion_morph", VertexFormat::Float32x1, {{"morph.occlusion", ""}}, file, true));
+    rig.attributes.push_back(makeAttribute(fmt::format("{}_morph", k.rigName), k.format, {{k.semantic, ""}}, file, true));
   }
   for (const auto& n : moved)
     if (n != "POSITION" && n != "NORMAL" && n != "TANGENT" && n != "_OCCLUSION")
@@ -918,6 +901,7 @@ bool readBounded(const std::string& path, std::string& out, std::string& why) {
 struct BufferFiles {
   std::filesystem::path root;  // canonical model folder; empty: no buffer files at all
   std::string refused;         // the first refusal, reported instead of "File not found"
+  size_t bytesRead = 0;        // all buffer files together stay under kMaxGltfFileBytes too
 };
 
 bool insideRoot(BufferFiles& ctx, const std::string& path) {
@@ -939,10 +923,16 @@ bool bufferFileExists(const std::string& path, void* user) {
 }
 std::string keepPath(const std::string& path, void*) { return path; }
 bool readBufferFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
-  if (!insideRoot(*static_cast<BufferFiles*>(user), path)) return false;
+  auto& ctx = *static_cast<BufferFiles*>(user);
+  if (!insideRoot(ctx, path)) return false;
   std::string bytes, why;
   if (!readBounded(path, bytes, why)) {
     if (err) *err += why;
+    return false;
+  }
+  ctx.bytesRead += bytes.size();
+  if (ctx.bytesRead > kMaxGltfFileBytes) {
+    if (err) *err += fmt::format("the buffer files together are larger than the limit of {}", mib(kMaxGltfFileBytes));
     return false;
   }
   out->assign(bytes.begin(), bytes.end());
@@ -992,8 +982,9 @@ std::pair<size_t, size_t> checkGlb(const std::string& b, const std::string& file
   fail(file, "cannot load the glTF model: " + err);
 }
 
-GltfImport loadAndImport(const std::string& file, const GltfImportOptions& opts, const std::string* text,
-                         const std::string& baseDir) {
+// Reads and parses the model with every check; returns the bytes of the file and its buffers.
+size_t loadChecked(const std::string& file, const std::string* text, const std::string& baseDir,
+                   tinygltf::Model& model) {
   std::string bytes, why;
   if (!text && !readBounded(file, bytes, why)) fail(file, "cannot read the glTF model: " + why);
   const std::string& b = text ? *text : bytes;
@@ -1015,16 +1006,22 @@ GltfImport loadAndImport(const std::string& file, const GltfImportOptions& opts,
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(skipImage, nullptr);
   loader.SetFsCallbacks(tinygltf::FsCallbacks{bufferFileExists, keepPath, readBufferFile, writeNothing, &files});
-  tinygltf::Model model;
   std::string err, warn;
   const auto* data = reinterpret_cast<const unsigned char*>(b.data());
   std::string base = files.root.string();
   bool ok = glb ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, static_cast<unsigned int>(b.size()), base)
                 : loader.LoadASCIIFromString(&model, &err, &warn, b.data(), static_cast<unsigned int>(b.size()), base);
   if (!ok) failLoad(file, err, glb, files);
-  // Decoded data in proportion to the input: what a few KB can claim stays small.
   size_t input = b.size();
   for (const auto& buf : model.buffers) input += buf.data.size();
+  return input;
+}
+
+GltfImport loadAndImport(const std::string& file, const GltfImportOptions& opts, const std::string* text,
+                         const std::string& baseDir) {
+  tinygltf::Model model;
+  size_t input = loadChecked(file, text, baseDir, model);
+  // Decoded data in proportion to the input: what a few KB can claim stays small.
   GltfImportOptions o = opts;
   input = std::min(input, kMaxGltfDecodedBytes);  // keeps the product below in range
   o.maxDecodedBytes = std::min(opts.maxDecodedBytes, kMinGltfDecodedBudget + input * kGltfDecodedPerInputByte);
@@ -1072,6 +1069,8 @@ GltfRef parseGltfRef(const std::string& path) {
   }
   return r;
 }
+
+void loadGltfModel(const std::string& file, tinygltf::Model& model) { loadChecked(file, nullptr, "", model); }
 
 GltfImport importGltf(const std::string& file, const GltfImportOptions& opts) {
   return loadAndImport(file, opts, nullptr, "");

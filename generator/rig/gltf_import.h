@@ -12,6 +12,10 @@
 
 #include "rig/rig.h"
 
+namespace tinygltf {
+class Model;
+}
+
 namespace sg {
 
 // The bone palette is one uniform array of mat4: 256 × 64 B = 16 KiB, Vulkan's guaranteed
@@ -150,6 +154,11 @@ GltfImport importGltf(const std::string& file, const GltfImportOptions& opts = {
 // when it is empty).
 GltfImport importGltfText(const std::string& json, const std::string& fileName, const GltfImportOptions& opts = {},
                           const std::string& baseDir = "");
+
+// The checked loader behind importGltf (bounded read, JSON depth, GLB layout, buffer files
+// confined to the model's folder), for tools that rewrite a model (bake/gltf_bake.cpp). The
+// caller includes tiny_gltf.h with the configuration of gltf_import.cpp.
+void loadGltfModel(const std::string& file, tinygltf::Model& model);
 
 // Any rig path: "rig.yaml" (loadRigFile) or "model.glb[#m/p]" (importGltf).
 Rig loadRig(const std::string& path);

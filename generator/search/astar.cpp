@@ -126,6 +126,7 @@ std::optional<Plan> astarSearch(const Problem& p, Heuristic& h, SearchStats* sta
       next.set(act.add);
       int64_t ng = g + act.cost;
       ++st.generated;
+      budget.checkTime(st.expanded);
       auto it = index.find(next);
       if (it != index.end()) {
         Node& old = nodes[it->second];

@@ -169,7 +169,7 @@ std::optional<Plan> integerProgramSearch(const Problem& p, SearchStats* stats, c
   glp_init_iocp(&parm);
   parm.presolve = GLP_ON;
   parm.msg_lev = GLP_MSG_OFF;
-  if (limits.maxSeconds > 0) parm.tm_lim = static_cast<int>(std::ceil(limits.maxSeconds * 1000));
+  if (limits.maxSeconds > 0) parm.tm_lim = static_cast<int>(std::min(std::ceil(limits.maxSeconds * 1000), 2e9));
   glp_term_out(GLP_OFF);
   int ret = glp_intopt(P, &parm);
   int count = 0, cpeak = 0;

@@ -358,6 +358,7 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
         child[static_cast<size_t>(t.pre[i]) >> 6] |= uint64_t{1} << (t.pre[i] & 63);
       const int64_t ng = g + op.cost;
       ++st.generated;
+      budget.checkTime(st.expanded);
       const int id = static_cast<int>(nodes.size());
       states.insert(states.end(), child.begin(), child.end());
       auto it = index.find(id);

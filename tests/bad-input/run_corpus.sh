@@ -38,8 +38,9 @@ expand() {  # expand <token> <D> <O> <T>
   case "$t" in examples/* | rules/* | tests/* | templates/*) t=$SRC/$t ;; esac
   printf '%s' "$t"
 }
-snapshot() { (cd "$1" && find . -print0 | LC_ALL=C sort -z | xargs -0 -I{} sh -c \
-  'if [ -f "{}" ]; then printf "%s %s\n" "$(sha256sum < "{}" | cut -c1-64)" "{}"; else printf "%s %s\n" "$(stat -c %F "{}")" "{}"; fi'); }
+snapshot() {  # every entry's type and size, then every regular file's checksum
+  (cd "$1" && find . -printf '%y %s %p\n' | LC_ALL=C sort && find . -type f -print0 | LC_ALL=C sort -z | xargs -0 -r sha256sum)
+}
 
 fails=0 n=0
 for D in "${cases[@]}"; do

@@ -26,15 +26,20 @@ void expectInputErrorsOnly(F&& f) {
   }
 }
 
-// A private scratch directory for inputs that must be files (removed at exit by the OS's
-// tmp cleaning; one per process, reused by every run).
+// A private scratch directory for inputs that must be files: one per process, reused by
+// every run, removed at exit.
+struct ScratchDir {
+  std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("shadergen-fuzz-" + std::to_string(::getpid()));
+  ScratchDir() { std::filesystem::create_directories(path); }
+  ~ScratchDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+};
 inline const std::filesystem::path& scratchDir() {
-  static const std::filesystem::path dir = [] {
-    auto d = std::filesystem::temp_directory_path() / ("shadergen-fuzz-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(d);
-    return d;
-  }();
-  return dir;
+  static const ScratchDir dir;
+  return dir.path;
 }
 inline std::string writeScratch(const std::string& name, const std::string& bytes) {
   auto p = scratchDir() / name;

@@ -49,6 +49,7 @@ seeds() {
         [ -f "$f" ] && { cat "$ex/dawn/face.rig.yaml"; printf '\n%%%%\n'; cat "$f"; } > "$d/frag-$(echo "$f" | md5sum | cut -c1-8)"
       done ;;
   esac
+  add "$SRC"/tests/fuzz/regressions/"$t"/*  # earlier findings, replayed first
   shopt -u nullglob globstar
 }
 
@@ -71,9 +72,9 @@ fails=0
 printf '%-10s %10s %8s %8s %8s  %s\n' target runs seconds exec/s corpus result
 for t in "${targets[@]}"; do
   log=$W/$t.log rc=$(cat "$W/$t.rc")
-  runs=$(grep -o 'stat::number_of_executed_units: [0-9]*' "$log" | awk '{print $2}' | tail -1)
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | awk '{print $2}' | tail -1)
   secs=$(grep -o 'Done [0-9]* runs in [0-9]* second' "$log" | awk '{print $5}' | tail -1)
-  eps=$(grep -o 'stat::average_exec_per_sec: [0-9]*' "$log" | awk '{print $2}' | tail -1)
+  eps=$(grep -o 'stat::average_exec_per_sec: *[0-9]*' "$log" | awk '{print $2}' | tail -1)
   files=$(find "$W/corpus/$t" -type f | wc -l)
   result="no finding"
   if [ "$rc" != 0 ]; then

@@ -116,6 +116,9 @@ case("sparse-index-out-of-range", {"m.gltf": text(model(
      "sparse index 9 is out of range (count 3)")
 case("sparse-index-type-float", {"m.gltf": text(sparse(1, idx_type=5126))}, rig_import("@D/m.gltf"), 1,
      "sparse indices must be unsigned byte, short or int")
+case("joints-set-number-overflows", {"m.gltf": text(model([POS], extra={
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "JOINTS_99999999999": 0}}]}]}))}, rig_import("@D/m.gltf"), 1,
+     "has JOINTS_99999999999 (4000004 influences per vertex); the rules serve at most 8")
 case("position-nan", {"m.gltf": text(model([POS], blob=struct.pack("<9f", 0, 0, 0, float("nan"), 0, 0, 0, 1, 0)))},
      rig_import("@D/m.gltf"), 1, "holds a non-finite value")
 
