@@ -241,6 +241,24 @@ TEST(GltfHostile, BufferUrisOutsideTheModelsFolderAreRefused) {
   EXPECT_HAS(errorOf([&] { importGltfText(text, "m.gltf"); }).message, "has no folder to read files from");
 }
 
+// Depfiles, variant cache keys and the clobbering checks all rest on this list: a .gltf
+// whose .bin changes must count as a changed rig.
+TEST(GltfHostile, RigListsTheModelAndEveryBufferFileItRead) {
+  TempDir t("sources");
+  t.write("model/sub/geometry.bin", std::string(36, '\0'));
+  std::string m = t.write("model/m.gltf",
+                          R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":"sub/geometry.bin"}],)"
+                          R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
+                          R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],)"
+                          R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}]})")
+                      .string();
+  Rig rig = importGltf(m).rig;
+  ASSERT_EQ(rig.sourceFiles.size(), 2u);
+  EXPECT_EQ(rig.sourceFiles[0], m);
+  EXPECT_EQ(fs::canonical(rig.sourceFiles[1]), fs::canonical(t.path / "model/sub/geometry.bin"));
+  EXPECT_EQ(loadRig(m + "#0/0").sourceFiles, rig.sourceFiles);
+}
+
 TEST(GltfHostile, NonRegularModelFilesAreRefusedWithoutReading) {
   TempDir t("special");
   fs::create_symlink("/dev/zero", t.path / "zero.glb");
