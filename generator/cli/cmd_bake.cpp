@@ -106,8 +106,7 @@ void registerBake(CLI::App& app, CliState& state) {
       ->check(finiteNumber(false));
   occ->add_option("--seed", cmd->seed, "Random seed (default 1); the result does not depend on --threads");
   occ->add_option("--threads", cmd->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
-  occ->add_option("--time", cmd->time, "Pose at this animation time in seconds (default: bind pose)")
-      ->check(finiteNumber(false));
+  occ->add_option("--time", cmd->time, "Pose at this animation time in seconds (default: bind pose)");
   occ->add_option("--animation", cmd->animation, "With --time: animation name or index (default: the first)");
   occ->add_flag("-q,--quiet", cmd->quiet, "No progress, summary or warnings");
   occ->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
