@@ -243,7 +243,7 @@ int appendScalarAccessor(tinygltf::Model& m, const std::vector<float>& values) {
 
 GltfBakeResult bakeGltfOcclusion(const std::string& file, const GltfBakeOptions& opts) {
   tinygltf::Model model;
-  loadGltfModel(file, model);  // the rig import's checked loader (docs/limits.md)
+  size_t inputBytes = loadGltfModel(file, model);  // the rig import's checked loader (docs/limits.md)
   if (model.meshes.empty()) fail(file, "the model has no meshes: nothing to bake");
   GltfBakeResult result;
 
@@ -258,7 +258,7 @@ GltfBakeResult bakeGltfOcclusion(const std::string& file, const GltfBakeOptions&
       GltfImportOptions io;
       io.mesh = d.mesh;
       io.primitive = d.primitive;
-      d.imp = importGltf(file, io);
+      d.imp = importGltfModel(model, inputBytes, file, io);  // parsed once, not per primitive
       d.triangles = primitiveTriangles(model, model.meshes[m].primitives[p], d.imp.data.vertexCount, file,
                                        fmt::format("mesh '{}' primitive {}", d.imp.data.meshName, p));
       primIndex[{d.mesh, d.primitive}] = prims.size();

@@ -1017,15 +1017,20 @@ size_t loadChecked(const std::string& file, const std::string* text, const std::
   return input;
 }
 
+// Decoded data in proportion to the input: what a few KB can claim stays small.
+GltfImport importLoaded(const tinygltf::Model& model, const std::string& file, const GltfImportOptions& opts,
+                        size_t inputBytes) {
+  GltfImportOptions o = opts;
+  inputBytes = std::min(inputBytes, kMaxGltfDecodedBytes);  // keeps the product below in range
+  o.maxDecodedBytes = std::min(opts.maxDecodedBytes, kMinGltfDecodedBudget + inputBytes * kGltfDecodedPerInputByte);
+  return importModel(model, file, o);
+}
+
 GltfImport loadAndImport(const std::string& file, const GltfImportOptions& opts, const std::string* text,
                          const std::string& baseDir) {
   tinygltf::Model model;
   size_t input = loadChecked(file, text, baseDir, model);
-  // Decoded data in proportion to the input: what a few KB can claim stays small.
-  GltfImportOptions o = opts;
-  input = std::min(input, kMaxGltfDecodedBytes);  // keeps the product below in range
-  o.maxDecodedBytes = std::min(opts.maxDecodedBytes, kMinGltfDecodedBudget + input * kGltfDecodedPerInputByte);
-  return importModel(model, file, o);
+  return importLoaded(model, file, opts, input);
 }
 
 std::string yamlQuote(const std::string& s) {
@@ -1070,7 +1075,12 @@ GltfRef parseGltfRef(const std::string& path) {
   return r;
 }
 
-void loadGltfModel(const std::string& file, tinygltf::Model& model) { loadChecked(file, nullptr, "", model); }
+size_t loadGltfModel(const std::string& file, tinygltf::Model& model) { return loadChecked(file, nullptr, "", model); }
+
+GltfImport importGltfModel(const tinygltf::Model& model, size_t inputBytes, const std::string& file,
+                           const GltfImportOptions& opts) {
+  return importLoaded(model, file, opts, inputBytes);
+}
 
 GltfImport importGltf(const std::string& file, const GltfImportOptions& opts) {
   return loadAndImport(file, opts, nullptr, "");
