@@ -77,6 +77,26 @@ class EmbreeCaster final : public RayCaster {
     rtcOccluded1(scene_, &ctx, &r);
     return r.tfar < 0;  // Embree sets tfar to -inf on a hit
   }
+  int countOccluded(const Vec3& o, const std::vector<Vec3>& dirs, float tnear, float tfar) const override {
+    thread_local std::vector<RTCRay> rays;
+    rays.resize(dirs.size());
+    for (size_t i = 0; i < dirs.size(); ++i) {
+      RTCRay& r = rays[i];
+      r = RTCRay{};
+      r.org_x = o[0], r.org_y = o[1], r.org_z = o[2];
+      r.dir_x = dirs[i][0], r.dir_y = dirs[i][1], r.dir_z = dirs[i][2];
+      r.tnear = tnear;
+      r.tfar = tfar;
+      r.mask = 0xFFFFFFFFu;
+    }
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;  // one origin: Embree packs the stream into packets
+    rtcOccluded1M(scene_, &ctx, rays.data(), static_cast<unsigned>(rays.size()), sizeof(RTCRay));
+    int hits = 0;
+    for (const RTCRay& r : rays) hits += r.tfar < 0;
+    return hits;
+  }
   const char* name() const override { return "embree"; }
 
  private:
@@ -138,6 +158,12 @@ void basis(const Vec3& n, Vec3& t, Vec3& b) {
 
 }  // namespace
 
+int RayCaster::countOccluded(const Vec3& origin, const std::vector<Vec3>& dirs, float tnear, float tfar) const {
+  int hits = 0;
+  for (const Vec3& d : dirs) hits += occluded(origin, d, tnear, tfar);
+  return hits;
+}
+
 void TriangleSoup::append(const TriangleSoup& o) {
   uint32_t base = static_cast<uint32_t>(positions.size());
   positions.insert(positions.end(), o.positions.begin(), o.positions.end());
@@ -193,10 +219,11 @@ std::vector<float> bakeOcclusion(const RayCaster& caster, const std::vector<Bake
     for (auto& c : n) c /= len;
     Vec3 o;
     for (size_t c = 0; c < 3; ++c) o[c] = p.position[c] + static_cast<float>(offset) * n[c];
-    int blocked = 0;
+    thread_local std::vector<Vec3> dirs;
+    dirs.resize(static_cast<size_t>(opts.rays));
     for (int i = 0; i < opts.rays; ++i)
-      if (caster.occluded(o, hemisphereDirection(n, opts.distribution, opts.seed, p.stream, i), 0.0f, tfar))
-        ++blocked;
+      dirs[static_cast<size_t>(i)] = hemisphereDirection(n, opts.distribution, opts.seed, p.stream, i);
+    int blocked = caster.countOccluded(o, dirs, 0.0f, tfar);
     out[k] = static_cast<float>(blocked) / static_cast<float>(opts.rays);
   };
 

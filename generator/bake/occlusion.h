@@ -57,6 +57,8 @@ class RayCaster {
   virtual ~RayCaster() = default;
   // True if the ray origin + t·dir, t in (tnear, tfar), hits a triangle.
   virtual bool occluded(const Vec3& origin, const Vec3& dir, float tnear, float tfar) const = 0;
+  // How many of the rays from one origin are occluded (Embree casts them as one stream).
+  virtual int countOccluded(const Vec3& origin, const std::vector<Vec3>& dirs, float tnear, float tfar) const;
   virtual const char* name() const = 0;
 };
 std::unique_ptr<RayCaster> makeEmbreeCaster(const TriangleSoup& scene);  // throws std::runtime_error

@@ -4,7 +4,6 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -40,8 +39,7 @@ struct BakeOcclusionCommand {
     if (ext != ".glb" && ext != ".gltf")
       throw CLI::ValidationError("--output", fmt::format("'{}' must end in .glb or .gltf", output));
     if (!animation.empty() && !time) throw CLI::ValidationError("--animation", "needs --time");
-    if (time && !std::isfinite(*time)) throw CLI::ValidationError("--time", "must be a finite number of seconds");
-    refuseClobbering({output}, {{model, "the glTF model"}});  // before the work; buffer files after
+    refuseClobbering({output}, {{model, "the glTF model"}});  // before the (long) bake; buffer files after
     bake::GltfBakeOptions o;
     o.occlusion.rays = rays;
     o.occlusion.distribution = distribution == "cosine" ? bake::Distribution::Cosine : bake::Distribution::Uniform;
@@ -58,7 +56,6 @@ struct BakeOcclusionCommand {
         std::cerr << fmt::format("\r\033[K[{}/{}] {}: {}%", pass, passes, what, total ? done * 100 / total : 100)
                   << std::flush;
       };
-    refuseClobbering({output}, {{model, "the glTF model"}});  // before the (long) bake
     auto start = std::chrono::steady_clock::now();
     bake::GltfBakeResult r = bake::bakeGltfOcclusion(model, o);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
