@@ -1020,16 +1020,21 @@ size_t loadChecked(const std::string& file, const std::string* text, const std::
   return input;
 }
 
+// Decoded data in proportion to the input: what a few KB can claim stays small.
+GltfImport importLoaded(const tinygltf::Model& model, const std::string& file, const GltfImportOptions& opts,
+                        size_t inputBytes) {
+  GltfImportOptions o = opts;
+  inputBytes = std::min(inputBytes, kMaxGltfDecodedBytes);  // keeps the product below in range
+  o.maxDecodedBytes = std::min(opts.maxDecodedBytes, kMinGltfDecodedBudget + inputBytes * kGltfDecodedPerInputByte);
+  return importModel(model, file, o);
+}
+
 GltfImport loadAndImport(const std::string& file, const GltfImportOptions& opts, const std::string* text,
                          const std::string& baseDir) {
   tinygltf::Model model;
   std::vector<std::string> buffers;
   size_t input = loadChecked(file, text, baseDir, model, &buffers);
-  // Decoded data in proportion to the input: what a few KB can claim stays small.
-  GltfImportOptions o = opts;
-  input = std::min(input, kMaxGltfDecodedBytes);  // keeps the product below in range
-  o.maxDecodedBytes = std::min(opts.maxDecodedBytes, kMinGltfDecodedBudget + input * kGltfDecodedPerInputByte);
-  GltfImport imp = importModel(model, file, o);
+  GltfImport imp = importLoaded(model, file, opts, input);
   if (!text) imp.rig.sourceFiles.push_back(file);
   imp.rig.sourceFiles.insert(imp.rig.sourceFiles.end(), buffers.begin(), buffers.end());
   return imp;
@@ -1077,7 +1082,12 @@ GltfRef parseGltfRef(const std::string& path) {
   return r;
 }
 
-void loadGltfModel(const std::string& file, tinygltf::Model& model) { loadChecked(file, nullptr, "", model); }
+size_t loadGltfModel(const std::string& file, tinygltf::Model& model) { return loadChecked(file, nullptr, "", model); }
+
+GltfImport importGltfModel(const tinygltf::Model& model, size_t inputBytes, const std::string& file,
+                           const GltfImportOptions& opts) {
+  return importLoaded(model, file, opts, inputBytes);
+}
 
 GltfImport importGltf(const std::string& file, const GltfImportOptions& opts) {
   return loadAndImport(file, opts, nullptr, "");
