@@ -11,6 +11,7 @@
 #include "search/astar.h"
 #include "search/instance.h"
 #include "search/plan.h"
+#include "search/search.h"
 
 namespace sg {
 

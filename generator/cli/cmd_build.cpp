@@ -18,6 +18,8 @@ namespace sg {
 namespace {
 
 bool sameContents(const std::string& path, const std::string& contents) {
+  std::error_code ec;
+  if (std::filesystem::file_size(path, ec) != contents.size() || ec) return false;
   std::ifstream in(path, std::ios::binary);
   if (!in) return false;
   std::ostringstream s;

@@ -82,7 +82,7 @@ CompiledVertexShader compileStage(const LoadedInputs& in, const Plan& plan, cons
 }
 
 std::vector<uint32_t> checkStage(const LoadedInputs& in, const EmittedGlsl& glsl, const CompiledVertexShader& vertex,
-                                 const CheckOptions& opts) {
+                                 const ShaderCheckOptions& opts) {
   std::vector<uint32_t> words = vertex.module.words;
   if (std::string err = validateSpirv(words, opts.env); !err.empty())
     throw InputError(SourceLoc{opts.glslName, 0, 0}, "generated SPIR-V fails validation: " + err);
@@ -157,7 +157,7 @@ GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const
   CompiledVertexShader compiled = compileStage(in, res.plan, res.glsl, opts.outputName, opts.targetEnv);
   res.spirv = compiled.module;
   res.spirv.words =
-      checkStage(in, res.glsl, compiled, CheckOptions{opts.outputName, opts.targetEnv, opts.optimize, opts.maxUniformBlockBytes});
+      checkStage(in, res.glsl, compiled, ShaderCheckOptions{opts.outputName, opts.targetEnv, opts.optimize, opts.maxUniformBlockBytes});
   res.inputsRead = inputsRead(in, templates);
   res.in = std::move(in);
   return res;

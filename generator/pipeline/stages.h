@@ -57,7 +57,7 @@ CompiledVertexShader compileStage(const LoadedInputs& in, const Plan& plan, cons
                                   const std::string& glslName, TargetEnv env);
 
 // ---- check ------------------------------------------------------------------------------
-struct CheckOptions {
+struct ShaderCheckOptions {
   std::string glslName;  // how the GLSL is named in diagnostics
   TargetEnv env = TargetEnv::Vulkan1_0;
   bool optimize = false;
@@ -67,7 +67,7 @@ struct CheckOptions {
 // uniform the plan reads), the link with the fragment shader, and (optimize) spirv-opt -O
 // + spirv-val again. Returns the final SPIR-V words.
 std::vector<uint32_t> checkStage(const LoadedInputs& in, const EmittedGlsl& glsl, const CompiledVertexShader& vertex,
-                                 const CheckOptions& opts);
+                                 const ShaderCheckOptions& opts);
 
 // Every file the stages read for this context (rig, fragment shader, rules files and their
 // includes, templates): the depfile's prerequisites.

@@ -30,7 +30,7 @@ struct SharedInputs {
   TemplateSet templates;
   std::map<std::string, Rig> rigs;                     // by manifest path
   std::map<std::string, FragmentInterface> fragments;  // by path
-  std::map<std::string, std::string> bytes;            // file -> contents (cache keys)
+  std::map<std::string, std::string> digests;          // file -> SHA-256 of its bytes (cache keys)
 };
 
 // A glTF rig path "model.glb#0/0" reads "model.glb".
@@ -66,9 +66,10 @@ SharedInputs loadShared(const Manifest& m, const std::vector<Variant>& variants)
     }
     if (!s.fragments.count(v.pass->fragment)) s.fragments.emplace(v.pass->fragment, loadFragmentStage(v.pass->fragment, m.targetEnv));
   }
+  // Each file is hashed once; a variant's key hashes the digests of its files.
   auto keep = [&](const std::string& path) {
     std::string f = fileOf(path);
-    if (!s.bytes.count(f)) s.bytes.emplace(f, readBytes(f));
+    if (!s.digests.count(f)) s.digests.emplace(f, sha256Hex(readBytes(f)));
   };
   for (const auto& f : s.rules.files) keep(f);
   keep(s.templates.file());
@@ -85,7 +86,8 @@ std::vector<std::string> inputsOf(const SharedInputs& s, const Variant& v) {
 }
 
 // Every byte that can change a variant's outputs: the tool, the options, the variant's
-// parameters and mappings, and each input file's path (outputs name them) and contents.
+// parameters and mappings, and each input file's path (outputs name them) and contents
+// (through the SHA-256 of the file).
 std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v, const std::vector<std::string>& inputs) {
   Sha256 h;
   h.field(kCacheFormat).field(shadergenVersion()).field(targetEnvName(m.targetEnv)).field(m.heuristic);
@@ -98,7 +100,7 @@ std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v,
     for (const auto& sem : ov.semantics) h.field(sem);
   }
   h.field("inputs");
-  for (const auto& f : inputs) h.field(f).field(s.bytes.at(f));
+  for (const auto& f : inputs) h.field(f).field(s.digests.at(f));
   return h.hex();
 }
 
