@@ -53,7 +53,7 @@ sanitize_build() {
 sanitize_test() {
   # Sanitized binaries run several times slower: the corpus's per-case limit scales with it.
   (source cmake/sanitizers/env.sh && SHADERGEN_CORPUS_TIME_SCALE=${SHADERGEN_CORPUS_TIME_SCALE:-10} \
-     ctest --test-dir "$sanitize_build" --output-on-failure -j2)
+     LD_PRELOAD=$sg_vulkan_driver ctest --test-dir "$sanitize_build" --output-on-failure -j2)
 }
 fuzz_run() { bash tests/fuzz/run.sh "$sanitize_build" "${SHADERGEN_FUZZ_SECONDS:-60}"; }
 

@@ -8,6 +8,8 @@
 #include <map>
 #include <set>
 
+#include "search/search.h"
+
 namespace sg {
 namespace {
 

@@ -17,7 +17,6 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <functional>
 #include <map>
 #include <sstream>
 
@@ -244,7 +243,7 @@ int appendScalarAccessor(tinygltf::Model& m, const std::vector<float>& values) {
 
 GltfBakeResult bakeGltfOcclusion(const std::string& file, const GltfBakeOptions& opts) {
   tinygltf::Model model;
-  loadGltfModel(file, model);  // the rig import's checked loader (docs/limits.md)
+  size_t inputBytes = loadGltfModel(file, model);  // the rig import's checked loader (docs/limits.md)
   if (model.meshes.empty()) fail(file, "the model has no meshes: nothing to bake");
   GltfBakeResult result;
 
@@ -259,7 +258,7 @@ GltfBakeResult bakeGltfOcclusion(const std::string& file, const GltfBakeOptions&
       GltfImportOptions io;
       io.mesh = d.mesh;
       io.primitive = d.primitive;
-      d.imp = importGltf(file, io);
+      d.imp = importGltfModel(model, inputBytes, file, io);  // parsed once, not per primitive
       d.triangles = primitiveTriangles(model, model.meshes[m].primitives[p], d.imp.data.vertexCount, file,
                                        fmt::format("mesh '{}' primitive {}", d.imp.data.meshName, p));
       primIndex[{d.mesh, d.primitive}] = prims.size();
@@ -278,13 +277,20 @@ GltfBakeResult bakeGltfOcclusion(const std::string& file, const GltfBakeOptions&
 
   // Instances: every node of the scene drawing a mesh, then each primitive's baking instance
   // (the node the rig import poses it with) if the scene does not already hold it.
+  // Depth first, pre-order, without recursion (node chains can be as long as the file) and
+  // each node once (a scene may list a root twice).
   std::vector<Instance> instances;
-  std::function<void(int)> walk = [&](int n) {
+  std::vector<int> todo(sceneData.sceneRoots.rbegin(), sceneData.sceneRoots.rend());
+  std::vector<char> seen(sceneData.nodes.size(), 0);
+  while (!todo.empty()) {
+    int n = todo.back();
+    todo.pop_back();
+    if (seen[static_cast<size_t>(n)]) continue;
+    seen[static_cast<size_t>(n)] = 1;
     const GltfNode& node = sceneData.nodes[static_cast<size_t>(n)];
     if (node.mesh >= 0 && node.mesh < static_cast<int>(model.meshes.size())) instances.push_back({n, node.mesh});
-    for (int c : node.children) walk(c);
-  };
-  for (int r : sceneData.sceneRoots) walk(r);
+    todo.insert(todo.end(), node.children.rbegin(), node.children.rend());
+  }
   std::vector<size_t> bakeInstance(prims.size());
   for (size_t i = 0; i < prims.size(); ++i) {
     int node = prims[i].imp.data.meshNode;

@@ -72,7 +72,8 @@ GenerateOptions GenerateArgs::resolve() const {
 }
 
 std::vector<InputFile> inputFiles(const LoadedInputs& in, const std::vector<std::string>& extra) {
-  std::vector<InputFile> files{{in.rig.file, "the rig"}, {in.fragment.file, "the fragment shader"}};
+  std::vector<InputFile> files{{in.fragment.file, "the fragment shader"}};
+  for (const auto& f : in.rig.sourceFiles) files.push_back({f, "the rig"});
   for (const auto& f : in.rules.files) files.push_back({f, "a rules file"});
   for (const auto& f : extra) files.push_back({f, "an input"});
   return files;

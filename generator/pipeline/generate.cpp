@@ -115,7 +115,8 @@ std::vector<uint32_t> checkStage(const LoadedInputs& in, const EmittedGlsl& glsl
 }
 
 std::vector<std::string> inputsRead(const LoadedInputs& in, const TemplateSet& templates) {
-  std::vector<std::string> files{in.rig.file, in.fragment.file};
+  std::vector<std::string> files = in.rig.sourceFiles;
+  files.push_back(in.fragment.file);
   files.insert(files.end(), in.rules.files.begin(), in.rules.files.end());
   files.push_back(templates.file());
   return files;

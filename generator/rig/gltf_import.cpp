@@ -902,6 +902,7 @@ struct BufferFiles {
   std::filesystem::path root;  // canonical model folder; empty: no buffer files at all
   std::string refused;         // the first refusal, reported instead of "File not found"
   size_t bytesRead = 0;        // all buffer files together stay under kMaxGltfFileBytes too
+  std::vector<std::string> read;  // the buffer files read, in order (depfiles, cache keys)
 };
 
 bool insideRoot(BufferFiles& ctx, const std::string& path) {
@@ -931,6 +932,7 @@ bool readBufferFile(std::vector<unsigned char>* out, std::string* err, const std
     return false;
   }
   ctx.bytesRead += bytes.size();
+  ctx.read.push_back(path);
   if (ctx.bytesRead > kMaxGltfFileBytes) {
     if (err) *err += fmt::format("the buffer files together are larger than the limit of {}", mib(kMaxGltfFileBytes));
     return false;
@@ -984,7 +986,7 @@ std::pair<size_t, size_t> checkGlb(const std::string& b, const std::string& file
 
 // Reads and parses the model with every check; returns the bytes of the file and its buffers.
 size_t loadChecked(const std::string& file, const std::string* text, const std::string& baseDir,
-                   tinygltf::Model& model) {
+                   tinygltf::Model& model, std::vector<std::string>* buffersRead = nullptr) {
   std::string bytes, why;
   if (!text && !readBounded(file, bytes, why)) fail(file, "cannot read the glTF model: " + why);
   const std::string& b = text ? *text : bytes;
@@ -1012,20 +1014,30 @@ size_t loadChecked(const std::string& file, const std::string* text, const std::
   bool ok = glb ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, static_cast<unsigned int>(b.size()), base)
                 : loader.LoadASCIIFromString(&model, &err, &warn, b.data(), static_cast<unsigned int>(b.size()), base);
   if (!ok) failLoad(file, err, glb, files);
+  if (buffersRead) *buffersRead = files.read;
   size_t input = b.size();
   for (const auto& buf : model.buffers) input += buf.data.size();
   return input;
 }
 
+// Decoded data in proportion to the input: what a few KB can claim stays small.
+GltfImport importLoaded(const tinygltf::Model& model, const std::string& file, const GltfImportOptions& opts,
+                        size_t inputBytes) {
+  GltfImportOptions o = opts;
+  inputBytes = std::min(inputBytes, kMaxGltfDecodedBytes);  // keeps the product below in range
+  o.maxDecodedBytes = std::min(opts.maxDecodedBytes, kMinGltfDecodedBudget + inputBytes * kGltfDecodedPerInputByte);
+  return importModel(model, file, o);
+}
+
 GltfImport loadAndImport(const std::string& file, const GltfImportOptions& opts, const std::string* text,
                          const std::string& baseDir) {
   tinygltf::Model model;
-  size_t input = loadChecked(file, text, baseDir, model);
-  // Decoded data in proportion to the input: what a few KB can claim stays small.
-  GltfImportOptions o = opts;
-  input = std::min(input, kMaxGltfDecodedBytes);  // keeps the product below in range
-  o.maxDecodedBytes = std::min(opts.maxDecodedBytes, kMinGltfDecodedBudget + input * kGltfDecodedPerInputByte);
-  return importModel(model, file, o);
+  std::vector<std::string> buffers;
+  size_t input = loadChecked(file, text, baseDir, model, &buffers);
+  GltfImport imp = importLoaded(model, file, opts, input);
+  if (!text) imp.rig.sourceFiles.push_back(file);
+  imp.rig.sourceFiles.insert(imp.rig.sourceFiles.end(), buffers.begin(), buffers.end());
+  return imp;
 }
 
 std::string yamlQuote(const std::string& s) {
@@ -1070,7 +1082,12 @@ GltfRef parseGltfRef(const std::string& path) {
   return r;
 }
 
-void loadGltfModel(const std::string& file, tinygltf::Model& model) { loadChecked(file, nullptr, "", model); }
+size_t loadGltfModel(const std::string& file, tinygltf::Model& model) { return loadChecked(file, nullptr, "", model); }
+
+GltfImport importGltfModel(const tinygltf::Model& model, size_t inputBytes, const std::string& file,
+                           const GltfImportOptions& opts) {
+  return importLoaded(model, file, opts, inputBytes);
+}
 
 GltfImport importGltf(const std::string& file, const GltfImportOptions& opts) {
   return loadAndImport(file, opts, nullptr, "");

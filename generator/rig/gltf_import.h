@@ -158,7 +158,12 @@ GltfImport importGltfText(const std::string& json, const std::string& fileName, 
 // The checked loader behind importGltf (bounded read, JSON depth, GLB layout, buffer files
 // confined to the model's folder), for tools that rewrite a model (bake/gltf_bake.cpp). The
 // caller includes tiny_gltf.h with the configuration of gltf_import.cpp.
-void loadGltfModel(const std::string& file, tinygltf::Model& model);
+// Returns the bytes read (the model and its buffer files), for importGltfModel's budget.
+size_t loadGltfModel(const std::string& file, tinygltf::Model& model);
+// importGltf on a model loadGltfModel loaded: tools that import every primitive parse the
+// file once (a file of many primitives re-read per primitive took quadratic time).
+GltfImport importGltfModel(const tinygltf::Model& model, size_t inputBytes, const std::string& file,
+                           const GltfImportOptions& opts = {});
 
 // Any rig path: "rig.yaml" (loadRigFile) or "model.glb[#m/p]" (importGltf).
 Rig loadRig(const std::string& path);

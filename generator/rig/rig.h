@@ -56,6 +56,9 @@ struct RigUniform {
 struct Rig {
   std::string name;
   std::string file;                            // where it came from (for diagnostics)
+  // Every file read to make it (a glTF model and its buffer files): depfiles, cache keys,
+  // and the outputs that must never overwrite an input.
+  std::vector<std::string> sourceFiles;
   std::map<std::string, int64_t> params;       // bones, influences, morph_targets, ...
   std::map<std::string, SourceLoc> paramLocs;
   std::vector<std::string> morphedAttributes;  // "position", "normal", "tangent"

@@ -86,6 +86,7 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
 
   Rig rig;
   rig.file = fileName;
+  rig.sourceFiles = {fileName};
   if (!root["rig"]) y.fail(root, "missing 'rig' (the rig's name)");
   rig.name = y.scalar(root["rig"], "'rig'");
   // The name is quoted in generated comments and messages: printable text, one line.

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <thread>
 
+#include "common/input_file.h"
 #include "emit/reflection.h"
 #include "pipeline/generate.h"
 #include "rig/rig_lod.h"
@@ -22,7 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // Bumped whenever the entry layout or what a key covers changes.
-constexpr const char* kCacheFormat = "shadergen-variant-cache 1";
+constexpr const char* kCacheFormat = "shadergen-variant-cache 2";  // 2: glTF buffer files keyed
 
 // Every file a build reads, loaded once and shared (read-only) by all workers.
 struct SharedInputs {
@@ -32,22 +33,6 @@ struct SharedInputs {
   std::map<std::string, FragmentInterface> fragments;  // by path
   std::map<std::string, std::string> digests;          // file -> SHA-256 of its bytes (cache keys)
 };
-
-// A glTF rig path "model.glb#0/0" reads "model.glb".
-std::string fileOf(const std::string& path) {
-  auto hash = path.rfind('#');
-  if (hash == std::string::npos) return path;
-  std::string ext = fs::path(path.substr(0, hash)).extension().string();
-  return ext == ".glb" || ext == ".gltf" ? path.substr(0, hash) : path;
-}
-
-std::string readBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(SourceLoc{path, 0, 0}, "cannot read this input file");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 SharedInputs loadShared(const Manifest& m, const std::vector<Variant>& variants) {
   SharedInputs s;
@@ -67,19 +52,20 @@ SharedInputs loadShared(const Manifest& m, const std::vector<Variant>& variants)
     if (!s.fragments.count(v.pass->fragment)) s.fragments.emplace(v.pass->fragment, loadFragmentStage(v.pass->fragment, m.targetEnv));
   }
   // Each file is hashed once; a variant's key hashes the digests of its files.
-  auto keep = [&](const std::string& path) {
-    std::string f = fileOf(path);
-    if (!s.digests.count(f)) s.digests.emplace(f, sha256Hex(readBytes(f)));
+  auto keep = [&](const std::string& f) {
+    if (!s.digests.count(f)) s.digests.emplace(f, sha256Hex(readInputFile(f)));
   };
   for (const auto& f : s.rules.files) keep(f);
   keep(s.templates.file());
-  for (const auto& [path, rig] : s.rigs) keep(rig.file);
+  for (const auto& [path, rig] : s.rigs)
+    for (const auto& f : rig.sourceFiles) keep(f);
   for (const auto& [path, frag] : s.fragments) keep(frag.file);
   return s;
 }
 
 std::vector<std::string> inputsOf(const SharedInputs& s, const Variant& v) {
-  std::vector<std::string> files{fileOf(s.rigs.at(v.rig->path).file), s.fragments.at(v.pass->fragment).file};
+  std::vector<std::string> files = s.rigs.at(v.rig->path).sourceFiles;
+  files.push_back(s.fragments.at(v.pass->fragment).file);
   files.insert(files.end(), s.rules.files.begin(), s.rules.files.end());
   files.push_back(s.templates.file());
   return files;

@@ -163,6 +163,19 @@ case("model-is-directory", {}, rig_import("@T/dir.gltf"), 1, "dir.gltf: error: c
 case("model-too-large", {}, rig_import("@T/huge.glb"), 1, "larger than the limit of 1024.0 MiB",
      setup='truncate -s 2G "$1/huge.glb"\n')
 
+# A valid model whose one mesh hangs at the end of a 50,000-node chain (generated: 1 MB):
+# the import, the pose and the baker's scene walk must not recurse per node. Succeeds.
+CHAIN_SETUP = r"""awk 'BEGIN { n = 50000
+  printf "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":36,\"uri\":\"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}],"
+  printf "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],"
+  printf "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],\"scenes\":[{\"nodes\":[0]}],\"nodes\":["
+  for (i = 0; i < n - 1; i++) printf "{\"children\":[%d]},", i + 1
+  printf "{\"mesh\":0}]}" }' > "$1/chain.gltf"
+"""
+case("bake-long-node-chain", {}, "bake occlusion @T/chain.gltf -o @O/baked.glb --rays 4 --threads 1", 0,
+     setup=CHAIN_SETUP)
+case("rig-import-long-node-chain", {}, "rig import @T/chain.gltf -o @O/rig.yaml", 0, setup=CHAIN_SETUP)
+
 # --- GLB -----------------------------------------------------------------------------------
 GLB_JSON = model([POS], extra={"buffers": [{"byteLength": 36}]})
 case("glb-bin-chunk-overrun", {"m.glb": glb(GLB_JSON, TRI, bin_len_field=44)}, rig_import("@D/m.glb"), 1,
