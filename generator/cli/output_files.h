@@ -1,6 +1,7 @@
 // Writing outputs the way build tools need: all-or-nothing (temp file + rename),
 // and Makefile depfiles listing every input read.
 #pragma once
+#include "emit/depfile.h"  // makeDepfile, for the commands that write outputs
 #include <string>
 #include <vector>
 
@@ -25,12 +26,5 @@ struct InputFile {
   std::string what;  // "the rig", "a rules file", ...
 };
 void refuseClobbering(const std::vector<std::string>& outputs, const std::vector<InputFile>& inputs);
-
-// "target1 target2: dep1 dep2 ..." with spaces, '#' and '$' escaped (Make/Ninja syntax).
-// A path with a newline cannot be written in that syntax: throws InputError.
-std::string makeDepfile(const std::vector<std::string>& targets, const std::vector<std::string>& deps);
-inline std::string makeDepfile(const std::string& target, const std::vector<std::string>& deps) {
-  return makeDepfile(std::vector<std::string>{target}, deps);
-}
 
 }  // namespace sg

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "common/input_file.h"
+#include "emit/depfile.h"
 #include "emit/reflection.h"
 #include "pipeline/generate.h"
 #include "rig/rig_lod.h"
@@ -262,24 +263,6 @@ std::string indexJson(const Manifest& m, const BuildReport& r) {
   return out;
 }
 
-// "target1 target2: dep1 dep2" (Make/Ninja syntax; spaces, '#' and '$' escaped).
-std::string depfile(const std::vector<std::string>& targets, const std::vector<std::string>& deps) {
-  auto esc = [](const std::string& p) {
-    std::string o;
-    for (char c : p) {
-      if (c == ' ' || c == '#') o += '\\';
-      if (c == '$') o += '$';
-      o += c;
-    }
-    return o;
-  };
-  std::string out;
-  for (const auto& t : targets) out += (out.empty() ? "" : " ") + esc(t);
-  out += ":";
-  for (const auto& d : deps) out += " \\\n  " + esc(d);
-  return out + "\n";
-}
-
 }  // namespace
 
 BuildReport buildVariants(const Manifest& m, const std::vector<Variant>& variants, const BuildOptions& opts) {
@@ -339,14 +322,14 @@ BuildReport buildVariants(const Manifest& m, const std::vector<Variant>& variant
     }
     std::vector<std::string> deps{m.file};
     deps.insert(deps.end(), b.inputs.begin(), b.inputs.end());
-    report.files.push_back({(fs::path(m.outputDir) / (v.name + ".d")).string(), depfile(targets, deps)});
+    report.files.push_back({(fs::path(m.outputDir) / (v.name + ".d")).string(), makeDepfile(targets, deps)});
     allInputs.insert(b.inputs.begin(), b.inputs.end());
   }
   if (report.failed == 0) {
     report.indexPath = (fs::path(m.outputDir) / "index.json").string();
     report.files.push_back({report.indexPath, indexJson(m, report)});
     report.files.push_back({report.indexPath + ".d",
-                            depfile({report.indexPath}, std::vector<std::string>(allInputs.begin(), allInputs.end()))});
+                            makeDepfile({report.indexPath}, std::vector<std::string>(allInputs.begin(), allInputs.end()))});
   }
   return report;
 }
