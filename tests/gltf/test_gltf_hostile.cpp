@@ -10,6 +10,7 @@
 #include <fstream>
 #include <functional>
 
+#include "../core/core_test_util.h"
 #include "gltf_builder.h"
 #include "rig/gltf_import.h"
 #include "validate/gltf_scene.h"
@@ -20,18 +21,7 @@ namespace {
 namespace fs = std::filesystem;
 using test::GltfBuilder;
 
-Diagnostic errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.diagnostic();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected InputError, got: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "expected InputError, nothing was thrown";
-  return {};
-}
+using sgtest::errorOf;
 #define EXPECT_HAS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
 
 // One triangle whose POSITION accessor carries `posExtra` members; `rest` adds top-level
