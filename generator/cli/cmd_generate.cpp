@@ -18,6 +18,10 @@ void GenerateArgs::add(CLI::App& cmd) {
   cmd.add_option("--fragment,-f", opts.fragmentPath, "Fragment shader whose inputs must be fed (GLSL 450)")->required();
   cmd.add_option("--rules,-r", opts.rulesPaths, "Rules file(s) (YAML)")->required();
   cmd.add_option("--map", maps, "Map a fragment input to semantics: Name=sem or Name=s1,s2,... (packs)");
+  cmd.add_option("--conventions", opts.conventions,
+                 "Varying naming conventions to apply, earlier first (threejs, gltf-sample-viewer, filament, ...; "
+                 "none). Default: every convention, where they agree")
+      ->delimiter(',');
   cmd.add_option("--heuristic", opts.heuristic, "A* heuristic (either engine): lmcut (default), hmax, blind")
       ->check(CLI::IsMember({"lmcut", "hmax", "blind"}));
   cmd.add_option("--search", opts.searchEngine,

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "common/yaml_util.h"
+#include "rules/loader_parts.h"
 #include "rules/rules.h"
 
 namespace sg {
@@ -157,17 +158,21 @@ std::vector<TemplateLine> snippetLines(const YamlCtx& y, const YAML::Node& n, co
 
 void loadRule(RuleSet& set, const YamlCtx& y, const YAML::Node& r, const std::vector<std::string>& raw) {
   y.expectMap(r, "a rule");
-  y.checkKeys(r, {"name", "produces", "needs", "when", "cost", "glsl", "doc"});
+  y.checkKeys(r, {"name", "produces", "needs", "when", "cost", "glsl", "doc", "override"});
   Rule rule;
   if (!r["name"]) y.fail(r, "rule has no 'name'");
   rule.name = y.scalar(r["name"], "'name'");
   rule.loc = locOf(r["name"], y.file);
   if (!validRuleName(rule.name)) y.fail(r["name"], fmt::format("'{}' is not a valid rule name", rule.name));
-  for (const auto& other : set.rules)
-    if (other.name == rule.name) {
+  bool overrides = r["override"] && y.boolean(r["override"], "'override'");
+  std::optional<size_t> existing;
+  for (size_t i = 0; i < set.rules.size(); ++i)
+    if (set.rules[i].name == rule.name) {
+      const Rule& other = set.rules[i];
       if (other.loc.file == rule.loc.file && other.loc.line == rule.loc.line) return;  // same file included twice
-      y.fail(r["name"], fmt::format("rule '{}' is defined twice (first at {}:{})", rule.name, other.loc.file, other.loc.line));
+      existing = i;
     }
+  if (overrides && !existing) failNothingToOverride(set, y, r["name"], rule.name);
   if (!r["produces"]) y.fail(r, fmt::format("rule '{}' has no 'produces'", rule.name));
   rule.produces = y.scalar(r["produces"], "'produces'");
   rule.producesLoc = locOf(r["produces"], y.file);
@@ -189,7 +194,8 @@ void loadRule(RuleSet& set, const YamlCtx& y, const YAML::Node& r, const std::ve
   if (!r["glsl"]) y.fail(r, fmt::format("rule '{}' has no 'glsl' snippet", rule.name));
   rule.glsl = snippetLines(y, r["glsl"], raw);
   if (r["doc"]) rule.doc = y.scalar(r["doc"], "'doc'");
-  set.rules.push_back(std::move(rule));
+  if (existing) replaceRule(set, y, r["name"], *existing, std::move(rule), overrides);
+  else set.rules.push_back(std::move(rule));
 }
 
 void loadFile(RuleSet& set, const std::string& path, std::vector<std::string>& stack);
@@ -199,7 +205,7 @@ void loadParsed(RuleSet& set, const std::string& text, const std::string& path, 
   YAML::Node root = parseYaml(text, path);
   if (!root.IsDefined() || root.IsNull()) throw InputError(SourceLoc{path, 1, 1}, "empty rules file");
   y.expectMap(root, "a rules file");
-  y.checkKeys(root, {"include", "semantics", "varyings", "rules", "doc"});
+  y.checkKeys(root, {"include", "semantics", "varyings", "conventions", "disable", "rules", "doc"});
   set.files.push_back(path);
   std::vector<std::string> raw = splitLines(text);
   if (auto inc = root["include"]) {
@@ -225,6 +231,8 @@ void loadParsed(RuleSet& set, const std::string& text, const std::string& path, 
   }
   if (auto s = root["semantics"]) loadSemantics(set, y, s);
   if (auto v = root["varyings"]) loadVaryings(set, y, v);
+  if (auto c = root["conventions"]) loadConventions(set, y, c);
+  if (auto d = root["disable"]) applyDisable(set, y, d);
   if (auto rs = root["rules"]) {
     y.expectSeq(rs, "'rules'");
     for (const auto& r : rs) {
