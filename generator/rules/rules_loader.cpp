@@ -200,6 +200,20 @@ void loadRule(RuleSet& set, const YamlCtx& y, const YAML::Node& r, const std::ve
 
 void loadFile(RuleSet& set, const std::string& path, std::vector<std::string>& stack);
 
+// The same file under another spelling (relative from two places, or absolute) is the
+// same file: loading it twice would declare everything twice.
+bool alreadyLoaded(const RuleSet& set, const std::string& path) {
+  if (std::find(set.files.begin(), set.files.end(), path) != set.files.end()) return true;
+  std::error_code ec;
+  auto canon = std::filesystem::weakly_canonical(path, ec);
+  if (ec) return false;
+  for (const auto& f : set.files) {
+    std::error_code ec2;
+    if (std::filesystem::weakly_canonical(f, ec2) == canon && !ec2) return true;
+  }
+  return false;
+}
+
 void loadParsed(RuleSet& set, const std::string& text, const std::string& path, std::vector<std::string>& stack) {
   YamlCtx y{path};
   YAML::Node root = parseYaml(text, path);
@@ -216,7 +230,7 @@ void loadParsed(RuleSet& set, const std::string& text, const std::string& path, 
       std::string incPath = p.lexically_normal().string();
       if (std::find(stack.begin(), stack.end(), incPath) != stack.end())
         y.fail(i, fmt::format("include cycle: '{}' includes itself", incPath));
-      if (std::find(set.files.begin(), set.files.end(), incPath) != set.files.end()) continue;  // already loaded
+      if (alreadyLoaded(set, incPath)) continue;
       std::error_code ec;
       if (!std::filesystem::exists(p, ec)) y.fail(i, fmt::format("included file '{}' does not exist", incPath));
       if (stack.size() >= kMaxIncludeDepth) y.fail(i, fmt::format("includes nest deeper than {} files", kMaxIncludeDepth));
@@ -264,7 +278,7 @@ const VaryingMapping* RuleSet::findVarying(const std::string& name) const {
 
 void loadRulesInto(RuleSet& set, const std::string& path) {
   std::string norm = std::filesystem::path(path).lexically_normal().string();
-  if (std::find(set.files.begin(), set.files.end(), norm) != set.files.end()) return;
+  if (alreadyLoaded(set, norm)) return;
   std::vector<std::string> stack;
   loadFile(set, norm, stack);
 }
