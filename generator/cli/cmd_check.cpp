@@ -13,6 +13,8 @@ struct CheckCommand {
   bool noCompile = false;
 
   int run() {
+    if (costs && noCompile)
+      throw CLI::ValidationError("--costs", "does not apply with --no-compile: the measured costs come from compiling");
     opts.compileSnippets = !noCompile;
     CheckReport r = checkRules(opts);
     std::cerr << formatCheckReport(r);

@@ -102,6 +102,8 @@ struct GenerateCommand {
     o.capture = capture;
     std::set<std::string> kinds(emit.begin(), emit.end());
     if (kinds.empty()) throw CLI::ValidationError("--emit", "nothing to emit");
+    if (optimize && !kinds.count("spv") && !kinds.count("header"))
+      throw CLI::ValidationError("-O", "does not apply: it optimises the SPIR-V, and --emit writes none (add spv or header)");
     // With one --emit kind, -o names that file exactly (like glslc -o). Otherwise -o is a
     // stem: known suffixes are stripped and each kind gets its own (.vert .spv .spv.h .json).
     bool single = kinds.size() == 1 && !output.empty();
