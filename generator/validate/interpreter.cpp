@@ -124,7 +124,6 @@ struct Interpreter::State {
   std::vector<Val> cache;
   std::vector<uint64_t> cachedAt;
   std::vector<std::pair<std::string, Val>> locals;
-  std::map<std::pair<int, int64_t>, const std::vector<glm::vec4>*> streams;
   std::vector<std::string>* trace = nullptr;
   std::set<std::string> traced;
   int evaluating = -1;  // semantic whose definition is being evaluated (messages)
@@ -147,44 +146,59 @@ struct Interpreter::State {
     if (trace && traced.insert(name).second) trace->push_back(name + " = " + showVal(v));
   }
 
-  // Provided value of a semantic (element `index` of a family or array, -1 for none), or
-  // false if neither the mesh nor the pose has it.
-  bool provided(int sem, int64_t index, Val& out, const DefNode* at) {
+  // Where a provided semantic instance lives, resolved once per (semantic, index).
+  struct Source {
+    const std::vector<double>* uniform = nullptr;  // with offset
+    size_t offset = 0;
+    const std::vector<glm::vec4>* stream = nullptr;
+    std::string name;  // "morph.position[2]"
+  };
+  std::map<std::pair<int, int64_t>, Source> sources;
+
+  const Source& sourceOf(int sem, int64_t index, const DefNode* at) {
+    auto key = std::make_pair(sem, index);
+    if (auto it = sources.find(key); it != sources.end()) return it->second;
     const SemanticDecl& d = rules.semantics[static_cast<size_t>(sem)];
-    DefType t = declType(d.type);
-    const int n = defTypeComponents(t);
-    std::string inst = index >= 0 ? fmt::format("{}[{}]", d.name, index) : d.name;
-    if (auto u = uniforms.find(d.name); u != uniforms.end()) {
-      size_t off = index >= 0 && d.count.empty() ? static_cast<size_t>(index) * static_cast<size_t>(n) : 0;
-      if (index >= 0 && !d.count.empty()) return false;  // families are per-vertex
-      if (off + static_cast<size_t>(n) > u->second.size()) {
-        std::string msg = fmt::format("index {} is out of range of '{}' ({} elements)", index, d.name, u->second.size() / static_cast<size_t>(n));
+    const size_t n = static_cast<size_t>(defTypeComponents(declType(d.type)));
+    Source src;
+    src.name = index >= 0 ? fmt::format("{}[{}]", d.name, index) : d.name;
+    auto u = uniforms.find(d.name);
+    if (u != uniforms.end() && !(index >= 0 && !d.count.empty())) {
+      size_t off = index >= 0 ? static_cast<size_t>(index) * n : 0;
+      if (off + n > u->second.size()) {
+        std::string msg = fmt::format("index {} is out of range of '{}' ({} elements)", index, d.name, u->second.size() / n);
         if (at) fail(*at, msg);
         throw std::invalid_argument(msg);
       }
-      out = unflatten(t, u->second.data() + off);
-      record(inst, out);
-      return true;
+      src.uniform = &u->second;
+      src.offset = off;
+    } else if (auto m = mesh.streams.find(src.name); m != mesh.streams.end()) {
+      if (m->second.size() != mesh.vertexCount)
+        throw std::invalid_argument(fmt::format("stream {} of mesh '{}' has {} values for {} vertices", src.name, mesh.name,
+                                                m->second.size(), mesh.vertexCount));
+      src.stream = &m->second;
     }
-    auto key = std::make_pair(sem, index);
-    auto it = streams.find(key);
-    if (it == streams.end()) {
-      auto m = mesh.streams.find(inst);
-      const std::vector<glm::vec4>* p = m == mesh.streams.end() ? nullptr : &m->second;
-      if (p && p->size() != mesh.vertexCount)
-        throw std::invalid_argument(fmt::format("stream {} of mesh '{}' has {} values for {} vertices", inst, mesh.name,
-                                                p->size(), mesh.vertexCount));
-      it = streams.emplace(key, p).first;
+    return sources.emplace(key, std::move(src)).first->second;
+  }
+
+  // Provided value of a semantic (element `index` of a family or array, -1 for none), or
+  // false if neither the mesh nor the pose has it.
+  bool provided(int sem, int64_t index, Val& out, const DefNode* at) {
+    const Source& src = sourceOf(sem, index, at);
+    DefType t = declType(rules.semantics[static_cast<size_t>(sem)].type);
+    if (src.uniform) {
+      out = unflatten(t, src.uniform->data() + src.offset);
+    } else if (src.stream) {
+      if (vertex == kNoVertex) {
+        const std::string& of = evaluating >= 0 ? rules.semantics[static_cast<size_t>(evaluating)].name : src.name;
+        throw std::invalid_argument(fmt::format("'{}' is evaluated as a uniform but reads per-vertex '{}'", of, src.name));
+      }
+      const glm::vec4& x = (*src.stream)[vertex];
+      out = t == DefType::Int || t == DefType::Float ? scalar(x.x, t) : vec(dvec4(x), t);
+    } else {
+      return false;
     }
-    if (!it->second) return false;
-    if (vertex == kNoVertex) {
-      const std::string& of = evaluating >= 0 ? rules.semantics[static_cast<size_t>(evaluating)].name : d.name;
-      throw std::invalid_argument(fmt::format("'{}' is evaluated as a uniform but reads per-vertex '{}'", of, inst));
-    }
-    const glm::vec4& x = (*it->second)[vertex];
-    out = vec(dvec4(x), t);
-    if (t == DefType::Int || t == DefType::Float) out = scalar(x.x, t);
-    record(inst, out);
+    if (trace) record(src.name, out);
     return true;
   }
 
@@ -232,7 +246,7 @@ struct Interpreter::State {
     auto apply = [&](double x, double y) {
       return op == "+" ? x + y : op == "-" ? x - y : op == "*" ? x * y : x / y;
     };
-    auto each = [&](const Val& x, std::function<double(double, int, int)> f) {
+    auto each = [&](const Val& x, auto f) {
       Val r;
       r.t = x.t;
       int cols = x.t == DefType::Mat3 ? 3 : x.t == DefType::Mat4 ? 4 : 1;
