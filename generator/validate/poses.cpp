@@ -62,6 +62,12 @@ std::vector<double> drawElement(const SemanticDecl& d, Rng& rng) {
       float zn = static_cast<float>(rng.uniform(0.1, 1.0)), zf = static_cast<float>(rng.uniform(10.0, 100.0));
       m = glm::perspectiveRH_ZO(fov, aspect, zn, zf);
       m[1][1] = -m[1][1];  // Vulkan's y points down
+      // Seen from 3..5 units away, looking at the origin (where the meshes are): usable as
+      // a view-projection too, with w well away from 0 (the perspective divide stays
+      // well-conditioned).
+      glm::vec3 eye(rng.unitVector() * rng.uniform(3.0, 5.0));
+      glm::vec3 up = std::abs(eye.y) > 0.9f * glm::length(eye) ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+      m = m * glm::lookAt(eye, glm::vec3(0.0f), up);
     } else {
       glm::vec3 axis(rng.unitVector());
       float angle = static_cast<float>(rng.uniform(-3.14159, 3.14159));

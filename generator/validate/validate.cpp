@@ -167,8 +167,9 @@ std::vector<uint8_t> buildUniforms(const Rig& rig, const EmittedGlsl& glsl, cons
 std::string nonFiniteReport(Interpreter& reference, const EmittedOutput& o, size_t v, int c, double gpu, double ref) {
   bool g = !std::isfinite(gpu), r = !std::isfinite(ref);
   std::string side = g && r ? "GPU and reference" : g ? "GPU" : "reference";
+  auto show = [](double x) { return std::isnan(x) ? std::string("nan") : fmt::format("{}", x); };  // no "-nan"
   std::string s = fmt::format("{} gives {} at vertex {}, output {} component {} (GPU {}, reference {})", side,
-                              g ? gpu : ref, v, o.name, c, gpu, ref);
+                              show(g ? gpu : ref), v, o.name, c, show(gpu), show(ref));
   for (const auto& sem : o.semantics) {
     try {
       auto inputs = reference.inputsAt(sem, v);
