@@ -457,3 +457,26 @@ TEST(BreakDefinitions, ClampedMorphWeights) {
 }
 
 }  // namespace
+
+namespace {
+
+// docs/semantics.md's table of definitions is the vocabulary's, verbatim (blanks collapsed).
+TEST(Docs, SemanticsListsEveryDefinition) {
+  sg::RuleSet set = sg::loadRules({sourcePath("rules/vocabulary.yaml")});
+  std::string table = "| semantic | type | definition |\n|---|---|---|\n";
+  for (const auto& d : set.semantics) {
+    if (!d.definition) continue;
+    std::string text, word;
+    std::istringstream in(d.definitionText);
+    while (in >> word) text += (text.empty() ? "" : " ") + word;
+    table += "| `" + d.name + "` | " + std::string(sg::glslName(d.type)) + " | `" + text + "` |\n";
+  }
+  std::string doc = sgtest::readText(sourcePath("docs/semantics.md"));
+  const std::string begin = "<!-- definitions begin -->\n", end = "<!-- definitions end -->";
+  size_t b = doc.find(begin), e = doc.find(end);
+  ASSERT_NE(b, std::string::npos);
+  ASSERT_NE(e, std::string::npos);
+  EXPECT_EQ(doc.substr(b + begin.size(), e - b - begin.size()), table);
+}
+
+}  // namespace
