@@ -159,6 +159,16 @@ std::vector<uint8_t> buildUniforms(const Rig& rig, const EmittedGlsl& glsl, cons
 
 }  // namespace
 
+rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh) { return quantizedMesh(rig, mesh); }
+
+rt::VertexStream vertexStream(const Rig& rig, const EmittedInput& in, const rt::Mesh& mesh) {
+  return buildStream(rig, in, mesh);
+}
+
+std::vector<uint8_t> uniformBlock(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spv, const rt::Pose& pose) {
+  return buildUniforms(rig, glsl, spv, pose);
+}
+
 ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_t seed, int poses) {
   rt::MeshOptions mo;
   mo.morphTargets = rig.morphTargets();
