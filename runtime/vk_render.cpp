@@ -496,6 +496,18 @@ Renderer::Renderer(const Harness& harness) : impl_(new Impl) {
 
 Renderer::~Renderer() { delete impl_; }
 
+std::string Renderer::driver() const {
+  const Impl& m = *impl_;
+  if (m.props.apiVersion >= VK_API_VERSION_1_2) {
+    VkPhysicalDeviceDriverProperties drv{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+    VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    p2.pNext = &drv;
+    vkGetPhysicalDeviceProperties2(m.h.physicalDevice, &p2);
+    return fmt::format("{} {}", drv.driverName, drv.driverInfo);
+  }
+  return fmt::format("driver version {:#x}", m.props.driverVersion);
+}
+
 Image Renderer::draw(const DrawRequest& r) {
   Impl& m = *impl_;
   m.validate(r, true);

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "runtime/vk_harness.h"
@@ -68,6 +69,8 @@ class Renderer {
   // Throws std::runtime_error on a bad request or a Vulkan error.
   Image draw(const DrawRequest& request);
   Timing time(const DrawRequest& request, const TimingRequest& timing);
+  // "<driver name> <driver info>" (VkPhysicalDeviceDriverProperties), or the driver version number.
+  std::string driver() const;
 
  private:
   struct Impl;

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "cli/commands.h"
+#include "render/gpu_bench.h"
 #include "render/render.h"
 
 namespace sg {
@@ -73,6 +74,33 @@ struct RenderCommand {
   }
 };
 
+struct BenchCommand {
+  GenerateArgs args;
+  GpuBenchOptions bo;
+  std::string size = "256x256";
+  std::string raster = "both";
+  bool noLayers = false;
+  bool noAlternatives = false, noFloor = false;
+
+  int run() {
+    bo.render.gen = args.resolve();
+    bo.render.validationLayers = !noLayers;
+    unsigned w = 0, h = 0;
+    char tail = 0;
+    if (std::sscanf(size.c_str(), "%ux%u%c", &w, &h, &tail) != 2 || w == 0 || h == 0 || w > 8192 || h > 8192)
+      throw CLI::ValidationError("--size", "expected WIDTHxHEIGHT with each in 1..8192, got '" + size + "'");
+    bo.render.width = w;
+    bo.render.height = h;
+    bo.rasterOn = raster != "off";
+    bo.rasterOff = raster != "on";
+    bo.alternatives = !noAlternatives;
+    bo.floor = !noFloor;
+    GpuBenchReport rep = runGpuBench(bo);
+    std::cout << formatGpuBench(rep);
+    return 0;
+  }
+};
+
 }  // namespace
 
 void registerRender(CLI::App& app, CliState& state) {
@@ -96,6 +124,27 @@ void registerRender(CLI::App& app, CliState& state) {
   sub->add_option("--light", cmd->light, "Direction towards the key light, x,y,z (world space)");
   sub->add_option("--rim-light", cmd->rim, "Direction of the hilight cube map's rim light, x,y,z");
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
+
+  auto bench = std::make_shared<BenchCommand>();
+  bench->bo.render.mesh = "dawn";
+  CLI::App* b = app.add_subcommand("bench", "Time the generated vertex program, its forced alternatives, a hand-written "
+                                            "port and a pass-through floor on the GPU (timestamp queries)");
+  bench->args.add(*b);
+  b->add_option("--hand-port", bench->bo.handPortPath, "A hand-written vertex shader with the same interface "
+                                                       "(a_<attribute>, u_<uniform>), e.g. examples/dawn/listing-3-3.vert");
+  b->add_option("--mesh", bench->bo.render.mesh, "Procedural mesh: dawn (default, 180k vertices), head, limb")
+      ->check(CLI::IsMember({"head", "limb", "dawn"}));
+  b->add_option("--size", bench->size, "Render target WIDTHxHEIGHT with rasterization on (default 256x256)");
+  b->add_option("--draws", bench->bo.drawsPerFrame, "Draws of the mesh between two timestamps (default 8)")
+      ->check(CLI::Range(1, 100000));
+  b->add_option("--frames", bench->bo.frames, "Timed frames; the median is reported (default 7)")->check(CLI::Range(1, 1000));
+  b->add_option("--raster", bench->raster, "on, off (rasterizer discard + transform feedback) or both (default)")
+      ->check(CLI::IsMember({"on", "off", "both"}));
+  b->add_flag("--no-alternatives", bench->noAlternatives, "Only the generated plan (and the hand port and floor)");
+  b->add_flag("--no-floor", bench->noFloor, "Leave out the pass-through floor");
+  b->add_option("--device", bench->bo.render.device, "Vulkan device name (substring); default lavapipe");
+  b->add_flag("--no-validation-layers", bench->noLayers, "Run without the Khronos validation layer (use for timings)");
+  b->callback([bench, &state] { state.run = [bench] { return bench->run(); }; });
 }
 
 }  // namespace sg
