@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <functional>
 #include <stdexcept>
@@ -594,7 +595,9 @@ Timing Renderer::time(const DrawRequest& r, const TimingRequest& t) {
     }
     vkCmdWriteTimestamp(o.cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, o.queries, 1);
     vkCmdEndRenderPass(o.cmd);
+    auto t0 = std::chrono::steady_clock::now();
     m.submitAndWait(o);
+    out.wallNs.push_back(std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count());
     uint64_t ts[2] = {0, 0};
     check(vkGetQueryPoolResults(m.h.device, o.queries, 0, 2, sizeof(ts), ts, sizeof(uint64_t),
                                 VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),

@@ -54,7 +54,10 @@ struct TimingRequest {
 };
 
 struct Timing {
-  std::vector<double> frameNs;  // GPU time of each frame's draws
+  std::vector<double> frameNs;  // GPU time of each frame's draws (timestamps)
+  // Host time of each frame's submit + wait: on a CPU device (lavapipe) work may run outside
+  // the timestamps' reach (deferred binning, rasterizer threads), so this is the honest one there.
+  std::vector<double> wallNs;
   uint32_t verticesPerDraw = 0;  // vertex shader invocations asked for per draw (unique vertices)
 };
 

@@ -264,30 +264,37 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     rt::TimingRequest t;
     t.drawsPerFrame = opts.drawsPerFrame;
     t.frames = opts.frames + 1;
-    auto perVertex = [&](const rt::Timing& tm) {
-      std::vector<double> frames(tm.frameNs.begin() + 1, tm.frameNs.end());  // the first warms up
-      return median(frames) / (double(opts.drawsPerFrame) * double(tm.verticesPerDraw));
+    auto perVertex = [&](const std::vector<double>& ns, uint32_t vertices) {
+      std::vector<double> frames(ns.begin() + 1, ns.end());  // the first warms up
+      return median(frames) / (double(opts.drawsPerFrame) * double(vertices));
     };
     if (opts.rasterOn) {
       req.vertexSpirv = p.renderSpirv;
       t.rasterize = true;
-      p.row.rasterOnNsPerVertex = perVertex(renderer.time(req, t));
+      rt::Timing tm = renderer.time(req, t);
+      p.row.rasterOnNsPerVertex = perVertex(tm.frameNs, tm.verticesPerDraw);
+      p.row.rasterOnWallNsPerVertex = perVertex(tm.wallNs, tm.verticesPerDraw);
     }
     if (opts.rasterOff) {
       req.vertexSpirv = p.captureSpirv;
       t.rasterize = false;
       t.captureStride = p.captureStride;
-      p.row.rasterOffNsPerVertex = perVertex(renderer.time(req, t));
+      rt::Timing tm = renderer.time(req, t);
+      p.row.rasterOffNsPerVertex = perVertex(tm.frameNs, tm.verticesPerDraw);
+      p.row.rasterOffWallNsPerVertex = perVertex(tm.wallNs, tm.verticesPerDraw);
     }
     rep.rows.push_back(p.row);
   }
-  std::vector<double> cost, on, off;
+  std::vector<double> cost, on, off, offWall;
   for (const auto& r : rep.rows)
     if (r.hasCost) {
       cost.push_back(double(r.planCost));
       on.push_back(r.rasterOnNsPerVertex);
       off.push_back(r.rasterOffNsPerVertex);
+      offWall.push_back(r.rasterOffWallNsPerVertex);
     }
+  rep.pearsonOffWall = pearson(cost, offWall);
+  rep.spearmanOffWall = spearman(cost, offWall);
   rep.pearsonOn = pearson(cost, on);
   rep.spearmanOn = spearman(cost, on);
   rep.pearsonOff = pearson(cost, off);
@@ -301,22 +308,27 @@ std::string formatGpuBench(const GpuBenchReport& r) {
   std::string s = fmt::format("device: {} (driver: {})\nmesh: {} vertices, {} triangles; {} draws per frame, median of {} frames; "
                               "rasterization on: {}x{} target\n\n",
                               r.device, r.driver, r.vertices, r.triangles, r.drawsPerFrame, r.frames, r.width, r.height);
-  double base = -1, baseOff = -1;
+  const GpuBenchRow* gen = nullptr;
   for (const auto& row : r.rows)
-    if (row.label == "generated") base = row.rasterOnNsPerVertex, baseOff = row.rasterOffNsPerVertex;
+    if (row.label == "generated") gen = &row;
   auto cell = [](double ns, double ref) {
     if (ns < 0) return std::string("—");
-    return ref > 0 ? fmt::format("{:.3f} ({:.2f}x)", ns, ns / ref) : fmt::format("{:.3f}", ns);
+    return ref > 0 ? fmt::format("{:.4f} ({:.2f}x)", ns, ns / ref) : fmt::format("{:.4f}", ns);
   };
-  s += "| program | plan cost | SPIR-V instr. | raster on, ns/vertex (vs generated) | raster off (xfb), ns/vertex (vs generated) |\n";
-  s += "|---|---:|---:|---:|---:|\n";
+  s += "ns per vertex (x: relative to the generated program); timestamps = GPU timestamp queries, "
+       "host = submit-to-fence wall time\n\n";
+  s += "| program | plan cost | SPIR-V instr. | raster on, timestamps | raster off (xfb), timestamps | raster on, host | raster off, host |\n";
+  s += "|---|---:|---:|---:|---:|---:|---:|\n";
   for (const auto& row : r.rows)
-    s += fmt::format("| {} | {} | {} | {} | {} |\n", row.label, row.hasCost ? std::to_string(row.planCost) : "—",
-                     row.spirvInstructions, cell(row.rasterOnNsPerVertex, base), cell(row.rasterOffNsPerVertex, baseOff));
-  s += fmt::format("\nplan cost vs time over the {} generated programs: raster on Pearson {:.2f}, Spearman {:.2f}; "
-                   "raster off Pearson {:.2f}, Spearman {:.2f}\n",
+    s += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", row.label, row.hasCost ? std::to_string(row.planCost) : "—",
+                     row.spirvInstructions, cell(row.rasterOnNsPerVertex, gen ? gen->rasterOnNsPerVertex : -1),
+                     cell(row.rasterOffNsPerVertex, gen ? gen->rasterOffNsPerVertex : -1),
+                     cell(row.rasterOnWallNsPerVertex, gen ? gen->rasterOnWallNsPerVertex : -1),
+                     cell(row.rasterOffWallNsPerVertex, gen ? gen->rasterOffWallNsPerVertex : -1));
+  s += fmt::format("\nplan cost vs time over the {} generated programs: raster on (timestamps) Pearson {:.2f}, Spearman {:.2f}; "
+                   "raster off (timestamps) Pearson {:.2f}, Spearman {:.2f}; raster off (host) Pearson {:.2f}, Spearman {:.2f}\n",
                    std::count_if(r.rows.begin(), r.rows.end(), [](const GpuBenchRow& x) { return x.hasCost; }), r.pearsonOn,
-                   r.spearmanOn, r.pearsonOff, r.spearmanOff);
+                   r.spearmanOn, r.pearsonOff, r.spearmanOff, r.pearsonOffWall, r.spearmanOffWall);
   return s;
 }
 

@@ -31,6 +31,8 @@ struct GpuBenchRow {
   size_t spirvInstructions = 0;    // of the render build
   double rasterOnNsPerVertex = -1;   // median frame / (draws x vertices); -1 = not measured
   double rasterOffNsPerVertex = -1;
+  double rasterOnWallNsPerVertex = -1;   // host submit-to-fence time (see rt::Timing::wallNs)
+  double rasterOffWallNsPerVertex = -1;
 };
 
 struct GpuBenchReport {
@@ -41,6 +43,7 @@ struct GpuBenchReport {
   // Over the generated plan and its alternatives (rows with a cost): Pearson correlation of
   // plan cost with time per vertex, and Spearman (rank) correlation; NaN if < 3 rows.
   double pearsonOn = 0, spearmanOn = 0, pearsonOff = 0, spearmanOff = 0;
+  double pearsonOffWall = 0, spearmanOffWall = 0;  // the same against host time, raster off
 };
 
 GpuBenchReport runGpuBench(const GpuBenchOptions& opts);
