@@ -85,7 +85,10 @@ void feedHandWritten(const GlslShader& s, const std::string& path, const Rig& ri
 
 // The floor: reads the position, writes it as gl_Position and a constant to every other
 // output of the generated program's interface.
-std::string floorShader(const GenerateResult& g, bool capture) {
+// With allInputs, it also reads every input the generated program reads (summed into
+// gl_Position with a factor the compiler cannot fold away), separating the cost of vertex
+// fetch from the cost of the arithmetic.
+std::string floorShader(const GenerateResult& g, bool capture, bool allInputs) {
   std::string pos;
   int location = -1;
   for (const auto& in : g.glsl.inputs)
@@ -97,9 +100,20 @@ std::string floorShader(const GenerateResult& g, bool capture) {
       }
   std::string text = "#version 450\n";
   for (const auto& in : g.glsl.inputs)
-    if (in.location == location) text += fmt::format("layout(location = {}) in {} {};\n", in.location, glslName(in.type), in.name);
+    if (in.location == location || allInputs)
+      text += fmt::format("layout(location = {}) in {} {};\n", in.location, glslName(in.type), in.name);
   std::string body = pos.empty() ? "  gl_Position = vec4(0.0, 0.0, 0.5, 1.0);\n"
                                  : fmt::format("  gl_Position = vec4({}, 1.0);\n", pos);
+  if (allInputs) {
+    body += "  vec4 fetched = vec4(0.0);\n";
+    for (const auto& in : g.glsl.inputs) {
+      const int n = componentCount(in.type);
+      const char* pad = n == 1 ? "" : n == 2 ? ", 0.0, 0.0" : n == 3 ? ", 0.0" : "";
+      std::string v = scalarKind(in.type) == ScalarKind::Float ? in.name : fmt::format("{}({})", n == 1 ? "float" : fmt::format("vec{}", n), in.name);
+      body += n == 1 ? fmt::format("  fetched += vec4({});\n", v) : fmt::format("  fetched += vec4({}{});\n", v, pad);
+    }
+    body += "  gl_Position += 1e-30 * fetched;\n";
+  }
   for (const auto& o : g.glsl.outputs) {
     if (o.location < 0) {
       if (capture)
@@ -228,13 +242,14 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     feedHandWritten(s, opts.handPortPath, rig, scene, p);
     programs.push_back(std::move(p));
   }
-  if (opts.floor) {
+  for (bool allInputs : {false, true}) {
+    if (!opts.floor) break;
     Program p;
-    p.row.label = "floor (pass-through)";
-    GlslShader s = parseVertex(floorShader(chosen, false), "floor.vert", env);
+    p.row.label = allInputs ? "floor + every input fetched" : "floor (pass-through)";
+    GlslShader s = parseVertex(floorShader(chosen, false, allInputs), "floor.vert", env);
     p.renderSpirv = s.spirv();
     p.row.spirvInstructions = countInstructions(p.renderSpirv);
-    p.captureSpirv = parseVertex(floorShader(chosenCapture, true), "floor.vert", env).spirv();
+    p.captureSpirv = parseVertex(floorShader(chosenCapture, true, allInputs), "floor.vert", env).spirv();
     p.captureStride = chosenCapture.glsl.captureStride;
     feedHandWritten(s, "floor.vert", rig, scene, p);
     programs.push_back(std::move(p));
