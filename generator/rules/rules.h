@@ -10,6 +10,7 @@
 
 #include "common/diagnostics.h"
 #include "common/types.h"
+#include "rules/definition.h"
 #include "rules/expr.h"
 
 namespace sg {
@@ -29,6 +30,16 @@ struct SemanticDecl {
   Expr count;              // indexed family (morph.position[i]): instance count expression
   std::string doc;
   SourceLoc loc;
+  // What the value is (docs/validation.md, "Definitions"): a formula over other semantics,
+  // evaluated by validate's reference interpreter. Null = no definition (outputs carrying it
+  // are reported unchecked).
+  DefNodeP definition;
+  std::string definitionText;
+  // Uniforms: how validation draws values (docs/validation.md, "Poses"): "" (by the
+  // standard pose, or unknown), rigid, affine, projection, unit, point, weight, int.
+  std::string kind;
+  double rangeLo = 0, rangeHi = 1;  // weight / int / scalar kinds
+  SourceLoc kindLoc;
 };
 
 // A reference to a semantic in `needs:`: "world.position", "morph.position[*]", "skin.joints[k/4]".

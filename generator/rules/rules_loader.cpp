@@ -1,6 +1,8 @@
 // Loads rules YAML (format: docs/rules-format.md) with located diagnostics.
 #include <fmt/format.h>
 
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <set>
 #include <sstream>
@@ -65,6 +67,37 @@ SemanticRef parseRef(const YamlCtx& y, const YAML::Node& n) {
   return r;
 }
 
+double finiteNumber(const YamlCtx& y, const YAML::Node& n, const char* what) {
+  std::string s = y.scalar(n, what);
+  char* end = nullptr;
+  double v = std::strtod(s.c_str(), &end);
+  if (s.empty() || end != s.c_str() + s.size() || !std::isfinite(v)) y.fail(n, fmt::format("{} must be a finite number, got '{}'", what, s));
+  return v;
+}
+
+// The `definition:`, `kind:` and `range:` keys of a semantic (rules/definition.h).
+void loadSemanticDefinition(SemanticDecl& d, const YamlCtx& y, const YAML::Node& body) {
+  if (body["definition"]) {
+    d.definitionText = y.scalar(body["definition"], "'definition'");
+    d.definition = parseDefinition(d.definitionText, exprLoc(body["definition"], y.file));
+  }
+  if (body["kind"]) {
+    d.kind = y.scalar(body["kind"], "'kind'");
+    d.kindLoc = locOf(body["kind"], y.file);
+    static const std::set<std::string> kinds = {"rigid", "affine", "projection", "unit", "point", "weight", "int"};
+    if (!kinds.count(d.kind))
+      y.fail(body["kind"], fmt::format("unknown kind '{}' (rigid, affine, projection, unit, point, weight, int)", d.kind));
+  }
+  if (body["range"]) {
+    YAML::Node r = body["range"];
+    y.expectSeq(r, "'range' ([low, high])");
+    if (r.size() != 2) y.fail(r, "'range' is [low, high]");
+    d.rangeLo = finiteNumber(y, r[0], "the low end of 'range'");
+    d.rangeHi = finiteNumber(y, r[1], "the high end of 'range'");
+    if (!(d.rangeLo <= d.rangeHi)) y.fail(r, "'range' is [low, high] with low <= high");
+  }
+}
+
 void loadSemantics(RuleSet& set, const YamlCtx& y, const YAML::Node& sems) {
   y.expectMap(sems, "'semantics'");
   for (auto it = sems.begin(); it != sems.end(); ++it) {
@@ -84,12 +117,13 @@ void loadSemantics(RuleSet& set, const YamlCtx& y, const YAML::Node& sems) {
       typeName = body.Scalar();
     } else {
       y.expectMap(body, "a semantic declaration");
-      y.checkKeys(body, {"type", "count", "array", "doc"});
+      y.checkKeys(body, {"type", "count", "array", "doc", "definition", "kind", "range"});
       if (!body["type"]) y.fail(body, fmt::format("semantic '{}' has no 'type'", d.name));
       typeName = y.scalar(body["type"], "'type'");
       if (body["count"]) d.count = Expr::parse(y.scalar(body["count"], "'count'"), exprLoc(body["count"], y.file));
       if (body["array"]) d.arrayParam = y.scalar(body["array"], "'array'");
       if (body["doc"]) d.doc = y.scalar(body["doc"], "'doc'");
+      loadSemanticDefinition(d, y, body);
     }
     auto t = parseType(typeName);
     if (!t) y.fail(body.IsMap() ? body["type"] : body, fmt::format("unknown type '{}' for semantic '{}'", typeName, d.name));
@@ -291,6 +325,7 @@ void loadRulesText(RuleSet& set, const std::string& text, const std::string& fil
 RuleSet loadRules(const std::vector<std::string>& paths) {
   RuleSet set;
   for (const auto& p : paths) loadRulesInto(set, p);
+  checkDefinitions(set);
   return set;
 }
 
