@@ -383,4 +383,22 @@ TEST(Authoring, CheckGroupsWarningsByKind) {
   EXPECT_TRUE(has(r.groups[0].kind, "rule '\u2026' states cost 1")) << r.groups[0].kind;
 }
 
+TEST(Authoring, CheckValidatesConventionEntries) {
+  auto dir = freshDir("conv");
+  writeText(dir / "c.yaml",
+            "semantics:\n  world.normal: vec3\n  world.handedness: float\n"
+            "conventions:\n  mine:\n    names:\n      vNrm: world.nrmal\n"
+            "      vTan: { vec3: [world.normal, world.handedness] }\n");
+  sg::CheckOptions o;
+  o.rulesPaths = {(dir / "c.yaml").string()};
+  o.compileSnippets = false;
+  sg::CheckReport r = sg::checkRules(o);
+  ASSERT_EQ(r.errors, 2) << sg::formatCheckReport(r);
+  EXPECT_EQ(r.findings[0].loc.line, 7);
+  EXPECT_TRUE(has(r.findings[0].message, "unknown semantic 'world.nrmal'")) << r.findings[0].message;
+  EXPECT_TRUE(has(r.findings[0].message, "world.normal")) << r.findings[0].message;  // did you mean
+  EXPECT_EQ(r.findings[1].loc.line, 8);
+  EXPECT_TRUE(has(r.findings[1].message, "maps vec3 'vTan' to 4 components; a vec3 has 3")) << r.findings[1].message;
+}
+
 }  // namespace
