@@ -65,6 +65,11 @@ TEST(Definitions, BadFormulasAreLocated) {
   EXPECT_EQ(loadError("semantics:\n  a.b: { type: float, definition: \"(((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((1)))))))))))))))))))))))))))))))))))))))))))))))))))))))))))))))))\" }\n"),
             "user.yaml:2:68: error: definition is nested deeper than 64 levels");
   EXPECT_EQ(loadError("semantics:\n  a.b: { type: vec3, definition: \"let n = world.normal; n * view.ndotv\" }\n"), "");
+  // A folded block: the error is located on its own source line.
+  EXPECT_EQ(loadError("semantics:\n  a.b:\n    type: vec3\n    definition: >-\n      let n = world.normal;\n      n * camera.view\n"),
+            "user.yaml:6:9: error: cannot apply '*' to vec3 and mat4");
+  EXPECT_EQ(loadError("semantics:\n  a.b: { type: float, definition: \"let n = world.normal; n.z + n.w\" }\n"),
+            "user.yaml:2:64: error: '.w' reaches past the end of a vec3");
 }
 
 // The hand-written reference and the interpreter, on one mesh in one pose: every computed
