@@ -79,11 +79,12 @@ void loadSemanticDefinition(SemanticDecl& d, const YamlCtx& y, const YAML::Node&
   if (body["definition"]) {
     d.definitionText = y.scalar(body["definition"], "'definition'");
     SourceLoc at = exprLoc(body["definition"], y.file);
+    SourceLoc mark = locOf(body["definition"], y.file);
     // A block scalar ('>' or '|'): map each source line's text to its place in the value.
     std::vector<std::pair<size_t, SourceLoc>> segments{{0, at}};
-    if (at.line > 0 && at.line <= static_cast<int>(raw.size()) && at.col > 0 &&
-        raw[at.line - 1].size() >= static_cast<size_t>(at.col) &&
-        (raw[at.line - 1][at.col - 1] == '>' || raw[at.line - 1][at.col - 1] == '|')) {
+    if (mark.line > 0 && mark.line <= static_cast<int>(raw.size()) && mark.col > 0 &&
+        raw[mark.line - 1].size() >= static_cast<size_t>(mark.col) &&
+        (raw[mark.line - 1][mark.col - 1] == '>' || raw[mark.line - 1][mark.col - 1] == '|')) {
       segments.clear();
       size_t off = 0;
       for (size_t l = static_cast<size_t>(at.line); l < raw.size() && off < d.definitionText.size(); ++l) {

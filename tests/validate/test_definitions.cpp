@@ -69,7 +69,7 @@ TEST(Definitions, BadFormulasAreLocated) {
   EXPECT_EQ(loadError("semantics:\n  a.b:\n    type: vec3\n    definition: >-\n      let n = world.normal;\n      n * camera.view\n"),
             "user.yaml:6:9: error: cannot apply '*' to vec3 and mat4");
   EXPECT_EQ(loadError("semantics:\n  a.b: { type: float, definition: \"let n = world.normal; n.z + n.w\" }\n"),
-            "user.yaml:2:64: error: '.w' reaches past the end of a vec3");
+            "user.yaml:2:66: error: '.w' reaches past the end of a vec3");
 }
 
 // The hand-written reference and the interpreter, on one mesh in one pose: every computed
