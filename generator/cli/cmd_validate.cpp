@@ -13,6 +13,7 @@ namespace sg {
 namespace {
 
 struct ValidateCommand {
+  CLI::App* cmd = nullptr;
   GenerateArgs args;
   std::string mesh = "head";
   uint32_t seed = 1;
@@ -36,7 +37,14 @@ struct ValidateCommand {
     vo.strict = strict;
     ValidationScene scene;
     std::string what;
-    if (isGltfPath(vo.gen.rigPath)) {  // a real model: its own mesh, posed by its animation
+    bool gltf = isGltfPath(vo.gen.rigPath);
+    if (gltf)
+      for (const char* o : {"--mesh", "--seed", "--poses"})
+        refuseOption(*cmd, o, "to a glTF rig: the model's own mesh is posed by its animation (use --time, --animation)");
+    if (!gltf)
+      for (const char* o : {"--time", "--animation"})
+        refuseOption(*cmd, o, "to a YAML rig: it is validated on a procedural mesh in random poses (--mesh, --seed, --poses)");
+    if (gltf) {  // a real model: its own mesh, posed by its animation
       GltfSceneOptions so;
       so.times = times;
       so.animation = animation;
@@ -80,6 +88,7 @@ struct ValidateCommand {
 void registerValidate(CLI::App& app, CliState& state) {
   auto cmd = std::make_shared<ValidateCommand>();
   CLI::App* sub = app.add_subcommand("validate", "Generate, run on lavapipe and compare with the GLM reference");
+  cmd->cmd = sub;
   cmd->args.add(*sub);
   sub->add_option("--mesh", cmd->mesh, "Procedural mesh: head (default), limb, dawn (180k vertices)")
       ->check(CLI::IsMember({"head", "limb", "dawn"}));

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "common/yaml_util.h"
+#include "rules/loader_parts.h"
 #include "rules/rules.h"
 
 namespace sg {
@@ -210,17 +211,21 @@ std::vector<TemplateLine> snippetLines(const YamlCtx& y, const YAML::Node& n, co
 
 void loadRule(RuleSet& set, const YamlCtx& y, const YAML::Node& r, const std::vector<std::string>& raw) {
   y.expectMap(r, "a rule");
-  y.checkKeys(r, {"name", "produces", "needs", "when", "cost", "glsl", "doc"});
+  y.checkKeys(r, {"name", "produces", "needs", "when", "cost", "glsl", "doc", "override"});
   Rule rule;
   if (!r["name"]) y.fail(r, "rule has no 'name'");
   rule.name = y.scalar(r["name"], "'name'");
   rule.loc = locOf(r["name"], y.file);
   if (!validRuleName(rule.name)) y.fail(r["name"], fmt::format("'{}' is not a valid rule name", rule.name));
-  for (const auto& other : set.rules)
-    if (other.name == rule.name) {
+  bool overrides = r["override"] && y.boolean(r["override"], "'override'");
+  std::optional<size_t> existing;
+  for (size_t i = 0; i < set.rules.size(); ++i)
+    if (set.rules[i].name == rule.name) {
+      const Rule& other = set.rules[i];
       if (other.loc.file == rule.loc.file && other.loc.line == rule.loc.line) return;  // same file included twice
-      y.fail(r["name"], fmt::format("rule '{}' is defined twice (first at {}:{})", rule.name, other.loc.file, other.loc.line));
+      existing = i;
     }
+  if (overrides && !existing) failNothingToOverride(set, y, r["name"], rule.name);
   if (!r["produces"]) y.fail(r, fmt::format("rule '{}' has no 'produces'", rule.name));
   rule.produces = y.scalar(r["produces"], "'produces'");
   rule.producesLoc = locOf(r["produces"], y.file);
@@ -242,17 +247,32 @@ void loadRule(RuleSet& set, const YamlCtx& y, const YAML::Node& r, const std::ve
   if (!r["glsl"]) y.fail(r, fmt::format("rule '{}' has no 'glsl' snippet", rule.name));
   rule.glsl = snippetLines(y, r["glsl"], raw);
   if (r["doc"]) rule.doc = y.scalar(r["doc"], "'doc'");
-  set.rules.push_back(std::move(rule));
+  if (existing) replaceRule(set, y, r["name"], *existing, std::move(rule), overrides);
+  else set.rules.push_back(std::move(rule));
 }
 
 void loadFile(RuleSet& set, const std::string& path, std::vector<std::string>& stack);
+
+// The same file under another spelling (relative from two places, or absolute) is the
+// same file: loading it twice would declare everything twice.
+bool alreadyLoaded(const RuleSet& set, const std::string& path) {
+  if (std::find(set.files.begin(), set.files.end(), path) != set.files.end()) return true;
+  std::error_code ec;
+  auto canon = std::filesystem::weakly_canonical(path, ec);
+  if (ec) return false;
+  for (const auto& f : set.files) {
+    std::error_code ec2;
+    if (std::filesystem::weakly_canonical(f, ec2) == canon && !ec2) return true;
+  }
+  return false;
+}
 
 void loadParsed(RuleSet& set, const std::string& text, const std::string& path, std::vector<std::string>& stack) {
   YamlCtx y{path};
   YAML::Node root = parseYaml(text, path);
   if (!root.IsDefined() || root.IsNull()) throw InputError(SourceLoc{path, 1, 1}, "empty rules file");
   y.expectMap(root, "a rules file");
-  y.checkKeys(root, {"include", "semantics", "varyings", "rules", "doc"});
+  y.checkKeys(root, {"include", "semantics", "varyings", "conventions", "disable", "rules", "doc"});
   set.files.push_back(path);
   std::vector<std::string> raw = splitLines(text);
   if (auto inc = root["include"]) {
@@ -263,7 +283,7 @@ void loadParsed(RuleSet& set, const std::string& text, const std::string& path, 
       std::string incPath = p.lexically_normal().string();
       if (std::find(stack.begin(), stack.end(), incPath) != stack.end())
         y.fail(i, fmt::format("include cycle: '{}' includes itself", incPath));
-      if (std::find(set.files.begin(), set.files.end(), incPath) != set.files.end()) continue;  // already loaded
+      if (alreadyLoaded(set, incPath)) continue;
       std::error_code ec;
       if (!std::filesystem::exists(p, ec)) y.fail(i, fmt::format("included file '{}' does not exist", incPath));
       if (stack.size() >= kMaxIncludeDepth) y.fail(i, fmt::format("includes nest deeper than {} files", kMaxIncludeDepth));
@@ -278,6 +298,8 @@ void loadParsed(RuleSet& set, const std::string& text, const std::string& path, 
   }
   if (auto s = root["semantics"]) loadSemantics(set, y, s, raw);
   if (auto v = root["varyings"]) loadVaryings(set, y, v);
+  if (auto c = root["conventions"]) loadConventions(set, y, c);
+  if (auto d = root["disable"]) applyDisable(set, y, d);
   if (auto rs = root["rules"]) {
     y.expectSeq(rs, "'rules'");
     for (const auto& r : rs) {
@@ -309,7 +331,7 @@ const VaryingMapping* RuleSet::findVarying(const std::string& name) const {
 
 void loadRulesInto(RuleSet& set, const std::string& path) {
   std::string norm = std::filesystem::path(path).lexically_normal().string();
-  if (std::find(set.files.begin(), set.files.end(), norm) != set.files.end()) return;
+  if (alreadyLoaded(set, norm)) return;
   std::vector<std::string> stack;
   loadFile(set, norm, stack);
 }

@@ -309,7 +309,8 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
         throw InputError(SourceLoc{}, fmt::format("cannot validate output '{}': {}", o.name, e.what()));
       }
       rep.referenceMs += msSince(t0);
-      int comps = componentCount(o.type);
+      // Matrices: columns in order; arrays: elements in order (both as their semantics list them).
+      int comps = componentCount(o.type) * std::max(1, o.arraySize);
       bool isFloat = scalarKind(o.type) == ScalarKind::Float;
       std::vector<double> ref(static_cast<size_t>(comps)), gpu(static_cast<size_t>(comps));
       for (size_t v = 0; v < mesh.vertexCount; ++v) {
