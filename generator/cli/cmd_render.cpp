@@ -138,6 +138,8 @@ void registerRender(CLI::App& app, CliState& state) {
   b->add_option("--draws", bench->bo.drawsPerFrame, "Draws of the mesh between two timestamps (default 8)")
       ->check(CLI::Range(1, 100000));
   b->add_option("--frames", bench->bo.frames, "Timed frames; the median is reported (default 7)")->check(CLI::Range(1, 1000));
+  b->add_option("--rounds", bench->bo.rounds, "Passes over every program, order rotated; the best counts (default 3)")
+      ->check(CLI::Range(1, 100));
   b->add_option("--raster", bench->raster, "on, off (rasterizer discard + transform feedback) or both (default)")
       ->check(CLI::IsMember({"on", "off", "both"}));
   b->add_flag("--no-alternatives", bench->noAlternatives, "Only the generated plan (and the hand port and floor)");

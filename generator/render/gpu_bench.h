@@ -21,6 +21,7 @@ struct GpuBenchOptions {
   bool rasterOn = true, rasterOff = true;
   uint32_t drawsPerFrame = 8;
   uint32_t frames = 7;         // + 1 warm-up frame, not counted
+  uint32_t rounds = 3;         // passes over every program; the best pass counts
 };
 
 struct GpuBenchRow {
@@ -38,7 +39,7 @@ struct GpuBenchRow {
 struct GpuBenchReport {
   std::string device, driver;
   size_t vertices = 0, triangles = 0;
-  uint32_t drawsPerFrame = 0, frames = 0, width = 0, height = 0;
+  uint32_t drawsPerFrame = 0, frames = 0, rounds = 0, width = 0, height = 0;
   std::vector<GpuBenchRow> rows;
   // Over the generated plan and its alternatives (rows with a cost): Pearson correlation of
   // plan cost with time per vertex, and Spearman (rank) correlation; NaN if < 3 rows.
