@@ -51,8 +51,8 @@ GlslShader parseVertex(const std::string& text, const std::string& path, TargetE
 
 // Streams and uniforms of a hand-written shader that follows the emitter's naming
 // (a_<attribute>[<target>], u_<uniform>), from its own reflection.
-void feedHandWritten(const GlslShader& s, const std::string& path, const Rig& rig, const RenderScene& scene,
-                     Program& p) {
+void feedHandWritten(const GlslShader& s, const std::string& path, const Rig& rig, const rt::Mesh& mesh,
+                     const rt::Pose& pose, std::vector<rt::VertexStream>& streams, std::vector<uint8_t>& uniforms) {
   for (const auto& in : s.inputs()) {
     EmittedInput e;
     e.name = in.name;
@@ -70,7 +70,7 @@ void feedHandWritten(const GlslShader& s, const std::string& path, const Rig& ri
     if (e.attribute < 0 || in.location < 0)
       throw InputError(SourceLoc{path, 0, 0}, fmt::format("input '{}' names no attribute of rig '{}' (a_<attribute>[target] "
                                                           "with a location)", in.name, rig.name));
-    p.streams.push_back(vertexStream(rig, e, scene.mesh));
+    streams.push_back(vertexStream(rig, e, mesh));
   }
   EmittedGlsl glsl;
   SpirvModule spv;
@@ -80,7 +80,7 @@ void feedHandWritten(const GlslShader& s, const std::string& path, const Rig& ri
     for (size_t u = 0; u < rig.uniforms.size(); ++u)
       if (m.name == "u_" + rig.uniforms[u].name) glsl.uniforms.push_back(EmittedUniform{m.name, static_cast<int>(u)});
   }
-  if (spv.uniformBlockSize) p.uniforms = uniformBlock(rig, glsl, spv, scene.pose);
+  if (spv.uniformBlockSize) uniforms = uniformBlock(rig, glsl, spv, pose);
 }
 
 // The floor: reads the position, writes it as gl_Position and a constant to every other
@@ -154,6 +154,17 @@ std::string addCaptureQualifiers(const std::string& glsl, const std::string& pat
   result.insert(main, fmt::format("out gl_PerVertex {{\n  layout(xfb_buffer = 0, xfb_offset = 0, xfb_stride = {}) vec4 gl_Position;\n}};\n",
                                   capture.captureStride));
   return result;
+}
+
+HandWrittenRun prepareHandWritten(const std::string& path, const Rig& rig, const rt::Mesh& mesh, const rt::Pose& pose,
+                                  const EmittedGlsl& capture, TargetEnv env) {
+  std::string text = readInputFile(path);
+  GlslShader s = parseVertex(text, path, env);
+  HandWrittenRun h;
+  h.renderSpirv = s.spirv();
+  h.captureSpirv = parseVertex(addCaptureQualifiers(text, path, capture), path, env).spirv();
+  feedHandWritten(s, path, rig, mesh, pose, h.streams, h.uniforms);
+  return h;
 }
 
 double pearson(const std::vector<double>& x, const std::vector<double>& y) {
@@ -231,15 +242,15 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     }
   }
   if (!opts.handPortPath.empty()) {
-    std::string text = readInputFile(opts.handPortPath);
-    GlslShader s = parseVertex(text, opts.handPortPath, env);
+    HandWrittenRun h = prepareHandWritten(opts.handPortPath, rig, scene.mesh, scene.pose, chosenCapture.glsl, env);
     Program p;
     p.row.label = "hand port (" + std::filesystem::path(opts.handPortPath).filename().string() + ")";
-    p.renderSpirv = s.spirv();
+    p.renderSpirv = std::move(h.renderSpirv);
     p.row.spirvInstructions = countInstructions(p.renderSpirv);
-    p.captureSpirv = parseVertex(addCaptureQualifiers(text, opts.handPortPath, chosenCapture.glsl), opts.handPortPath, env).spirv();
+    p.captureSpirv = std::move(h.captureSpirv);
     p.captureStride = chosenCapture.glsl.captureStride;
-    feedHandWritten(s, opts.handPortPath, rig, scene, p);
+    p.streams = std::move(h.streams);
+    p.uniforms = std::move(h.uniforms);
     programs.push_back(std::move(p));
   }
   for (bool allInputs : {false, true}) {
@@ -251,7 +262,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     p.row.spirvInstructions = countInstructions(p.renderSpirv);
     p.captureSpirv = parseVertex(floorShader(chosenCapture, true, allInputs), "floor.vert", env).spirv();
     p.captureStride = chosenCapture.glsl.captureStride;
-    feedHandWritten(s, "floor.vert", rig, scene, p);
+    feedHandWritten(s, "floor.vert", rig, scene.mesh, scene.pose, p.streams, p.uniforms);
     programs.push_back(std::move(p));
   }
 

@@ -62,4 +62,15 @@ double spearman(const std::vector<double>& x, const std::vector<double>& y);
 // capture layout lacks.
 std::string addCaptureQualifiers(const std::string& glsl, const std::string& path, const EmittedGlsl& capture);
 
+// A hand-written vertex shader (emitter naming: a_<attribute>[target], u_<uniform>) fed
+// the way the generated one is: its capture build (xfb at the offsets of `capture`), its
+// vertex streams from `mesh` and its uniform block for `pose`.
+struct HandWrittenRun {
+  std::vector<uint32_t> renderSpirv, captureSpirv;
+  std::vector<rt::VertexStream> streams;
+  std::vector<uint8_t> uniforms;
+};
+HandWrittenRun prepareHandWritten(const std::string& path, const Rig& rig, const rt::Mesh& mesh, const rt::Pose& pose,
+                                  const EmittedGlsl& capture, TargetEnv env);
+
 }  // namespace sg
