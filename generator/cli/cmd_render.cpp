@@ -113,6 +113,9 @@ void registerRender(CLI::App& app, CliState& state) {
   sub->add_option("--size", cmd->size, "Image size WIDTHxHEIGHT (default 512x512)");
   sub->add_option("--device", cmd->ro.device, "Vulkan device name (substring); default lavapipe");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer");
+  sub->add_option("--time", cmd->ro.time, "glTF rig (MODEL.glb#m/p): animation time in seconds (default 0)")
+      ->check(finiteNumber(false));
+  sub->add_option("--animation", cmd->ro.animation, "glTF rig: animation name or index (default: the first)");
   sub->add_option("--pose-seed", cmd->ro.poseSeed, "0 (default): rest pose; N: the random pose of seed N");
   sub->add_option("--morph-weight", cmd->ro.morphWeight, "Rest pose: weight of every morph target (default 0.5)")
       ->check(finiteNumber(false));
