@@ -51,7 +51,7 @@ GlslShader parseVertex(const std::string& text, const std::string& path, TargetE
 
 // Streams and uniforms of a hand-written shader that follows the emitter's naming
 // (a_<attribute>[<target>], u_<uniform>), from its own reflection.
-void feedHandWritten(const GlslShader& s, const std::string& path, const Rig& rig, const rt::Mesh& mesh,
+void feedHandWritten(const GlslShader& s, const std::string& path, const Rig& rig, const RuleSet& rules, const rt::Mesh& mesh,
                      const rt::Pose& pose, std::vector<rt::VertexStream>& streams, std::vector<uint8_t>& uniforms) {
   for (const auto& in : s.inputs()) {
     EmittedInput e;
@@ -80,7 +80,7 @@ void feedHandWritten(const GlslShader& s, const std::string& path, const Rig& ri
     for (size_t u = 0; u < rig.uniforms.size(); ++u)
       if (m.name == "u_" + rig.uniforms[u].name) glsl.uniforms.push_back(EmittedUniform{m.name, static_cast<int>(u)});
   }
-  if (spv.uniformBlockSize) uniforms = uniformBlock(rig, glsl, spv, pose);
+  if (spv.uniformBlockSize) uniforms = uniformBlock(rig, rules, glsl, spv, mesh, pose);
 }
 
 // The floor: reads the position, writes it as gl_Position and a constant to every other
@@ -156,14 +156,14 @@ std::string addCaptureQualifiers(const std::string& glsl, const std::string& pat
   return result;
 }
 
-HandWrittenRun prepareHandWritten(const std::string& path, const Rig& rig, const rt::Mesh& mesh, const rt::Pose& pose,
-                                  const EmittedGlsl& capture, TargetEnv env) {
+HandWrittenRun prepareHandWritten(const std::string& path, const Rig& rig, const RuleSet& rules, const rt::Mesh& mesh,
+                                  const rt::Pose& pose, const EmittedGlsl& capture, TargetEnv env) {
   std::string text = readInputFile(path);
   GlslShader s = parseVertex(text, path, env);
   HandWrittenRun h;
   h.renderSpirv = s.spirv();
   h.captureSpirv = parseVertex(addCaptureQualifiers(text, path, capture), path, env).spirv();
-  feedHandWritten(s, path, rig, mesh, pose, h.streams, h.uniforms);
+  feedHandWritten(s, path, rig, rules, mesh, pose, h.streams, h.uniforms);
   return h;
 }
 
@@ -213,7 +213,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     p.captureSpirv = c.spirv.words;
     p.captureStride = c.glsl.captureStride;
     for (const auto& i : r.glsl.inputs) p.streams.push_back(vertexStream(rig, i, scene.mesh));
-    p.uniforms = uniformBlock(rig, r.glsl, r.spirv, scene.pose);
+    p.uniforms = uniformBlock(rig, r.in.rules, r.glsl, r.spirv, scene.mesh, scene.pose);
     programs.push_back(std::move(p));
     return true;
   };
@@ -242,7 +242,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     }
   }
   if (!opts.handPortPath.empty()) {
-    HandWrittenRun h = prepareHandWritten(opts.handPortPath, rig, scene.mesh, scene.pose, chosenCapture.glsl, env);
+    HandWrittenRun h = prepareHandWritten(opts.handPortPath, rig, in.rules, scene.mesh, scene.pose, chosenCapture.glsl, env);
     Program p;
     p.row.label = "hand port (" + std::filesystem::path(opts.handPortPath).filename().string() + ")";
     p.renderSpirv = std::move(h.renderSpirv);
@@ -262,7 +262,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     p.row.spirvInstructions = countInstructions(p.renderSpirv);
     p.captureSpirv = parseVertex(floorShader(chosenCapture, true, allInputs), "floor.vert", env).spirv();
     p.captureStride = chosenCapture.glsl.captureStride;
-    feedHandWritten(s, "floor.vert", rig, scene.mesh, scene.pose, p.streams, p.uniforms);
+    feedHandWritten(s, "floor.vert", rig, in.rules, scene.mesh, scene.pose, p.streams, p.uniforms);
     programs.push_back(std::move(p));
   }
 

@@ -70,7 +70,7 @@ struct HandWrittenRun {
   std::vector<rt::VertexStream> streams;
   std::vector<uint8_t> uniforms;
 };
-HandWrittenRun prepareHandWritten(const std::string& path, const Rig& rig, const rt::Mesh& mesh, const rt::Pose& pose,
-                                  const EmittedGlsl& capture, TargetEnv env);
+HandWrittenRun prepareHandWritten(const std::string& path, const Rig& rig, const RuleSet& rules, const rt::Mesh& mesh,
+                                  const rt::Pose& pose, const EmittedGlsl& capture, TargetEnv env);
 
 }  // namespace sg

@@ -220,7 +220,7 @@ RenderResult RenderSession::render(const GenerateResult& gen, const std::vector<
   req.vertexCount = static_cast<uint32_t>(scene.mesh.vertexCount);
   req.indices = scene.indices;
   for (const auto& in : gen.glsl.inputs) req.streams.push_back(vertexStream(gen.in.rig, in, scene.mesh));
-  req.uniformData = uniformBlock(gen.in.rig, gen.glsl, gen.spirv, scene.pose);
+  req.uniformData = uniformBlock(gen.in.rig, gen.in.rules, gen.glsl, gen.spirv, scene.mesh, scene.pose);
   req.textures = textures;
   req.width = opts.width;
   req.height = opts.height;

@@ -28,6 +28,11 @@ struct OutputReport {
   size_t worstVertex = 0;
   int worstComponent = 0;
   bool pass = true;
+  // A semantic it carries has no definition (and the rig does not provide it): not compared.
+  bool unchecked = false;
+  std::string uncheckedReason;
+  // The first NaN or infinity seen, on which side, where, and the inputs that produced it.
+  std::string nonFinite;
 };
 
 struct RunReport {
@@ -47,6 +52,7 @@ struct ValidateReport {
   std::string device;
   bool validationLayers = false;
   std::vector<RunReport> runs;
+  std::vector<rt::Pose> poses;  // as run (declared uniforms drawn): what --save-poses writes
   bool pass = true;
 };
 
@@ -63,10 +69,12 @@ ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_
 
 // The data a run feeds the GPU, for other users of the device (render, GPU timing):
 // the mesh with every integer/normalized stream rounded as its attribute format stores it,
-// one input's vertex stream, and the uniform block for a pose.
+// one input's vertex stream, and the uniform block for a pose (uniforms with a definition,
+// such as a normal matrix, computed from the pose's).
 rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh);
 rt::VertexStream vertexStream(const Rig& rig, const EmittedInput& in, const rt::Mesh& mesh);
-std::vector<uint8_t> uniformBlock(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spv, const rt::Pose& pose);
+std::vector<uint8_t> uniformBlock(const Rig& rig, const RuleSet& rules, const EmittedGlsl& glsl, const SpirvModule& spv,
+                                  const rt::Mesh& mesh, const rt::Pose& pose);
 
 struct ValidateOptions {
   GenerateOptions gen;
@@ -74,6 +82,7 @@ struct ValidateOptions {
   Tolerance tolerance;
   std::string device;       // "" = lavapipe
   bool validationLayers = true;
+  bool strict = false;  // an unchecked output (no definition) fails the run
 };
 
 class Validator {
@@ -89,7 +98,7 @@ class Validator {
  private:
   // runOne on a mesh already quantized to the rig's attribute formats.
   RunReport runQuantized(const GenerateResult& r, const rt::Mesh& mesh, const ValidationScene& scene,
-                         const std::string& label);
+                         const std::vector<rt::Pose>& poses, const std::string& label);
 
   ValidateOptions opts_;
   std::unique_ptr<rt::Harness> harness_;

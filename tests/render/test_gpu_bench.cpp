@@ -29,7 +29,14 @@ TEST(GpuBench, CorrelationsMatchHandComputedValues) {
 TEST(GpuBench, CaptureQualifiersGoOnEveryOutputAndUnknownOutputsAreErrors) {
   sg::EmittedGlsl capture;
   capture.captureStride = 32;
-  capture.outputs = {{"gl_Position", -1, sg::Type::Vec4, {}, 0}, {"A", 0, sg::Type::Vec3, {}, 16}, {"B", 1, sg::Type::Float, {}, 28}};
+  auto output = [](const char* name, int location, uint32_t offset) {
+    sg::EmittedOutput o;
+    o.name = name;
+    o.location = location;
+    o.captureOffset = offset;
+    return o;
+  };
+  capture.outputs = {output("gl_Position", -1, 0), output("A", 0, 16), output("B", 1, 28)};
   std::string text = "#version 450\nlayout(location = 0) out vec3 A;\nlayout(location=1) flat out float B;\nvoid main() {}\n";
   std::string out = sg::addCaptureQualifiers(text, "h.vert", capture);
   EXPECT_NE(out.find("layout(location = 0, xfb_buffer = 0, xfb_offset = 16, xfb_stride = 32) out vec3 A;"), std::string::npos) << out;
@@ -54,7 +61,8 @@ TEST(GpuBench, HandPortOfListing33ComputesWhatTheGeneratedShaderComputes) {
   sg::rt::Mesh mesh = sg::quantizeForRig(gen.in.rig, scene.mesh);
   const sg::rt::Pose& pose = scene.poses.front();
   sg::HandWrittenRun hand =
-      sg::prepareHandWritten(sourcePath("examples/dawn/listing-3-3.vert"), gen.in.rig, mesh, pose, gen.glsl, g.targetEnv);
+      sg::prepareHandWritten(sourcePath("examples/dawn/listing-3-3.vert"), gen.in.rig, gen.in.rules, mesh, pose, gen.glsl,
+                             g.targetEnv);
 
   sg::rt::Harness harness;
   sg::rt::RunRequest a;
@@ -62,7 +70,7 @@ TEST(GpuBench, HandPortOfListing33ComputesWhatTheGeneratedShaderComputes) {
   a.vertexCount = static_cast<uint32_t>(mesh.vertexCount);
   a.capture.strideBytes = gen.glsl.captureStride;
   for (const auto& in : gen.glsl.inputs) a.streams.push_back(sg::vertexStream(gen.in.rig, in, mesh));
-  a.uniformData = sg::uniformBlock(gen.in.rig, gen.glsl, gen.spirv, pose);
+  a.uniformData = sg::uniformBlock(gen.in.rig, gen.in.rules, gen.glsl, gen.spirv, mesh, pose);
   sg::rt::RunRequest b = a;
   b.spirv = hand.captureSpirv;
   b.streams = hand.streams;
