@@ -85,6 +85,7 @@ RenderScene renderScene(const Rig& rig, const RenderOptions& opts) {
     GltfSceneOptions so;
     so.times = {opts.time};
     so.animation = opts.animation;
+    if (!model.data.indicesError.empty()) throw InputError(SourceLoc{ref.file, 0, 0}, model.data.indicesError);
     ValidationScene vs = gltfScene(model, so);
     RenderScene s;
     s.mesh = quantizeForRig(rig, vs.mesh);
