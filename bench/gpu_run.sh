@@ -22,10 +22,10 @@ echo "== validate (Dawn face, Dawn-scale mesh, cross-check)"
 "$sg" validate "${dawn[@]}" --mesh "$mesh" --cross-check --poses 1 --device "$device" --no-validation-layers | grep -v '^  '
 echo "== bench, rasterization on and off"
 "$sg" bench "${dawn[@]}" --hand-port "$here/examples/dawn/listing-3-3.vert" --device "$device" --no-validation-layers \
-  --mesh "$mesh" --draws "$draws" --frames "$frames"
+  --mesh "$mesh" --draws "$draws" --frames "$frames" --rounds 1
 echo "== bench again (run-to-run spread)"
 "$sg" bench "${dawn[@]}" --hand-port "$here/examples/dawn/listing-3-3.vert" --device "$device" --no-validation-layers \
-  --mesh "$mesh" --draws "$draws" --frames "$frames" | tail -n +4
+  --mesh "$mesh" --draws "$draws" --frames "$frames" --rounds 1 | tail -n +4
 echo "== render"
 "$sg" render "${dawn[@]}" --mesh "$mesh" --size 480x480 --yaw 20 --pitch 5 --device "$device" --no-validation-layers \
   -o "$outdir/dawn-face-gpu.png"

@@ -113,6 +113,9 @@ void registerRender(CLI::App& app, CliState& state) {
   sub->add_option("--size", cmd->size, "Image size WIDTHxHEIGHT (default 512x512)");
   sub->add_option("--device", cmd->ro.device, "Vulkan device name (substring); default lavapipe");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer");
+  sub->add_option("--time", cmd->ro.time, "glTF rig (MODEL.glb#m/p): animation time in seconds (default 0)")
+      ->check(finiteNumber(false));
+  sub->add_option("--animation", cmd->ro.animation, "glTF rig: animation name or index (default: the first)");
   sub->add_option("--pose-seed", cmd->ro.poseSeed, "0 (default): rest pose; N: the random pose of seed N");
   sub->add_option("--morph-weight", cmd->ro.morphWeight, "Rest pose: weight of every morph target (default 0.5)")
       ->check(finiteNumber(false));
@@ -138,6 +141,8 @@ void registerRender(CLI::App& app, CliState& state) {
   b->add_option("--draws", bench->bo.drawsPerFrame, "Draws of the mesh between two timestamps (default 8)")
       ->check(CLI::Range(1, 100000));
   b->add_option("--frames", bench->bo.frames, "Timed frames; the median is reported (default 7)")->check(CLI::Range(1, 1000));
+  b->add_option("--rounds", bench->bo.rounds, "Passes over every program, order rotated; the best counts (default 3)")
+      ->check(CLI::Range(1, 100));
   b->add_option("--raster", bench->raster, "on, off (rasterizer discard + transform feedback) or both (default)")
       ->check(CLI::IsMember({"on", "off", "both"}));
   b->add_flag("--no-alternatives", bench->noAlternatives, "Only the generated plan (and the hand port and floor)");

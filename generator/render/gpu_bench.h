@@ -21,6 +21,7 @@ struct GpuBenchOptions {
   bool rasterOn = true, rasterOff = true;
   uint32_t drawsPerFrame = 8;
   uint32_t frames = 7;         // + 1 warm-up frame, not counted
+  uint32_t rounds = 3;         // passes over every program; the best pass counts
 };
 
 struct GpuBenchRow {
@@ -38,7 +39,7 @@ struct GpuBenchRow {
 struct GpuBenchReport {
   std::string device, driver;
   size_t vertices = 0, triangles = 0;
-  uint32_t drawsPerFrame = 0, frames = 0, width = 0, height = 0;
+  uint32_t drawsPerFrame = 0, frames = 0, rounds = 0, width = 0, height = 0;
   std::vector<GpuBenchRow> rows;
   // Over the generated plan and its alternatives (rows with a cost): Pearson correlation of
   // plan cost with time per vertex, and Spearman (rank) correlation; NaN if < 3 rows.
@@ -60,5 +61,16 @@ double spearman(const std::vector<double>& x, const std::vector<double>& y);
 // with the same outputs), and redeclares gl_PerVertex. Throws InputError for an output the
 // capture layout lacks.
 std::string addCaptureQualifiers(const std::string& glsl, const std::string& path, const EmittedGlsl& capture);
+
+// A hand-written vertex shader (emitter naming: a_<attribute>[target], u_<uniform>) fed
+// the way the generated one is: its capture build (xfb at the offsets of `capture`), its
+// vertex streams from `mesh` and its uniform block for `pose`.
+struct HandWrittenRun {
+  std::vector<uint32_t> renderSpirv, captureSpirv;
+  std::vector<rt::VertexStream> streams;
+  std::vector<uint8_t> uniforms;
+};
+HandWrittenRun prepareHandWritten(const std::string& path, const Rig& rig, const RuleSet& rules, const rt::Mesh& mesh,
+                                  const rt::Pose& pose, const EmittedGlsl& capture, TargetEnv env);
 
 }  // namespace sg

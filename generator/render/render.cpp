@@ -53,7 +53,48 @@ void frameCamera(const rt::Mesh& mesh, const rt::RigShape& shape, const RenderCa
   pose.projection[1][1] *= -1.0f;  // Vulkan's clip-space Y points down
 }
 
+std::vector<uint32_t> triangleList(const std::vector<uint32_t>& indices, int mode, size_t vertexCount,
+                                   const std::string& what) {
+  std::vector<uint32_t> in = indices;
+  if (in.empty())
+    for (size_t i = 0; i < vertexCount; ++i) in.push_back(static_cast<uint32_t>(i));
+  std::vector<uint32_t> out;
+  if (mode == 4) {
+    out.assign(in.begin(), in.begin() + static_cast<long>(in.size() / 3 * 3));
+  } else if (mode == 5) {  // strip: every other triangle reversed to keep the winding
+    for (size_t i = 0; i + 2 < in.size(); ++i)
+      out.insert(out.end(), i % 2 ? std::initializer_list<uint32_t>{in[i + 1], in[i], in[i + 2]}
+                                  : std::initializer_list<uint32_t>{in[i], in[i + 1], in[i + 2]});
+  } else if (mode == 6) {
+    for (size_t i = 1; i + 1 < in.size(); ++i) out.insert(out.end(), {in[0], in[i], in[i + 1]});
+  } else {
+    throw InputError(SourceLoc{what, 0, 0}, fmt::format("primitive mode {} has no triangles to draw (render draws "
+                                                        "triangles, strips and fans)", mode));
+  }
+  if (out.empty()) throw InputError(SourceLoc{what, 0, 0}, "the primitive has no triangles");
+  return out;
+}
+
 RenderScene renderScene(const Rig& rig, const RenderOptions& opts) {
+  if (isGltfPath(opts.gen.rigPath)) {
+    GltfRef ref = parseGltfRef(opts.gen.rigPath);
+    GltfImportOptions io;
+    io.mesh = ref.mesh;
+    io.primitive = ref.primitive;
+    GltfImport model = importGltf(ref.file, io);
+    GltfSceneOptions so;
+    so.times = {opts.time};
+    so.animation = opts.animation;
+    if (!model.data.indicesError.empty()) throw InputError(SourceLoc{ref.file, 0, 0}, model.data.indicesError);
+    ValidationScene vs = gltfScene(model, so);
+    RenderScene s;
+    s.mesh = quantizeForRig(rig, vs.mesh);
+    s.indices = triangleList(model.data.indices, model.data.mode, s.mesh.vertexCount, ref.file);
+    s.shape = vs.shape;
+    s.pose = vs.poses.front();
+    frameCamera(s.mesh, s.shape, opts.camera, float(opts.width) / float(opts.height), s.pose);
+    return s;
+  }
   // The grid sizes of validate's procedural meshes (proceduralScene).
   static const std::map<std::string, std::pair<int, int>> grids = {{"head", {40, 48}}, {"limb", {32, 24}}, {"dawn", {299, 599}}};
   auto grid = grids.find(opts.mesh);

@@ -12,6 +12,7 @@
 #include "pipeline/generate.h"
 #include "render/dawn_textures.h"
 #include "runtime/vk_render.h"
+#include "validate/gltf_scene.h"
 #include "validate/validate.h"
 
 namespace sg {
@@ -28,7 +29,9 @@ struct RenderOptions {
   std::string device;             // "" = lavapipe
   bool validationLayers = true;
   uint32_t width = 512, height = 512;
-  std::string mesh = "head";      // procedural mesh: head, limb, dawn
+  std::string mesh = "head";      // procedural mesh: head, limb, dawn (glTF rigs draw their own mesh)
+  double time = 0;                // glTF rigs: animation time in seconds
+  std::string animation;          // glTF rigs: animation name or index ("" = the first)
   uint32_t poseSeed = 0;          // 0 = rest pose (identity bones), else makeRandomPose(seed)
   float morphWeight = 0.5f;       // rest pose: every morph target's weight
   RenderCamera camera;
@@ -47,7 +50,14 @@ struct RenderScene {
 // Triangles of a (rings + 1) x (segments + 1) vertex grid (row-major), two per quad.
 std::vector<uint32_t> gridIndices(int rings, int segments);
 
+// A procedural mesh, or for a glTF rig ("model.glb#m/p") the primitive's own vertices,
+// triangles and pose at opts.time (posed as validation poses it).
 RenderScene renderScene(const Rig& rig, const RenderOptions& opts);
+
+// A glTF primitive's triangles as a list: `indices` (empty: 0..vertexCount-1) in `mode`
+// (4 triangles, 5 strip, 6 fan). Throws InputError for points and lines.
+std::vector<uint32_t> triangleList(const std::vector<uint32_t>& indices, int mode, size_t vertexCount,
+                                   const std::string& what);
 
 // Sets pose.cameraPosition/view/projection so the posed mesh (its reference world
 // positions) fills the image.
