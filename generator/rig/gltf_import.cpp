@@ -617,6 +617,25 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
                                     formatText(imp.attributes[infoIndex.at(name)]), why));
   };
 
+  // Indices, for drawing (shadergen render). Shaders run per vertex, so generation and
+  // validation never needed them: a bad index accessor is recorded, not an import error.
+  if (prim.indices >= 0) {
+    try {
+      AccessorData idx = reader.read(prim.indices, where + " indices");
+      if (idx.components != 1 || (idx.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+                                  idx.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                                  idx.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+        fail(file, fmt::format("{}: indices must be unsigned byte, short or int scalars", where));
+      for (float v : idx.values)
+        if (!(v >= 0.0f) || static_cast<size_t>(v) >= data.vertexCount)
+          fail(file, fmt::format("{}: index {} is out of range ({} vertices)", where, v, data.vertexCount));
+      data.indices.assign(idx.values.begin(), idx.values.end());
+    } catch (const InputError& e) {
+      data.indices.clear();
+      data.indicesError = e.diagnostic().message;
+    }
+  }
+
   // POSITION
   if (!isFloat(posAcc, TINYGLTF_TYPE_VEC3))
     fail(file, fmt::format("{}: POSITION is {}; only float VEC3 positions are supported (KHR_mesh_quantization is not)",
