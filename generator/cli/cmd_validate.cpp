@@ -94,7 +94,12 @@ void registerValidate(CLI::App& app, CliState& state) {
   sub->add_option("--mesh", cmd->mesh, "Procedural mesh: head (default), limb, dawn (180k vertices)")
       ->check(CLI::IsMember({"head", "limb", "dawn"}));
   sub->add_option("--seed", cmd->seed, "Seed of the random poses");
-  sub->add_option("--poses", cmd->poses, "Number of random poses (1..100), or a pose file written by --save-poses");
+  sub->add_option("--poses", cmd->poses, "Number of random poses (1..100), or a pose file written by --save-poses")
+      ->check([](const std::string& v) -> std::string {  // a count out of range is a usage error
+        bool digits = !v.empty() && v.find_first_not_of("0123456789") == std::string::npos;
+        if (digits && (v.size() > 3 || std::stoi(v) < 1 || std::stoi(v) > 100)) return "a count of poses is 1..100";
+        return "";
+      });
   sub->add_option("--save-poses", cmd->savePoses, "Write the poses run (with drawn uniforms) to FILE, for --poses FILE");
   sub->add_flag("--strict", cmd->strict, "Fail outputs whose semantic has no definition (unchecked)");
   CLI::Validator finiteNonNegative = finiteNumber(false);  // no nan, inf or negative times and tolerances

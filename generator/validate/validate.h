@@ -52,8 +52,8 @@ struct ValidateReport {
   std::string device;
   bool validationLayers = false;
   std::vector<RunReport> runs;
-  std::vector<rt::Pose> poses;  // as run (declared uniforms drawn): what --save-poses writes
   bool pass = true;
+  std::vector<rt::Pose> poses;  // as run (declared uniforms drawn): what --save-poses writes
 };
 
 // What to run the shader on.

@@ -252,15 +252,15 @@ EOF
   ;;
 
 search)
-  # --search picks the engine, --stats reports the effort; every engine finds cost 81.
+  # --search picks the engine, --stats reports the effort; every engine finds cost 100 (81 before the degenerate-tangent fallback, docs/design.md).
   expect 0 "--stats (default engine)" -- "$SG" generate "${DAWN[@]}" -o s/face --stats
   grep -q '^search (regression A\*, lmcut): [0-9]* expanded, [0-9]* generated' last.out && ok "--stats names engine and counts" ||
     fail "--stats printed: $(head -2 last.out)"
-  grep -q 'initial h 81 vs cost 81; heuristic [0-9.]* ms of [0-9.]* ms' last.out && ok "--stats: initial h vs cost, heuristic time" ||
+  grep -q 'initial h 100 vs cost 100; heuristic [0-9.]* ms of [0-9.]* ms' last.out && ok "--stats: initial h vs cost, heuristic time" ||
     fail "--stats printed: $(head -2 last.out)"
   for engine in forward ip regression; do
     expect 0 "--search $engine" -- "$SG" generate "${DAWN[@]}" -o "s/$engine" --search "$engine" --stats
-    grep -q "^search ($engine" last.out && grep -q 'total cost 81$' last.out && ok "--search $engine: cost 81" ||
+    grep -q "^search ($engine" last.out && grep -q 'total cost 100$' last.out && ok "--search $engine: cost 100" ||
       fail "--search $engine printed: $(head -3 last.out)"
   done
   expect 2 "unknown --search" -- "$SG" generate "${DAWN[@]}" -o x --search sideways
