@@ -30,6 +30,13 @@ void GenerateArgs::add(CLI::App& cmd) {
   cmd.add_option("--max-expansions", opts.searchLimits.maxExpansions,
                  "Give up (error) after this many A* expansions")
       ->check(CLI::PositiveNumber);
+  cmd.add_option("--max-attributes", opts.maxAttributes,
+                 "Vertex input attributes the plan may use (the device's maxVertexInputAttributes; default 16, "
+                 "what every Vulkan device supports). A constraint of the search, not a cost")
+      ->check(CLI::Range(1, 4096));
+  cmd.add_option("--max-uniform-bytes", opts.maxUniformBlockBytes,
+                 "Bytes of the uniform block (the device's maxUniformBufferRange; default 16384)")
+      ->check(CLI::Range(16, 1 << 30));
   cmd.add_option("--target-env", targetEnv, "vulkan1.0 (default), vulkan1.1, vulkan1.2, vulkan1.3")
       ->check(CLI::IsMember({"vulkan", "vulkan1.0", "vulkan1.1", "vulkan1.2", "vulkan1.3"}));
   cmd.add_option("--templates", opts.templateDir, "Directory with vertex.glsl templates");

@@ -42,6 +42,9 @@ struct GenerateOptions {
   // The uniform block must fit the device's maxUniformBufferRange; 16384 bytes is what
   // every Vulkan device guarantees (docs/limits.md). A known device may raise it.
   uint32_t maxUniformBlockBytes = kVulkanMinUniformBufferRange;
+  // Vertex input attributes the plan may read (maxVertexInputAttributes; 16 guaranteed).
+  // Like the uniform block, a constraint of the search (docs/search.md, "Resource limits").
+  int maxAttributes = static_cast<int>(kVulkanMinVertexAttributes);
 };
 
 struct GenerateResult {

@@ -55,6 +55,7 @@ class Builder {
     std::sort(p_.goals.begin(), p_.goals.end());
     p_.goals.erase(std::unique(p_.goals.begin(), p_.goals.end()), p_.goals.end());
     std::sort(p_.init.begin(), p_.init.end());
+    setDeviceLimits(p_, kVulkanMinVertexAttributes, kVulkanMinUniformBytes);
     return std::move(p_);
   }
 
@@ -122,6 +123,9 @@ class Builder {
           int f = factOrFail(name, attr.loc, fmt::format("attribute '{}' provides", attr.name).c_str());
           provide(f, Fact::Source::Attribute, static_cast<int>(a), attr.perMorphTarget ? t : -1, part.swizzle, *have,
                   attr.loc);
+          p_.facts[f].resource = resourceFor(attr.perMorphTarget ? fmt::format("attribute a_{}{}", attr.name, t)
+                                                                 : "attribute a_" + attr.name,
+                                             kLimitAttributes, 1);
         }
     }
     for (size_t u = 0; u < rig_.uniforms.size(); ++u) {
@@ -134,7 +138,24 @@ class Builder {
                                              fact.arraySize ? fmt::format("an array of {}", fact.arraySize) : "not an array",
                                              un.arraySize ? fmt::format("an array of {}", un.arraySize) : "not an array"));
       provide(f, Fact::Source::Uniform, static_cast<int>(u), -1, "", un.type, un.loc);
+      p_.facts[f].resource = resourceFor("uniform u_" + un.name, kLimitUniformBytes, std140Bytes(un.type, un.arraySize));
     }
+  }
+
+  int resourceFor(const std::string& name, int limit, int64_t amount) {
+    for (size_t i = 0; i < p_.resources.size(); ++i)
+      if (p_.resources[i].name == name) return static_cast<int>(i);
+    p_.resources.push_back(ResourceItem{name, limit, amount});
+    return static_cast<int>(p_.resources.size()) - 1;
+  }
+
+  // Bytes a uniform adds to a std140 block, rounded up to 16: exact for arrays and
+  // matrices (their std140 stride is a multiple of 16), an over-estimate by at most 12
+  // bytes for a lone scalar or vector that could pack after another member. Additive, so
+  // the search and the integer program can sum it (docs/search.md).
+  static int64_t std140Bytes(Type t, int arraySize) {
+    int64_t element = t == Type::Mat4 ? 64 : t == Type::Mat3 ? 48 : 16;
+    return element * std::max(1, arraySize);
   }
 
   void instantiate(int r) {
@@ -173,6 +194,39 @@ class Builder {
 
 Problem buildProblem(const Rig& rig, const RuleSet& rules, const std::vector<Varying>& varyings) {
   return Builder(rig, rules).build(varyings);
+}
+
+void setDeviceLimits(Problem& p, int64_t maxAttributes, int64_t maxUniformBytes) {
+  p.limits.assign(2, ResourceLimit{});
+  p.limits[kLimitAttributes] = ResourceLimit{"vertex input attributes", "--max-attributes", maxAttributes};
+  p.limits[kLimitUniformBytes] =
+      ResourceLimit{"uniform block bytes (std140, members rounded to 16)", "maxUniformBufferRange", maxUniformBytes};
+}
+
+std::vector<int64_t> resourceUsage(const Problem& p, const std::vector<int>& actions) {
+  std::vector<bool> seen(p.resources.size(), false);
+  std::vector<int64_t> usage(p.limits.size(), 0);
+  auto read = [&](int f) {
+    int r = p.facts[f].resource;
+    if (r < 0 || seen[r]) return;
+    seen[r] = true;
+    if (static_cast<size_t>(p.resources[r].limit) < usage.size()) usage[p.resources[r].limit] += p.resources[r].amount;
+  };
+  for (int a : actions)
+    for (int q : p.actions[a].pre) read(q);
+  for (int g : p.goals) read(g);
+  return usage;
+}
+
+int exceededLimit(const Problem& p, const std::vector<int64_t>& usage) {
+  for (size_t l = 0; l < p.limits.size() && l < usage.size(); ++l)
+    if (usage[l] > p.limits[l].max) return static_cast<int>(l);
+  return -1;
+}
+
+std::string describeExceeded(const Problem& p, const std::vector<int64_t>& usage, int limit) {
+  const ResourceLimit& l = p.limits[limit];
+  return fmt::format("{} {}, above the limit of {} ({})", usage[limit], l.what, l.max, l.option);
 }
 
 Problem withoutRules(const Problem& p, const std::vector<std::string>& ruleNames) {

@@ -25,7 +25,26 @@ struct Fact {
   int rigIndex = -1;    // attribute or uniform index in the rig
   int target = -1;      // morph target of a per-target attribute
   std::string swizzle;  // part of the attribute ("" = whole)
+  int resource = -1;    // the ResourceItem reading this fact occupies (-1: none)
 };
+
+// Device limits are constraints, not costs (docs/search.md, "Resource limits"). Every rig
+// input a plan reads occupies a resource item (an attribute stream takes vertex input
+// locations, a uniform takes bytes of the uniform block); a plan's usage of a limit is the
+// sum over the distinct items its rules' needs and its pass-through goals read.
+constexpr int64_t kVulkanMinVertexAttributes = 16;  // maxVertexInputAttributes every device has
+constexpr int64_t kVulkanMinUniformBytes = 16384;   // maxUniformBufferRange every device has
+struct ResourceLimit {
+  std::string what;    // "vertex input attributes"
+  std::string option;  // how the user raises it: "--max-attributes"
+  int64_t max = INT64_MAX;
+};
+struct ResourceItem {
+  std::string name;  // "attribute a_coord_morph3", "uniform u_bone_xf"
+  int limit = 0;     // index in Problem::limits
+  int64_t amount = 0;
+};
+enum ResourceLimitIndex { kLimitAttributes = 0, kLimitUniformBytes = 1 };
 
 // One line of instantiated snippet. Fact references are encoded as
 // kFactRefBegin <id> kFactRefEnd so the emitter picks the GLSL names.
@@ -56,6 +75,8 @@ struct Problem {
   std::vector<int> goals;  // requested facts (sorted, unique)
   // Rules skipped at instantiation and why (for explain/check): "when is false", ...
   std::vector<std::pair<int, std::string>> skippedRules;
+  std::vector<ResourceLimit> limits;  // empty: unconstrained (random libraries, tests)
+  std::vector<ResourceItem> resources;
 
   int findFact(const std::string& name) const;  // -1 if absent
 };
@@ -64,6 +85,17 @@ struct Problem {
 // inconsistent inputs (rig semantics unknown to the rules, type mismatches, bad snippet
 // templates, references to semantics not listed in `needs`, negative costs).
 Problem buildProblem(const Rig& rig, const RuleSet& rules, const std::vector<Varying>& varyings);
+
+// The device limits of a generation: vertex input attributes (Vulkan guarantees 16) and
+// uniform block bytes (maxUniformBufferRange, 16384 guaranteed).
+void setDeviceLimits(Problem& p, int64_t maxAttributes, int64_t maxUniformBytes);
+
+// Usage per limit of the rig inputs a set of actions (and the goals) read.
+std::vector<int64_t> resourceUsage(const Problem& p, const std::vector<int>& actions);
+// The first limit the usage exceeds, or -1.
+int exceededLimit(const Problem& p, const std::vector<int64_t>& usage);
+// "21 vertex input attributes, above the limit of 16 (--max-attributes)".
+std::string describeExceeded(const Problem& p, const std::vector<int64_t>& usage, int limit);
 
 // Same problem without the actions of the named rules (to force alternatives).
 Problem withoutRules(const Problem& p, const std::vector<std::string>& ruleNames);
