@@ -139,7 +139,7 @@ struct GenerateCommand {
       for (auto& c : sym)
         if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
       if (sym.empty() || std::isdigit(static_cast<unsigned char>(sym[0]))) sym = "sg_" + sym;
-      files.push_back({pathFor("header"), spirvHeader(r.spirv.words, sym + "_spv")});
+      files.push_back({pathFor("header"), spirvHeader(r.spirv.words, sym + "_spv") + buffersHeader(r.glsl, sym)});
     }
     if (kinds.count("reflection")) files.push_back({pathFor("reflection"), reflectionJson(r.in.rig, r.glsl, r.spirv)});
     if (depfile || !depfilePath.empty()) {

@@ -196,7 +196,7 @@ GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts) {
 GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const GenerateOptions& opts) {
   GenerateResult res;
   if (!opts.bannedRules.empty()) in.problem = withoutRules(in.problem, opts.bannedRules);
-  setDeviceLimits(in.problem, opts.maxAttributes, opts.maxUniformBlockBytes);
+  setDeviceLimits(in.problem, opts.maxAttributes, opts.maxUniformBlockBytes, opts.maxStorageBuffers);
   res.plan = searchStage(in, SearchOptions{opts.searchEngine, opts.heuristic, opts.searchLimits}, &res.stats);
   EmitOptions eo;
   eo.capture = opts.capture;

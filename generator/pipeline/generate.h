@@ -45,6 +45,7 @@ struct GenerateOptions {
   // Vertex input attributes the plan may read (maxVertexInputAttributes; 16 guaranteed).
   // Like the uniform block, a constraint of the search (docs/search.md, "Resource limits").
   int maxAttributes = static_cast<int>(kVulkanMinVertexAttributes);
+  int maxStorageBuffers = static_cast<int>(kVulkanMinStorageBuffers);  // maxPerStageDescriptorStorageBuffers
 };
 
 struct GenerateResult {

@@ -55,7 +55,7 @@ class Builder {
     std::sort(p_.goals.begin(), p_.goals.end());
     p_.goals.erase(std::unique(p_.goals.begin(), p_.goals.end()), p_.goals.end());
     std::sort(p_.init.begin(), p_.init.end());
-    setDeviceLimits(p_, kVulkanMinVertexAttributes, kVulkanMinUniformBytes);
+    setDeviceLimits(p_, kVulkanMinVertexAttributes, kVulkanMinUniformBytes, kVulkanMinStorageBuffers);
     return std::move(p_);
   }
 
@@ -140,6 +140,65 @@ class Builder {
       provide(f, Fact::Source::Uniform, static_cast<int>(u), -1, "", un.type, un.loc);
       p_.facts[f].resource = resourceFor("uniform u_" + un.name, kLimitUniformBytes, std140Bytes(un.type, un.arraySize));
     }
+    for (const auto& d : rules_.semantics)
+      if (!d.bufferOf.empty()) provideBuffer(d);
+  }
+
+  // A `buffer_of:` semantic is provided when the rig provides every instance of what it
+  // packs: families of attributes (per-vertex buffers) or one uniform array (a palette).
+  void provideBuffer(const SemanticDecl& d) {
+    BufferSource b;
+    b.fact = index_.at(d.name);
+    const ScalarKind kind = scalarKind(d.type);
+    int components = 0;
+    for (const auto& name : d.bufferOf) {
+      const SemanticDecl* src = rules_.findSemantic(name);
+      if (!src) throw InputError(d.loc, fmt::format("semantic '{}': buffer_of names unknown semantic '{}'", d.name, name));
+      if (scalarKind(src->type) != kind)
+        throw InputError(d.loc, fmt::format("semantic '{}' is {} but '{}' is {}", d.name, glslName(d.type), name,
+                                            glslName(src->type)));
+      if (!src->arrayParam.empty()) {  // a uniform array
+        if (d.bufferOf.size() != 1 || src->type != d.type)
+          throw InputError(d.loc, fmt::format("semantic '{}': a buffer of uniform array '{}' holds only it, as {}",
+                                              d.name, name, glslName(src->type)));
+        int f = index_.at(name);
+        if (p_.facts[f].source != Fact::Source::Uniform) return;
+        b.kind = BufferSource::Kind::Array;
+        b.uniform = p_.facts[f].rigIndex;
+        b.count = p_.facts[f].arraySize;
+        b.element = d.type;
+        break;
+      }
+      auto fam = shape_.families.find(name);
+      if (fam == shape_.families.end())
+        throw InputError(d.loc, fmt::format("semantic '{}': buffer_of '{}' is neither a family (count:) nor a "
+                                            "uniform array", d.name, name));
+      if (!b.parts.empty() && fam->second != b.count)
+        throw InputError(d.loc, fmt::format("semantic '{}': families '{}' and '{}' have different counts", d.name,
+                                            b.parts[0].family, name));
+      b.count = fam->second;
+      BufferSource::Part part{name, componentCount(src->type), components, {}};
+      for (int64_t i = 0; i < fam->second; ++i) {
+        int f = index_.at(indexedName(name, i));
+        if (p_.facts[f].source != Fact::Source::Attribute) return;  // the rig lacks an instance
+        part.facts.push_back(f);
+      }
+      components += part.components;
+      b.parts.push_back(std::move(part));
+    }
+    if (b.kind == BufferSource::Kind::PerVertex) {
+      if (components != componentCount(d.type))
+        throw InputError(d.loc, fmt::format("semantic '{}' is {} but buffer_of packs {} components", d.name,
+                                            glslName(d.type), components));
+      if (b.count == 0) return;
+      b.element = kind == ScalarKind::UInt ? Type::UVec4 : kind == ScalarKind::Int ? Type::IVec4 : Type::Vec4;
+    }
+    Fact& fact = p_.facts[b.fact];
+    fact.source = Fact::Source::Buffer;
+    fact.rigIndex = static_cast<int>(p_.buffers.size());
+    fact.resource = resourceFor("storage buffer " + d.name, kLimitStorageBuffers, 1);
+    p_.init.push_back(b.fact);
+    p_.buffers.push_back(std::move(b));
   }
 
   int resourceFor(const std::string& name, int limit, int64_t amount) {
@@ -196,8 +255,10 @@ Problem buildProblem(const Rig& rig, const RuleSet& rules, const std::vector<Var
   return Builder(rig, rules).build(varyings);
 }
 
-void setDeviceLimits(Problem& p, int64_t maxAttributes, int64_t maxUniformBytes) {
-  p.limits.assign(2, ResourceLimit{});
+void setDeviceLimits(Problem& p, int64_t maxAttributes, int64_t maxUniformBytes, int64_t maxStorageBuffers) {
+  p.limits.assign(3, ResourceLimit{});
+  p.limits[kLimitStorageBuffers] =
+      ResourceLimit{"storage buffers", "maxPerStageDescriptorStorageBuffers", maxStorageBuffers};
   p.limits[kLimitAttributes] = ResourceLimit{"vertex input attributes", "--max-attributes", maxAttributes};
   p.limits[kLimitUniformBytes] =
       ResourceLimit{"uniform block bytes (std140, members rounded to 16)", "maxUniformBufferRange", maxUniformBytes};

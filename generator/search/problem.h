@@ -17,12 +17,12 @@ struct RuleSet;
 struct Varying;
 
 struct Fact {
-  enum class Source { Computed, Attribute, Uniform };
+  enum class Source { Computed, Attribute, Uniform, Buffer };
   std::string name;  // "world.normal", "morph.position[3]"
   Type type = Type::Vec3;
   int arraySize = 0;  // uniform arrays
   Source source = Source::Computed;
-  int rigIndex = -1;    // attribute or uniform index in the rig
+  int rigIndex = -1;    // attribute or uniform index in the rig; Buffer: index in Problem::buffers
   int target = -1;      // morph target of a per-target attribute
   std::string swizzle;  // part of the attribute ("" = whole)
   int resource = -1;    // the ResourceItem reading this fact occupies (-1: none)
@@ -44,7 +44,28 @@ struct ResourceItem {
   int limit = 0;     // index in Problem::limits
   int64_t amount = 0;
 };
-enum ResourceLimitIndex { kLimitAttributes = 0, kLimitUniformBytes = 1 };
+enum ResourceLimitIndex { kLimitAttributes = 0, kLimitUniformBytes = 1, kLimitStorageBuffers = 2 };
+constexpr int64_t kVulkanMinStorageBuffers = 4;  // maxPerStageDescriptorStorageBuffers every device has
+
+// A storage buffer the rig's data can fill (a `buffer_of:` semantic, docs/buffers.md).
+// PerVertex: element (vertex v, instance i) at index v * count + i, each element packing
+// one instance of every family in `parts` (facts[i] of each part). Array: the elements
+// of one uniform array (a joint palette), element i at index i.
+struct BufferSource {
+  enum class Kind { PerVertex, Array };
+  Kind kind = Kind::PerVertex;
+  int fact = -1;       // the buffer semantic's fact
+  int64_t count = 0;   // instances per vertex (PerVertex) or elements (Array)
+  Type element = Type::Vec4;  // std430 element: vec4, uvec4, ivec4 or mat4
+  struct Part {
+    std::string family;      // "morph.normal"
+    int components = 0;      // of the element, from `firstComponent`
+    int firstComponent = 0;
+    std::vector<int> facts;  // the family's instances (rig attribute facts)
+  };
+  std::vector<Part> parts;  // PerVertex
+  int uniform = -1;         // Array: the rig uniform whose values it holds
+};
 
 // One line of instantiated snippet. Fact references are encoded as
 // kFactRefBegin <id> kFactRefEnd so the emitter picks the GLSL names.
@@ -77,6 +98,7 @@ struct Problem {
   std::vector<std::pair<int, std::string>> skippedRules;
   std::vector<ResourceLimit> limits;  // empty: unconstrained (random libraries, tests)
   std::vector<ResourceItem> resources;
+  std::vector<BufferSource> buffers;
 
   int findFact(const std::string& name) const;  // -1 if absent
 };
@@ -88,7 +110,8 @@ Problem buildProblem(const Rig& rig, const RuleSet& rules, const std::vector<Var
 
 // The device limits of a generation: vertex input attributes (Vulkan guarantees 16) and
 // uniform block bytes (maxUniformBufferRange, 16384 guaranteed).
-void setDeviceLimits(Problem& p, int64_t maxAttributes, int64_t maxUniformBytes);
+void setDeviceLimits(Problem& p, int64_t maxAttributes, int64_t maxUniformBytes,
+                     int64_t maxStorageBuffers = kVulkanMinStorageBuffers);
 
 // Usage per limit of the rig inputs a set of actions (and the goals) read.
 std::vector<int64_t> resourceUsage(const Problem& p, const std::vector<int>& actions);

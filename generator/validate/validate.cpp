@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <random>
 #include <set>
 
 #include "runtime/procedural.h"
@@ -122,6 +123,80 @@ void putMat4(std::vector<uint8_t>& block, uint32_t offset, const glm::mat4& m, u
   for (int c = 0; c < 4; ++c) putFloats(block, offset + static_cast<uint32_t>(c) * matrixStride, &m[c][0], 4);
 }
 
+// The sparse-morph protocol (docs/buffers.md): the targets with a non-zero weight, in
+// increasing order, and their count.
+void putActiveTargets(std::vector<uint8_t>& block, const UniformLayout& l, const RigUniform& ru, const rt::Pose& pose) {
+  std::vector<uint32_t> active;
+  for (size_t i = 0; i < pose.morphWeights.size(); ++i)
+    if (pose.morphWeights[i] != 0.0f) active.push_back(static_cast<uint32_t>(i));
+  if (ru.semantic == "morph.active_count") {
+    uint32_t n = static_cast<uint32_t>(active.size());
+    if (l.offset + 4 > block.size()) throw std::logic_error("uniform write past the block");
+    std::memcpy(block.data() + l.offset, &n, 4);
+    return;
+  }
+  if (active.size() > static_cast<size_t>(ru.arraySize))
+    throw InputError(ru.loc, fmt::format("the pose has {} targets with a non-zero weight; the active-target list "
+                                         "holds {}", active.size(), ru.arraySize));
+  for (size_t i = 0; i < active.size(); ++i) {
+    uint32_t off = l.offset + static_cast<uint32_t>(i) * l.arrayStride;
+    if (off + 4 > block.size()) throw std::logic_error("uniform write past the block");
+    std::memcpy(block.data() + off, &active[i], 4);
+  }
+}
+
+// Element bytes of a buffer element from up to 16 float components.
+void putElement(std::vector<uint8_t>& out, size_t at, Type element, const float* comps, int n) {
+  for (int c = 0; c < n; ++c) {
+    if (element == Type::UVec4 || element == Type::IVec4) {
+      auto u = static_cast<uint32_t>(static_cast<int64_t>(std::lround(comps[c])));
+      std::memcpy(out.data() + at + 4 * static_cast<size_t>(c), &u, 4);
+    } else {
+      std::memcpy(out.data() + at + 4 * static_cast<size_t>(c), &comps[c], 4);
+    }
+  }
+}
+
+}  // namespace
+
+// Storage buffers of a generated shader (docs/buffers.md layout): per-vertex ones from
+// the mesh's streams (one zero vertex of padding: the harness draws an even count), the
+// palette from the pose.
+std::vector<rt::StorageBufferData> buildStorageBuffers(const Problem& p, const EmittedGlsl& glsl, const rt::Mesh& mesh,
+                                                       const rt::Pose& pose, bool perVertex) {
+  std::vector<rt::StorageBufferData> out;
+  for (const auto& e : glsl.buffers) {
+    const BufferSource& b = p.buffers[e.buffer];
+    rt::StorageBufferData sb;
+    sb.binding = static_cast<uint32_t>(e.binding);
+    if (b.kind == BufferSource::Kind::Array) {
+      if (!perVertex) {
+        sb.data.assign(static_cast<size_t>(b.count) * e.strideBytes, 0);
+        for (int64_t j = 0; j < b.count && j < static_cast<int64_t>(pose.bones.size()); ++j)
+          putElement(sb.data, static_cast<size_t>(j) * e.strideBytes, e.element, &pose.bones[static_cast<size_t>(j)][0][0], 16);
+        out.push_back(std::move(sb));
+      }
+      continue;
+    }
+    if (!perVertex) continue;
+    const size_t count = static_cast<size_t>(b.count);
+    sb.data.assign((mesh.vertexCount + 1) * count * e.strideBytes, 0);
+    for (const auto& part : b.parts)
+      for (size_t i = 0; i < count; ++i) {
+        const std::string sem = p.facts[part.facts[i]].name;
+        if (!mesh.has(sem)) throw InputError(SourceLoc{}, fmt::format("mesh '{}' has no data for '{}' (buffer {})", mesh.name, sem, e.name));
+        const auto& src = mesh.at(sem);
+        for (size_t v = 0; v < mesh.vertexCount; ++v)
+          putElement(sb.data, ((v * count + i) * e.strideBytes) + 4 * static_cast<size_t>(part.firstComponent), e.element,
+                     &src[v][0], part.components);
+      }
+    out.push_back(std::move(sb));
+  }
+  return out;
+}
+
+namespace {
+
 std::vector<uint8_t> buildUniforms(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spv,
                                    const rt::Pose& pose) {
   std::vector<uint8_t> block(spv.uniformBlockSize, 0);
@@ -141,6 +216,8 @@ std::vector<uint8_t> buildUniforms(const Rig& rig, const EmittedGlsl& glsl, cons
         float w = i < static_cast<int>(pose.morphWeights.size()) ? pose.morphWeights[i] : 0.0f;
         putFloats(block, l.offset + static_cast<uint32_t>(i) * l.arrayStride, &w, 1);
       }
+    } else if (s == "morph.active_targets" || s == "morph.active_count") {
+      putActiveTargets(block, l, ru, pose);
     } else if (s == "camera.position") {
       putFloats(block, l.offset, &pose.cameraPosition[0], 3);
     } else {
@@ -158,6 +235,21 @@ std::vector<uint8_t> buildUniforms(const Rig& rig, const EmittedGlsl& glsl, cons
 }
 
 }  // namespace
+
+void limitActiveTargets(const Rig& rig, std::vector<rt::Pose>& poses, uint32_t seed) {
+  for (const auto& u : rig.uniforms) {
+    if (u.semantic != "morph.active_targets") continue;
+    for (size_t k = 0; k < poses.size(); ++k) {
+      auto& w = poses[k].morphWeights;
+      std::vector<size_t> order(w.size());
+      for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+      std::mt19937 rng(seed * 7919u + static_cast<uint32_t>(k));
+      for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng() % i]);  // portable shuffle
+      const auto keep = static_cast<size_t>(std::clamp<int64_t>(rig.param("max_active_targets", u.arraySize), 0, u.arraySize));
+      for (size_t i = keep; i < order.size(); ++i) w[order[i]] = 0.0f;
+    }
+  }
+}
 
 ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_t seed, int poses) {
   rt::MeshOptions mo;
@@ -184,6 +276,7 @@ ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_
   for (const auto& u : rig.uniforms)
     if (u.semantic == "model.matrix") s.shape.hasModelMatrix = true;
   for (int i = 0; i < poses; ++i) s.poses.push_back(rt::makeRandomPose(s.shape, seed + static_cast<uint32_t>(i)));
+  limitActiveTargets(rig, s.poses, seed);
   return s;
 }
 
@@ -214,6 +307,8 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
   req.vertexCount = static_cast<uint32_t>(mesh.vertexCount);
   req.capture.strideBytes = r.glsl.captureStride;
   for (const auto& in : r.glsl.inputs) req.streams.push_back(buildStream(rig, in, mesh));
+  const std::vector<rt::StorageBufferData> perVertexBuffers =
+      buildStorageBuffers(r.in.problem, r.glsl, mesh, rt::Pose{}, true);
 
   for (const auto& o : r.glsl.outputs) {
     OutputReport out;
@@ -225,6 +320,10 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
   size_t before = reportedMessages_;
   for (const rt::Pose& pose : scene.poses) {
     req.uniformData = buildUniforms(rig, r.glsl, r.spirv, pose);
+    req.storageBuffers = perVertexBuffers;
+    for (auto& sb : buildStorageBuffers(r.in.problem, r.glsl, mesh, pose, false)) req.storageBuffers.push_back(std::move(sb));
+    std::sort(req.storageBuffers.begin(), req.storageBuffers.end(),
+              [](const auto& a, const auto& b) { return a.binding < b.binding; });
     rt::RunResult res = harness_->run(req);
     rep.timings.setupMs += res.timings.setupMs;
     rep.timings.uploadMs += res.timings.uploadMs;

@@ -61,6 +61,15 @@ struct ValidationScene {
 // Throws InputError if the rig asks for something the procedural meshes can't supply.
 ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_t seed, int poses);
 
+// For rigs with an active-target list (morph.active_targets, docs/buffers.md): keeps, per
+// pose, a seeded choice of as many non-zero morph weights as the list holds.
+void limitActiveTargets(const Rig& rig, std::vector<rt::Pose>& poses, uint32_t seed);
+
+// The storage buffers a generated shader reads, filled from the mesh (per-vertex buffers,
+// `perVertex`) or from the pose (palettes, !perVertex), in the layout of docs/buffers.md.
+std::vector<rt::StorageBufferData> buildStorageBuffers(const Problem& p, const EmittedGlsl& glsl, const rt::Mesh& mesh,
+                                                       const rt::Pose& pose, bool perVertex);
+
 struct ValidateOptions {
   GenerateOptions gen;
   bool crossCheck = false;  // also force each alternative derivation and check it

@@ -1,0 +1,119 @@
+// Buffer-fed deformation on lavapipe (issue 14, docs/buffers.md): rigs whose morph targets,
+// influences or bone palette exceed the device limits validate with storage buffers, the
+// buffer forms are cross-checked against the attribute forms where those fit, and the
+// Dawn face plan is unchanged. The Khronos validation layer is on and must stay silent.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <iostream>
+
+#include "test_util.h"
+#include "validate/validate.h"
+
+namespace {
+
+using namespace sgtest;
+
+sg::ValidateReport validate(const std::string& rig, const std::string& fragment, const std::string& rules,
+                            const std::string& mesh, bool crossCheck, int poses, int maxAttributes = 16) {
+  sg::ValidateOptions vo;
+  vo.gen.rigPath = rig;
+  vo.gen.fragmentPath = fragment;
+  vo.gen.rulesPaths = {rules};
+  vo.gen.maxAttributes = maxAttributes;
+  vo.crossCheck = crossCheck;
+  sg::ValidationScene scene = sg::proceduralScene(sg::loadRigFile(rig), mesh, 3, poses);
+  sg::Validator v(vo);
+  sg::ValidateReport rep = v.run(scene);
+  std::cout << sg::formatReport(rep);
+  return rep;
+}
+
+bool has(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
+
+std::vector<std::string> forced(const sg::ValidateReport& rep) {
+  std::vector<std::string> out;
+  for (size_t i = 1; i < rep.runs.size(); ++i) {
+    const std::string& l = rep.runs[i].label;
+    out.push_back(l.substr(7, l.find(" for ") - 7));  // "forced <rule> for <semantic>"
+  }
+  return out;
+}
+
+void expectAllPass(const sg::ValidateReport& rep) {
+  EXPECT_TRUE(rep.validationLayers);
+  EXPECT_NE(rep.device.find("llvmpipe"), std::string::npos) << rep.device;
+  EXPECT_TRUE(rep.pass);
+  for (const auto& run : rep.runs) {
+    EXPECT_TRUE(run.pass) << run.label;
+    EXPECT_TRUE(run.validationMessages.empty()) << run.label;
+  }
+}
+
+const std::string kFaceFrag = "examples/dawn/face.frag", kFaceRules = "examples/dawn/rules.yaml";
+
+// 52 targets at 180,000 vertices, dense and with 6 active targets: one pose each (the
+// 180k-vertex runs are the slow part of this file).
+TEST(Buffers, Face52TargetsAt180kVerticesDenseAndSparse) {
+  for (const char* rig : {"face52.rig.yaml", "face52_sparse.rig.yaml"}) {
+    SCOPED_TRACE(rig);
+    bool sparse = std::string(rig).find("sparse") != std::string::npos;
+    sg::ValidateReport rep = validate(dataPath(rig), sourcePath(kFaceFrag), sourcePath(kFaceRules), "dawn", false, 1);
+    expectAllPass(rep);
+    ASSERT_EQ(rep.runs.size(), 1u);
+    EXPECT_EQ(rep.runs[0].vertices, 180000u);
+    const auto& rules = rep.runs[0].rules;
+    EXPECT_TRUE(has(rules, sparse ? "object_position_morphed_sparse" : "object_position_morphed_buffer"));
+    EXPECT_TRUE(has(rules, sparse ? "normal_occlusion_morphed_sparse" : "normal_occlusion_morphed_buffer"));
+  }
+}
+
+// The 52-target face with cross-check on a small head: the sparse plan is checked against
+// the dense buffer forms (the attribute forms need 110 attributes and are skipped).
+TEST(Buffers, Face52SparseCrossChecksDense) {
+  sg::ValidateReport rep =
+      validate(dataPath("face52_sparse.rig.yaml"), sourcePath(kFaceFrag), sourcePath(kFaceRules), "head", true, 2);
+  expectAllPass(rep);
+  std::vector<std::string> f = forced(rep);
+  EXPECT_TRUE(has(f, "object_position_morphed_buffer"));
+  EXPECT_TRUE(has(f, "normal_occlusion_morphed_buffer"));
+  EXPECT_FALSE(has(f, "object_position_morphed"));  // 52 attribute streams cannot fit
+}
+
+// 16 influences: 12 attributes fit 16, so the attribute blend is chosen and the buffered
+// influences are cross-checked against it; within 8 attributes only the buffers fit.
+TEST(Buffers, Limb16InfluencesAttributesAndBuffers) {
+  sg::ValidateReport rep = validate(dataPath("limb16.rig.yaml"), dataPath("world.frag"), sourcePath("rules/standard.yaml"),
+                                    "limb", true, 2);
+  expectAllPass(rep);
+  EXPECT_TRUE(has(rep.runs[0].rules, "skin_matrix_blend"));
+  EXPECT_TRUE(has(forced(rep), "skin_matrix_blend_buffered_influences"));
+  sg::ValidateReport small = validate(dataPath("limb16.rig.yaml"), dataPath("world.frag"),
+                                      sourcePath("rules/standard.yaml"), "limb", false, 2, 8);
+  expectAllPass(small);
+  EXPECT_TRUE(has(small.runs[0].rules, "skin_matrix_blend_buffered_influences"));
+}
+
+// 8 influences over 300 bones: the palette does not fit the 16 KiB uniform block.
+TEST(Buffers, Limb8With300BonesReadsThePaletteFromABuffer) {
+  sg::ValidateReport rep = validate(dataPath("limb8_palette300.rig.yaml"), dataPath("world.frag"),
+                                    sourcePath("rules/standard.yaml"), "limb", true, 2);
+  expectAllPass(rep);
+  EXPECT_TRUE(has(rep.runs[0].rules, "skin_matrix_blend_buffer_palette"));
+}
+
+// The Dawn face keeps its plan (cost 81, no buffer) and cross-checks every buffer form
+// that fits next to the other attributes.
+TEST(Buffers, DawnFaceUnchangedAndBufferFormsCrossChecked) {
+  sg::ValidateReport rep = validate(sourcePath("examples/dawn/face.rig.yaml"), sourcePath(kFaceFrag),
+                                    sourcePath(kFaceRules), "head", true, 1);
+  expectAllPass(rep);
+  EXPECT_EQ(rep.runs[0].planCost, 81);
+  for (const auto& r : rep.runs[0].rules) EXPECT_EQ(r.find("buffer"), std::string::npos) << r;
+  std::vector<std::string> f = forced(rep);
+  EXPECT_TRUE(has(f, "object_position_morphed_buffer"));
+  EXPECT_TRUE(has(f, "normal_occlusion_morphed_buffer"));
+  EXPECT_TRUE(has(f, "skin_matrix_blend_buffer_palette"));
+}
+
+}  // namespace
