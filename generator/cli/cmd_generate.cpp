@@ -37,6 +37,10 @@ void GenerateArgs::add(CLI::App& cmd) {
   cmd.add_option("--max-uniform-bytes", opts.maxUniformBlockBytes,
                  "Bytes of the uniform block (the device's maxUniformBufferRange; default 16384)")
       ->check(CLI::Range(16, 1 << 30));
+  cmd.add_option("--vertices", opts.maxVertices,
+                 "The most vertices one draw has: per-vertex storage buffers that would exceed "
+                 "maxStorageBufferRange (2^27 bytes) at that count are not used (default: unknown, all allowed)")
+      ->check(CLI::Range(int64_t{0}, int64_t{1} << 32));
   cmd.add_option("--target-env", targetEnv, "vulkan1.0 (default), vulkan1.1, vulkan1.2, vulkan1.3")
       ->check(CLI::IsMember({"vulkan", "vulkan1.0", "vulkan1.1", "vulkan1.2", "vulkan1.3"}));
   cmd.add_option("--templates", opts.templateDir, "Directory with vertex.glsl templates");

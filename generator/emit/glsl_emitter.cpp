@@ -165,7 +165,7 @@ class Emitter {
       e.binding = binding++;
       e.buffer = p_.facts[f].rigIndex;
       e.element = b.element;
-      e.strideBytes = b.element == Type::Mat4 ? 64 : 16;
+      e.strideBytes = static_cast<uint32_t>(b.strideBytes);
       e.perVertex = b.kind == BufferSource::Kind::PerVertex;
       e.count = b.count;
       if (e.perVertex) {
@@ -190,11 +190,20 @@ class Emitter {
                               ? fmt::format("uint(gl_VertexIndex) * {}u + uint(i)", b.count)
                               : std::string("uint(i)");
       int n = componentCount(f.type);
-      std::string swizzle = f.type == b.element ? "" : "." + std::string("xyzw").substr(0, static_cast<size_t>(n));
+      std::string value;
+      if (e.element == Type::Float) {  // tightly packed floats
+        index = fmt::format("({}) * {}u", index, b.components);
+        std::string parts;
+        for (int c = 0; c < n; ++c) parts += fmt::format("{}{}_data[k + {}u]", c ? ", " : "", e.name, c);
+        value = n == 1 ? parts : fmt::format("{}({})", glslName(f.type), parts);
+      } else {
+        std::string swizzle = f.type == e.element ? "" : "." + std::string("xyzw").substr(0, static_cast<size_t>(n));
+        value = fmt::format("{}_data[k]{}", e.name, swizzle);
+      }
       s += fmt::format(
           "layout(set = 0, binding = {}, std430) readonly buffer ShadergenBuffer{} {{\n  {} {}_data[];\n}};\n"
-          "{} {}(int i) {{ return {}_data[{}]{}; }}\n",
-          e.binding, e.binding, glslName(e.element), e.name, glslName(f.type), e.name, e.name, index, swizzle);
+          "{} {}(int i) {{ uint k = {}; return {}; }}\n",
+          e.binding, e.binding, glslName(e.element), e.name, glslName(f.type), e.name, index, value);
     }
     return s;
   }

@@ -197,6 +197,7 @@ GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const
   GenerateResult res;
   if (!opts.bannedRules.empty()) in.problem = withoutRules(in.problem, opts.bannedRules);
   setDeviceLimits(in.problem, opts.maxAttributes, opts.maxUniformBlockBytes, opts.maxStorageBuffers);
+  dropOversizedBuffers(in.problem, opts.maxVertices, opts.maxStorageBufferBytes);
   res.plan = searchStage(in, SearchOptions{opts.searchEngine, opts.heuristic, opts.searchLimits}, &res.stats);
   EmitOptions eo;
   eo.capture = opts.capture;

@@ -46,6 +46,10 @@ struct GenerateOptions {
   // Like the uniform block, a constraint of the search (docs/search.md, "Resource limits").
   int maxAttributes = static_cast<int>(kVulkanMinVertexAttributes);
   int maxStorageBuffers = static_cast<int>(kVulkanMinStorageBuffers);  // maxPerStageDescriptorStorageBuffers
+  // The most vertices one draw has (0 = unknown): per-vertex storage buffers larger than
+  // maxStorageBufferBytes for that many vertices are not used (docs/buffers.md).
+  int64_t maxVertices = 0;
+  int64_t maxStorageBufferBytes = int64_t{1} << 27;  // maxStorageBufferRange every device has
 };
 
 struct GenerateResult {

@@ -192,8 +192,17 @@ class Builder {
                                             glslName(d.type), components));
       if (b.count == 0) return;
       b.element = kind == ScalarKind::UInt ? Type::UVec4 : kind == ScalarKind::Int ? Type::IVec4 : Type::Vec4;
+      // Tight floats for vec3/vec2/float: a 52-target face at 180k vertices must stay
+      // within maxStorageBufferRange (2^27 bytes guaranteed).
+      if (kind == ScalarKind::Float && components < 4) b.element = Type::Float;
+      b.components = b.element == Type::Float ? components : 4;
+      b.strideBytes = 4 * b.components;
+    } else {
+      b.components = 16;
+      b.strideBytes = 64;
     }
     Fact& fact = p_.facts[b.fact];
+    if (b.kind == BufferSource::Kind::PerVertex && b.element == Type::Float && components == 4) b.element = Type::Vec4;
     fact.source = Fact::Source::Buffer;
     fact.rigIndex = static_cast<int>(p_.buffers.size());
     fact.resource = resourceFor("storage buffer " + d.name, kLimitStorageBuffers, 1);
@@ -262,6 +271,18 @@ void setDeviceLimits(Problem& p, int64_t maxAttributes, int64_t maxUniformBytes,
   p.limits[kLimitAttributes] = ResourceLimit{"vertex input attributes", "--max-attributes", maxAttributes};
   p.limits[kLimitUniformBytes] =
       ResourceLimit{"uniform block bytes (std140, members rounded to 16)", "maxUniformBufferRange", maxUniformBytes};
+}
+
+void dropOversizedBuffers(Problem& p, int64_t maxVertices, int64_t maxBytes) {
+  if (maxVertices <= 0) return;
+  for (const auto& b : p.buffers) {
+    if (b.kind != BufferSource::Kind::PerVertex) continue;
+    // Checked in long double: vertices x count x stride can pass 2^63 for hostile options.
+    long double bytes = static_cast<long double>(maxVertices) * b.count * b.strideBytes;
+    if (bytes <= static_cast<long double>(maxBytes)) continue;
+    p.facts[b.fact].source = Fact::Source::Computed;
+    p.init.erase(std::remove(p.init.begin(), p.init.end(), b.fact), p.init.end());
+  }
 }
 
 std::vector<int64_t> resourceUsage(const Problem& p, const std::vector<int>& actions) {

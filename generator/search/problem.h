@@ -56,7 +56,11 @@ struct BufferSource {
   Kind kind = Kind::PerVertex;
   int fact = -1;       // the buffer semantic's fact
   int64_t count = 0;   // instances per vertex (PerVertex) or elements (Array)
-  Type element = Type::Vec4;  // std430 element: vec4, uvec4, ivec4 or mat4
+  // std430 array element: float (1-3 float components packed tightly, `components` floats
+  // per instance), vec4, uvec4, ivec4 or mat4.
+  Type element = Type::Vec4;
+  int components = 4;       // floats (or uints) per instance
+  int64_t strideBytes = 16;  // bytes per instance
   struct Part {
     std::string family;      // "morph.normal"
     int components = 0;      // of the element, from `firstComponent`
@@ -112,6 +116,11 @@ Problem buildProblem(const Rig& rig, const RuleSet& rules, const std::vector<Var
 // uniform block bytes (maxUniformBufferRange, 16384 guaranteed).
 void setDeviceLimits(Problem& p, int64_t maxAttributes, int64_t maxUniformBytes,
                      int64_t maxStorageBuffers = kVulkanMinStorageBuffers);
+
+// Per-vertex storage buffers larger than `maxBytes` for draws of up to `maxVertices`
+// vertices (maxStorageBufferRange, 2^27 guaranteed) are not offered: their facts stop being
+// provided, so the search uses other forms. maxVertices <= 0: vertex count unknown, keep all.
+void dropOversizedBuffers(Problem& p, int64_t maxVertices, int64_t maxBytes);
 
 // Usage per limit of the rig inputs a set of actions (and the goals) read.
 std::vector<int64_t> resourceUsage(const Problem& p, const std::vector<int>& actions);

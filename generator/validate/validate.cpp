@@ -396,6 +396,8 @@ ValidateReport Validator::run(const ValidationScene& scene) {
   report.validationLayers = harness_->validationEnabled();
   GenerateOptions gen = opts_.gen;
   gen.capture = true;
+  // The buffer forms must fit this mesh (+1: the harness draws an even count).
+  if (gen.maxVertices == 0) gen.maxVertices = static_cast<int64_t>(scene.mesh.vertexCount) + 1;
   LoadedInputs in = loadInputs(gen);
   auto t0 = Clock::now();
   GenerateResult chosen = generateFrom(in, gen);
