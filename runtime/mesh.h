@@ -35,6 +35,9 @@ struct Pose {
   glm::mat4 projection{1.0f};         // camera.projection
   glm::mat4 model{1.0f};              // model.matrix
   glm::mat4 dapple{1.0f};             // dapple.matrix
+  // Uniforms of other semantics (declared by users' rules): flat column-major components,
+  // arrays element after element, by semantic (docs/validation.md, "Poses").
+  std::map<std::string, std::vector<double>> uniforms;
   glm::mat4 viewProjection() const { return projection * view; }  // camera.view_projection
 };
 
@@ -44,6 +47,8 @@ struct RigShape {
   int influences = 0;     // 0 = unskinned, 1 = rigid, 2/4/8 = linear blend
   int morphTargets = 0;
   bool hasModelMatrix = false;  // unskinned rigs transform by model.matrix when provided
+  // The rig declares uniform_scale: world.normal uses mat3(M), else its inverse transpose.
+  bool uniformScale = false;
 };
 
 }  // namespace sg::rt

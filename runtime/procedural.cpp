@@ -298,11 +298,13 @@ Pose makeRandomPose(const RigShape& shape, uint32_t seed, const PoseOptions& opt
     float s = rng.uniform(1.0f - opts.uniformScaleRange, 1.0f + opts.uniformScaleRange);
     glm::vec3 scale(s);
     if (opts.nonUniformScaleFraction > 0.0f && rng.unit() < opts.nonUniformScaleFraction)
-      scale *= rng.vec3(0.8f, 1.2f);
+      scale *= rng.vec3(opts.nonUniformScaleMin, opts.nonUniformScaleMax);
     pose.bones.push_back(glm::rotate(glm::mat4(1.0f), angle, axis) * glm::translate(glm::mat4(1.0f), t) *
                          glm::scale(glm::mat4(1.0f), scale));
   }
-  for (int i = 0; i < shape.morphTargets; ++i) pose.morphWeights.push_back(rng.unit());
+  const bool unitWeights = opts.morphWeightMin == 0.0f && opts.morphWeightMax == 1.0f;
+  for (int i = 0; i < shape.morphTargets; ++i)
+    pose.morphWeights.push_back(unitWeights ? rng.unit() : rng.uniform(opts.morphWeightMin, opts.morphWeightMax));
 
   glm::vec3 dir = rng.unitVector();
   float dist = rng.uniform(3.0f, 5.0f);
@@ -318,7 +320,22 @@ Pose makeRandomPose(const RigShape& shape, uint32_t seed, const PoseOptions& opt
   glm::vec3 modelAxis = rng.unitVector();
   float modelAngle = rng.uniform(0.0f, static_cast<float>(kTwoPi));
   pose.model = glm::translate(glm::mat4(1.0f), modelT) * glm::rotate(glm::mat4(1.0f), modelAngle, modelAxis);
+  if (opts.modelNonUniformScale)  // drawn last: poses without it keep their values
+    pose.model = pose.model * glm::scale(glm::mat4(1.0f), rng.vec3(opts.nonUniformScaleMin, opts.nonUniformScaleMax));
   return pose;
+}
+
+PoseOptions hostilePoseOptions(bool uniformScale) {
+  PoseOptions o;
+  o.morphWeightMin = -0.5f;
+  o.morphWeightMax = 1.5f;
+  if (!uniformScale) {
+    o.nonUniformScaleFraction = 0.5f;
+    o.nonUniformScaleMin = 0.25f;
+    o.nonUniformScaleMax = 2.5f;
+    o.modelNonUniformScale = true;
+  }
+  return o;
 }
 
 Pose makeRestPose(const RigShape& shape) {

@@ -44,7 +44,15 @@ struct PoseOptions {
   float maxTranslation = 0.3f;        // bone translation, each component in [-max, max]
   float uniformScaleRange = 0.1f;     // bone uniform scale in [1 - r, 1 + r]
   float nonUniformScaleFraction = 0;  // fraction of bones given a non-uniform scale (off by default)
+  float nonUniformScaleMin = 0.8f, nonUniformScaleMax = 1.2f;  // per-axis factor of those bones
+  float morphWeightMin = 0.0f, morphWeightMax = 1.0f;          // morph weights, uniform in [min, max]
+  bool modelNonUniformScale = false;  // model = translate * rotate * scale(per-axis factor)
 };
+
+// Poses that find bugs (validate's default unless the rig declares uniform_scale): half the
+// bones and the model matrix scaled per axis by 0.25..2.5 (normals then need the inverse
+// transpose), morph weights in [-0.5, 1.5] (a rule that clamps them fails).
+PoseOptions hostilePoseOptions(bool uniformScale);
 
 // Seeded random pose with non-trivial rotations. Bones: rotate(random axis, angle) *
 // translate(t) * scale(s) (rigid + uniform scale unless opts.nonUniformScaleFraction > 0);

@@ -287,13 +287,17 @@ struct ReferenceEvaluator::State {
     return *worldPos;
   }
 
-  // world.normal = normalize(mat3(M)·object.normal)
+  // world.normal = normalize(transpose(inverse(mat3(M)))·object.normal); a rig declaring
+  // uniform_scale: normalize(mat3(M)·object.normal)
   const std::vector<dvec3>& worldNormalValues() {
     if (worldNormal) return *worldNormal;
     const auto& N = objectNormal();
     prepareSkinning();
     std::vector<dvec3> out(n);
-    for (size_t v = 0; v < n; ++v) out[v] = glm::normalize(dmat3(skinAt(v)) * N[v]);
+    for (size_t v = 0; v < n; ++v) {
+      const dmat3 M3(skinAt(v));
+      out[v] = glm::normalize((shape.uniformScale ? M3 : glm::transpose(glm::inverse(M3))) * N[v]);
+    }
     worldNormal = std::move(out);
     return *worldNormal;
   }

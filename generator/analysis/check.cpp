@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <regex>
@@ -59,6 +60,11 @@ std::map<std::string, RuleKeys> locateRuleKeys(const RuleSet& rules) {
     if (!root.IsMap() || !root["rules"] || !root["rules"].IsSequence()) continue;
     for (const auto& r : root["rules"]) {
       if (!r.IsMap() || !r["name"] || !r["name"].IsScalar()) continue;
+      SourceLoc nameLoc = locOf(r["name"], file);
+      bool loaded = std::any_of(rules.rules.begin(), rules.rules.end(), [&](const Rule& x) {
+        return x.name == r["name"].Scalar() && x.loc.file == file && x.loc.line == nameLoc.line;
+      });
+      if (!loaded) continue;  // replaced by an override, or disabled
       RuleKeys k;
       k.cost = valueLoc(r["cost"], file, lines);
       k.when = valueLoc(r["when"], file, lines);
@@ -87,6 +93,10 @@ class Checker {
       return finish();
     }
     keys_ = locateRuleKeys(rules_);
+    for (const auto& c : rules_.changes)  // overrides and disables are deliberate: notes, not warnings
+      add(Severity::Note, c.loc, fmt::format("rule '{}' {} the rule at {}:{}", c.rule,
+                                             c.disabled ? "is disabled here:" : "overrides", c.original.file,
+                                             c.original.line));
     structural_.assign(rules_.rules.size(), false);
     for (size_t r = 0; r < rules_.rules.size(); ++r) checkRuleNames(static_cast<int>(r));
     checkVaryings();
@@ -519,12 +529,59 @@ class Checker {
       });
       if (!dup) unique.push_back(d);
     }
-    report_.findings = std::move(unique);
-    for (const auto& d : report_.findings) {
+    report_.findings = scopeToNamedFiles(std::move(unique));
+    report_.werror = opts_.werror;
+    for (auto& d : report_.findings) {
+      if (opts_.werror && d.severity == Severity::Warning) d.severity = Severity::Error;
       if (d.severity == Severity::Error) ++report_.errors;
       else if (d.severity == Severity::Warning) ++report_.warnings;
     }
+    report_.groups = groupFindings(report_.findings);
     return std::move(report_);
+  }
+
+  // The user checks the files they name: warnings and notes located in included files
+  // (the standard library, usually) are counted but shown only with --all. Errors are
+  // always shown: an included file that fails breaks the named one too.
+  std::vector<Diagnostic> scopeToNamedFiles(std::vector<Diagnostic> findings) {
+    if (opts_.all) return findings;
+    std::vector<std::filesystem::path> named;
+    for (const auto& p : opts_.rulesPaths) named.push_back(canonicalOrSelf(p));
+    if (!opts_.rigPath.empty()) named.push_back(canonicalOrSelf(opts_.rigPath));
+    std::vector<Diagnostic> shown;
+    for (auto& d : findings) {
+      bool mine = d.loc.file.empty() || std::find(named.begin(), named.end(), canonicalOrSelf(d.loc.file)) != named.end();
+      if (mine || d.severity == Severity::Error) shown.push_back(std::move(d));
+      else ++report_.hiddenWarnings;
+    }
+    return shown;
+  }
+
+  static std::filesystem::path canonicalOrSelf(const std::string& p) {
+    std::error_code ec;
+    auto c = std::filesystem::weakly_canonical(p, ec);
+    return ec ? std::filesystem::path(p) : c;
+  }
+
+  static std::vector<FindingGroup> groupFindings(const std::vector<Diagnostic>& findings) {
+    std::vector<FindingGroup> groups;
+    for (const auto& d : findings) {
+      if (d.severity == Severity::Error) continue;
+      std::string kind;  // quoted names elided: "rule '…' is never used"
+      for (size_t i = 0; i < d.message.size(); ++i) {
+        kind += d.message[i];
+        if (d.message[i] != '\'') continue;
+        size_t close = d.message.find('\'', i + 1);
+        if (close == std::string::npos) continue;
+        kind += "\u2026'";
+        i = close;
+      }
+      auto it = std::find_if(groups.begin(), groups.end(), [&](const FindingGroup& g) { return g.kind == kind && g.severity == d.severity; });
+      if (it == groups.end()) groups.push_back(FindingGroup{kind, d.severity, 1});
+      else ++it->count;
+    }
+    std::stable_sort(groups.begin(), groups.end(), [](const FindingGroup& a, const FindingGroup& b) { return a.count > b.count; });
+    return groups;
   }
 
   CheckOptions opts_;
@@ -544,9 +601,18 @@ CheckReport checkRules(const CheckOptions& opts) { return Checker(opts).run(); }
 std::string formatCheckReport(const CheckReport& r) {
   std::string out;
   for (const auto& d : r.findings) out += renderDiagnostic(d) + "\n";
-  out += fmt::format("{} error{}, {} warning{}\n", r.errors, r.errors == 1 ? "" : "s", r.warnings,
-                     r.warnings == 1 ? "" : "s");
-  return out;
+  bool several = std::any_of(r.groups.begin(), r.groups.end(), [](const FindingGroup& g) { return g.count > 1; });
+  if (several) {
+    out += "by kind:\n";
+    for (const auto& g : r.groups)
+      out += fmt::format("  {:>4} {}: {}\n", g.count, g.severity == Severity::Note ? "note" : "warning", g.kind);
+  }
+  out += fmt::format("{} error{}, {} warning{}", r.errors, r.errors == 1 ? "" : "s", r.warnings, r.warnings == 1 ? "" : "s");
+  if (r.werror && r.errors) out += " (-Werror: warnings are errors)";
+  if (r.hiddenWarnings)
+    out += fmt::format("; {} warning{} and note{} in included files not shown (--all shows them)", r.hiddenWarnings,
+                       r.hiddenWarnings == 1 ? "" : "s", r.hiddenWarnings == 1 ? "" : "s");
+  return out + "\n";
 }
 
 std::string formatCostTable(const CheckReport& r) {

@@ -15,6 +15,8 @@ struct CheckOptions {
   std::vector<std::string> rulesPaths;
   std::string rigPath;          // "" = probe snippets against the default rigs
   bool compileSnippets = true;  // compile each snippet alone (and measure its cost)
+  bool all = false;     // also report warnings and notes located in included files
+  bool werror = false;  // warnings count as errors
 };
 
 // One row of the stated-versus-measured cost table (`check --costs`).
@@ -28,8 +30,18 @@ struct CostRow {
   bool disagrees = false;          // differs by more than a factor of two
 };
 
+// Warnings of one kind ("rule '…' is never used"), counted (`check` prints a summary).
+struct FindingGroup {
+  std::string kind;  // the message with quoted names replaced by '…'
+  Severity severity = Severity::Warning;
+  int count = 0;
+};
+
 struct CheckReport {
-  std::vector<Diagnostic> findings;  // sorted by file, line, column
+  std::vector<Diagnostic> findings;  // in the named files (all files with --all), by file, line, column
+  std::vector<FindingGroup> groups;  // the shown warnings and notes by kind, most frequent first
+  int hiddenWarnings = 0;            // warnings and notes in included files, not shown (no --all)
+  bool werror = false;
   std::vector<CostRow> costs;        // in rule order
   int errors = 0;
   int warnings = 0;
@@ -42,7 +54,8 @@ CheckReport checkRules(const CheckOptions& opts);
 // (Differences of a single slot are tolerated so 0 vs 1 is not flagged.)
 bool costsDisagree(int64_t stated, int64_t measured);
 
-// Findings rendered with quoted lines and carets, then "N errors, M warnings".
+// Findings rendered with quoted lines and carets, then the warnings grouped by kind and
+// "N errors, M warnings" (with -Werror, warnings are rendered and counted as errors).
 std::string formatCheckReport(const CheckReport& r);
 // The cost table: rule, rig, stated, measured.
 std::string formatCostTable(const CheckReport& r);

@@ -133,7 +133,10 @@ std::string formatExplanation(const LoadedInputs& in, const Explanation& e) {
     std::string sems;
     for (const auto& s : v.semantics) sems += (sems.empty() ? "" : ", ") + s;
     std::string where = v.location >= 0 ? fmt::format("location {}", v.location) : "position";
-    out += fmt::format("{} ({} {}) = {}\n", v.name, glslName(v.type), where, v.semantics.size() > 1 ? "pack(" + sems + ")" : sems);
+    std::string type(glslName(v.type));
+    if (v.arraySize) type += fmt::format("[{}]", v.arraySize);
+    std::string value = v.arraySize ? "{" + sems + "}" : v.semantics.size() > 1 ? "pack(" + sems + ")" : sems;
+    out += fmt::format("{} ({} {}) = {}{}\n", v.name, type, where, value, v.via.empty() ? "" : "  [mapped by " + v.via + "]");
     for (const auto& s : v.semantics) {
       int f = p.findFact(s);
       if (f < 0) continue;
@@ -163,6 +166,15 @@ std::string formatExplanation(const LoadedInputs& in, const Explanation& e) {
     out += fmt::format("  {:<40} {:<24} {:>5} {:>5}  {}\n", a.name, p.facts[a.add].name, a.cost, s.uses, without);
   }
   out += fmt::format("total cost {} ({} rules, each paid once; {} A*)\n", sum, e.steps.size(), e.heuristic);
+  if (!in.rules.changes.empty()) out += "\n" + formatRuleChanges(in.rules);
+  return out;
+}
+
+std::string formatRuleChanges(const RuleSet& rules) {
+  std::string out = "rules changed by the rules files (override: true, disable:):\n";
+  for (const auto& c : rules.changes)
+    out += fmt::format("  {} {} at {}:{} (the rule at {}:{})\n", c.disabled ? "disabled" : "overridden", c.rule,
+                       c.loc.file, c.loc.line, c.original.file, c.original.line);
   return out;
 }
 

@@ -61,6 +61,9 @@ std::vector<UnreachableGoal> analyzeUnreachable(const Problem& p, const RuleSet&
                                                 const std::vector<Varying>& varyings);
 std::string formatUnreachable(const Problem& p, const std::vector<UnreachableGoal>& goals);
 
+// The rules the rules files replaced or disabled (RuleSet::changes), one line each.
+std::string formatRuleChanges(const RuleSet& rules);
+
 // "morph.position[0..4]"-style compact list of fact names.
 std::string compactFactList(const std::vector<std::string>& names);
 

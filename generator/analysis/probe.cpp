@@ -39,6 +39,7 @@ ProbeRig makeDefault(const RuleSet& rules, const std::string& name, std::map<std
   ProbeRig pr;
   pr.name = name;
   pr.params = std::move(params);
+  pr.params.emplace("uniform_scale", 1);  // probe the rules that need it too
   pr.isDefault = true;
   evalFamilies(pr, rules, false);
   if (provideLeaves)

@@ -39,6 +39,9 @@ struct BuildCommand {
   bool list = false;
 
   int run() {
+    if (noCache && !cacheDir.empty())
+      throw CLI::ValidationError("--cache-dir", "does not apply with --no-cache");
+    if (quiet && progress) throw CLI::ValidationError("--progress", "does not apply with --quiet");
     auto start = std::chrono::steady_clock::now();
     Manifest m = loadManifest(manifest);
     if (!output.empty()) m.outputDir = output;

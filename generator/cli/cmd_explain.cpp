@@ -22,11 +22,20 @@ std::pair<LoadedInputs, std::optional<Plan>> loadAndSearch(const GenerateOptions
   return {std::move(in), std::move(plan)};
 }
 
+// explain and graph search with the default engine and write no shader: the generate
+// options about the engine, its limits and the templates would be silently ignored.
+void refuseSearchAndEmitOptions(const CLI::App& cmd) {
+  for (const char* o : {"--search", "--search-time-limit", "--max-expansions", "--templates"})
+    refuseOption(cmd, o, fmt::format("to '{}': it searches with the default engine and writes no shader", cmd.get_name()));
+}
+
 struct ExplainCommand {
+  CLI::App* cmd = nullptr;
   GenerateArgs args;
   bool noAlternatives = false;
 
   int run() {
+    refuseSearchAndEmitOptions(*cmd);
     GenerateOptions o = args.resolve();
     auto [in, plan] = loadAndSearch(o);
     if (!plan) {
@@ -44,11 +53,13 @@ struct ExplainCommand {
 };
 
 struct GraphCommand {
+  CLI::App* cmd = nullptr;
   GenerateArgs args;
   std::string output;
   std::string svg;
 
   int run() {
+    refuseSearchAndEmitOptions(*cmd);
     GenerateOptions o = args.resolve();
     if (!svg.empty() && findOnPath("dot").empty())
       throw std::runtime_error("cannot write " + svg + ": Graphviz 'dot' is not on PATH (install graphviz)");
@@ -76,12 +87,14 @@ struct GraphCommand {
 void registerExplain(CLI::App& app, CliState& state) {
   auto ex = std::make_shared<ExplainCommand>();
   CLI::App* sub = app.add_subcommand("explain", "Show the chosen plan, its costs, and each choice's best alternative");
+  ex->cmd = sub;
   ex->args.add(*sub);
   sub->add_flag("--no-alternatives", ex->noAlternatives, "Do not re-search for each choice's alternative");
   sub->callback([ex, &state] { state.run = [ex] { return ex->run(); }; });
 
   auto gr = std::make_shared<GraphCommand>();
   CLI::App* g = app.add_subcommand("graph", "Write the chosen plan as a Graphviz DOT graph (and SVG)");
+  gr->cmd = g;
   gr->args.add(*g);
   g->add_option("-o", gr->output, "DOT output path (default: standard output)");
   g->add_option("--svg", gr->svg, "Also render SVG with Graphviz 'dot' (must be on PATH)");

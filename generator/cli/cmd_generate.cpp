@@ -18,6 +18,10 @@ void GenerateArgs::add(CLI::App& cmd) {
   cmd.add_option("--fragment,-f", opts.fragmentPath, "Fragment shader whose inputs must be fed (GLSL 450)")->required();
   cmd.add_option("--rules,-r", opts.rulesPaths, "Rules file(s) (YAML)")->required();
   cmd.add_option("--map", maps, "Map a fragment input to semantics: Name=sem or Name=s1,s2,... (packs)");
+  cmd.add_option("--conventions", opts.conventions,
+                 "Varying naming conventions to apply, earlier first (threejs, gltf-sample-viewer, filament, ...; "
+                 "none). Default: every convention, where they agree")
+      ->delimiter(',');
   cmd.add_option("--heuristic", opts.heuristic, "A* heuristic (either engine): lmcut (default), hmax, blind")
       ->check(CLI::IsMember({"lmcut", "hmax", "blind"}));
   cmd.add_option("--search", opts.searchEngine,
@@ -109,6 +113,8 @@ struct GenerateCommand {
     o.capture = capture;
     std::set<std::string> kinds(emit.begin(), emit.end());
     if (kinds.empty()) throw CLI::ValidationError("--emit", "nothing to emit");
+    if (optimize && !kinds.count("spv") && !kinds.count("header"))
+      throw CLI::ValidationError("-O", "does not apply: it optimises the SPIR-V, and --emit writes none (add spv or header)");
     // With one --emit kind, -o names that file exactly (like glslc -o). Otherwise -o is a
     // stem: known suffixes are stripped and each kind gets its own (.vert .spv .spv.h .json).
     bool single = kinds.size() == 1 && !output.empty();

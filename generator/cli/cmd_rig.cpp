@@ -21,6 +21,9 @@ struct RigImportCommand {
 
   int run() {
     GltfRef ref = parseGltfRef(model);
+    if (model.find('#') != std::string::npos && (mesh >= 0 || primitive >= 0))
+      throw CLI::ValidationError(mesh >= 0 ? "--mesh" : "--primitive",
+                                 fmt::format("does not apply: '{}' already names the mesh and primitive", model));
     GltfImportOptions o;
     o.mesh = mesh >= 0 ? mesh : ref.mesh;
     o.primitive = primitive >= 0 ? primitive : ref.primitive;

@@ -5,16 +5,21 @@
 
 #include "cli/commands.h"
 #include "validate/gltf_scene.h"
+#include "validate/poses.h"
+#include "cli/output_files.h"
 #include "validate/validate.h"
 
 namespace sg {
 namespace {
 
 struct ValidateCommand {
+  CLI::App* cmd = nullptr;
   GenerateArgs args;
   std::string mesh = "head";
   uint32_t seed = 1;
-  int poses = 2;
+  std::string poses = "2";  // a count of random poses, or a pose file
+  std::string savePoses;
+  bool strict = false;
   bool crossCheck = false;
   std::string device;
   bool noLayers = false;
@@ -29,9 +34,17 @@ struct ValidateCommand {
     vo.device = device;
     vo.validationLayers = !noLayers;
     vo.tolerance = tol;
+    vo.strict = strict;
     ValidationScene scene;
     std::string what;
-    if (isGltfPath(vo.gen.rigPath)) {  // a real model: its own mesh, posed by its animation
+    bool gltf = isGltfPath(vo.gen.rigPath);
+    if (gltf)
+      for (const char* o : {"--mesh", "--seed", "--poses"})
+        refuseOption(*cmd, o, "to a glTF rig: the model's own mesh is posed by its animation (use --time, --animation)");
+    if (!gltf)
+      for (const char* o : {"--time", "--animation"})
+        refuseOption(*cmd, o, "to a YAML rig: it is validated on a procedural mesh in random poses (--mesh, --seed, --poses)");
+    if (gltf) {  // a real model: its own mesh, posed by its animation
       GltfSceneOptions so;
       so.times = times;
       so.animation = animation;
@@ -45,12 +58,25 @@ struct ValidateCommand {
                                                               info.start, info.end),
                          ts);
     } else {
-      scene = proceduralScene(loadRigFile(vo.gen.rigPath), mesh, seed, poses);
-      what = fmt::format("mesh '{}' ({} vertices), {} pose(s) from seed {}\n", scene.mesh.name,
-                         scene.mesh.vertexCount, scene.poses.size(), seed);
+      bool count = !poses.empty() && poses.find_first_not_of("0123456789") == std::string::npos && poses.size() < 4;
+      int n = count ? std::stoi(poses) : 1;
+      if (count && (n < 1 || n > 100)) throw InputError(SourceLoc{}, fmt::format("--poses {}: a count is 1..100", poses));
+      scene = proceduralScene(loadRigFile(vo.gen.rigPath), mesh, seed, n);
+      if (count) {
+        what = fmt::format("mesh '{}' ({} vertices), {} pose(s) from seed {}\n", scene.mesh.name,
+                           scene.mesh.vertexCount, scene.poses.size(), seed);
+      } else {
+        scene.poses = readPoseFile(poses);
+        what = fmt::format("mesh '{}' ({} vertices), {} pose(s) from {}\n", scene.mesh.name, scene.mesh.vertexCount,
+                           scene.poses.size(), poses);
+      }
     }
     Validator v(vo);
     ValidateReport report = v.run(scene);
+    if (!savePoses.empty()) {
+      refuseClobbering({savePoses}, {{vo.gen.rigPath, "the rig"}, {poses, "the pose file"}});
+      writeFilesAtomically({{savePoses, formatPoseFile(report.poses)}});
+    }
     std::cout << what;
     std::cout << formatReport(report);
     return report.pass ? 0 : 1;
@@ -62,11 +88,14 @@ struct ValidateCommand {
 void registerValidate(CLI::App& app, CliState& state) {
   auto cmd = std::make_shared<ValidateCommand>();
   CLI::App* sub = app.add_subcommand("validate", "Generate, run on lavapipe and compare with the GLM reference");
+  cmd->cmd = sub;
   cmd->args.add(*sub);
   sub->add_option("--mesh", cmd->mesh, "Procedural mesh: head (default), limb, dawn (180k vertices)")
       ->check(CLI::IsMember({"head", "limb", "dawn"}));
   sub->add_option("--seed", cmd->seed, "Seed of the random poses");
-  sub->add_option("--poses", cmd->poses, "Number of random poses")->check(CLI::Range(1, 100));
+  sub->add_option("--poses", cmd->poses, "Number of random poses (1..100), or a pose file written by --save-poses");
+  sub->add_option("--save-poses", cmd->savePoses, "Write the poses run (with drawn uniforms) to FILE, for --poses FILE");
+  sub->add_flag("--strict", cmd->strict, "Fail outputs whose semantic has no definition (unchecked)");
   CLI::Validator finiteNonNegative = finiteNumber(false);  // no nan, inf or negative times and tolerances
   sub->add_option("--time", cmd->times, "glTF rig (MODEL.glb#m/p): animation time in seconds (repeatable)")
       ->check(finiteNonNegative);

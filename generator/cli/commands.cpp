@@ -7,6 +7,10 @@
 
 namespace sg {
 
+void refuseOption(const CLI::App& cmd, const std::string& option, const std::string& why) {
+  if (cmd.count(option) > 0) throw CLI::ValidationError(option, "does not apply " + why);
+}
+
 CLI::Validator finiteNumber(bool positive) {
   return CLI::Validator(
       [positive](std::string& s) -> std::string {

@@ -30,6 +30,10 @@ struct GenerateArgs {
 // Every file `in` was loaded from (plus `extra`), named for refuseClobbering (output_files.h).
 std::vector<InputFile> inputFiles(const LoadedInputs& in, const std::vector<std::string>& extra = {});
 
+// Options that do not apply to the inputs given are usage errors, not silence: throws
+// CLI::ValidationError("--mesh does not apply ...: why") when `option` was given on `cmd`.
+void refuseOption(const CLI::App& cmd, const std::string& option, const std::string& why);
+
 // CLI11's NonNegativeNumber/PositiveNumber let "nan" and "inf" through (every comparison
 // with NaN is false); this refuses them: "must be a finite number >= 0, got 'nan'".
 CLI::Validator finiteNumber(bool positive);

@@ -13,7 +13,7 @@ int main(int argc, char** argv) {
   // glslc spells depfile flags -MD/-MF; CLI11 only has one-letter short flags.
   std::vector<std::string> args(argv, argv + argc);
   for (auto& a : args)
-    if (a == "-MD" || a == "-MF") a = "-" + a;
+    if (a == "-MD" || a == "-MF" || a == "-Werror") a = "-" + a;  // glslc spells -Werror with one dash too
   std::vector<char*> cargs;
   for (auto& a : args) cargs.push_back(a.data());
 

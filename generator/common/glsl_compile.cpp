@@ -183,6 +183,11 @@ std::vector<StageVariable> stageVariables(glslang::TProgram& prog, bool outputs)
     const glslang::TType* t = r.getType();
     if (t) {
       v.type = typeOf(*t);
+      if (t->isArray() && !t->isStruct() && t->getArraySizes()->getNumDims() == 1 && t->getOuterArraySize() > 0) {
+        glslang::TType element(*t, 0);  // the array's element type
+        v.type = typeOf(element);
+        v.arraySize = t->getOuterArraySize();
+      }
       v.typeText = t->getCompleteString();
       const auto& q = t->getQualifier();
       if (q.hasLocation()) v.location = static_cast<int>(q.layoutLocation);

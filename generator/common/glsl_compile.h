@@ -34,7 +34,8 @@ struct GlslUnit {
 // A user input or output of one stage, as reflected from the parse.
 struct StageVariable {
   std::string name;
-  std::optional<Type> type;  // none for arrays, structs and other unsupported types
+  std::optional<Type> type;  // the element type for 1-D arrays; none for structs and other unsupported types
+  int arraySize = 0;         // elements of a 1-D array, 0 = not an array
   std::string typeText;      // glslang's spelling of the type (for messages)
   int location = -1;         // -1: no layout(location)
   bool flat = false;

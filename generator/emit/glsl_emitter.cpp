@@ -77,10 +77,18 @@ class Emitter {
     uniforms += bufferDeclarations();
     std::string stores;
     for (const auto& o : out_.outputs) {
+      if (o.arraySize) {  // one semantic per element
+        for (size_t i = 0; i < o.semantics.size(); ++i) {
+          if (!stores.empty()) stores += "\n";
+          stores += t_.fill("store", {{"name", fmt::format("{}[{}]", o.name, i)},
+                                      {"value", factExpr(p_.findFact(o.semantics[i]))}});
+        }
+        continue;
+      }
       std::string value;
       if (o.semantics.size() == 1) {
         value = factExpr(p_.findFact(o.semantics[0]));
-      } else {
+      } else {  // packed vector, or a matrix filled column by column
         std::string args;
         for (const auto& s : o.semantics) args += (args.empty() ? "" : ", ") + factExpr(p_.findFact(s));
         value = t_.fill("pack", {{"type", std::string(glslName(o.type))}, {"args", args}});
@@ -215,9 +223,12 @@ class Emitter {
       o.name = v.name;
       o.location = v.location;
       o.type = v.type;
+      o.arraySize = v.arraySize;
       o.semantics = v.semantics;
       o.captureOffset = offset;
-      offset += 4u * static_cast<uint32_t>(componentCount(v.type));
+      // Transform feedback captures matrices column after column and arrays element after
+      // element, 4 bytes a component with no padding.
+      offset += 4u * static_cast<uint32_t>(componentCount(v.type) * std::max(1, v.arraySize));
       out_.outputs.push_back(o);
     }
     out_.captureStride = offset;
@@ -236,7 +247,7 @@ class Emitter {
                                  {"xfb", xfb},
                                  {"qualifier", v && v->flat ? "flat " : ""},
                                  {"type", std::string(glslName(o.type))},
-                                 {"name", o.name}}) + "\n";
+                                 {"name", o.arraySize ? fmt::format("{}[{}]", o.name, o.arraySize) : o.name}}) + "\n";
     }
     return text;
   }

@@ -51,7 +51,8 @@ struct EmittedBuffer {
 struct EmittedOutput {
   std::string name;
   int location = -1;  // -1: gl_Position
-  Type type = Type::Vec4;
+  Type type = Type::Vec4;  // the element type of an array
+  int arraySize = 0;       // 0 = not an array (one semantic per element otherwise)
   std::vector<std::string> semantics;
   uint32_t captureOffset = 0;  // byte offset in the transform-feedback record
 };

@@ -100,8 +100,9 @@ std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvM
     const auto& o = glsl.outputs[i];
     std::string sems;
     for (const auto& s : o.semantics) sems += (sems.empty() ? "" : ", ") + quote(s);
-    j += fmt::format("{}\n    {{\"name\": {}, \"location\": {}, \"type\": {}, \"semantics\": [{}]}}", i ? "," : "",
-                     quote(o.name), o.location, quote(std::string(glslName(o.type))), sems);
+    std::string array = o.arraySize ? fmt::format(", \"array_size\": {}", o.arraySize) : "";
+    j += fmt::format("{}\n    {{\"name\": {}, \"location\": {}, \"type\": {}{}, \"semantics\": [{}]}}", i ? "," : "",
+                     quote(o.name), o.location, quote(std::string(glslName(o.type))), array, sems);
   }
   j += "\n  ]\n}\n";
   return j;

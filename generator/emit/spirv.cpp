@@ -42,7 +42,7 @@ void checkLink(const GlslShader& vertex, const GlslShader& fragment) {
     if (it == outs.end())
       throw InputError(SourceLoc{fragmentFile, 0, 0},
                        fmt::format("link check: fragment input at location {} has no vertex output", loc));
-    if (it->second.type != in.type || !in.type)
+    if (it->second.type != in.type || !in.type || it->second.arraySize != in.arraySize)
       throw InputError(SourceLoc{fragmentFile, 0, 0},
                        fmt::format("link check: location {}: vertex writes {} but the fragment shader reads {}", loc,
                                    it->second.typeText, in.typeText));

@@ -7,6 +7,7 @@
 
 #include "common/glsl_compile.h"
 #include "common/yaml_util.h"
+#include "interface/suggest.h"
 #include "rules/rules.h"
 
 namespace sg {
@@ -75,13 +76,26 @@ SourceLoc findDeclaration(const std::string& src, const std::string& file, const
   return SourceLoc{file, 0, 0};
 }
 
-// The declared semantic whose name, with '.' written as '_', is the input's name
-// (world_eye_dir -> world.eye_dir; '_' inside a semantic name stays '_').
+// The declared semantic the input's name spells in this project's own style: '.' as '_'
+// (world_eye_dir), or camelCase / PascalCase words (worldEyeDir, WorldEyeDir).
 const SemanticDecl* semanticNamed(const RuleSet& rules, const std::string& inputName) {
   for (const auto& d : rules.semantics) {
-    std::string s = d.name;
-    std::replace(s.begin(), s.end(), '.', '_');
-    if (s == inputName) return &d;
+    std::string snake = d.name;
+    std::replace(snake.begin(), snake.end(), '.', '_');
+    if (snake == inputName) return &d;
+    std::string camel;
+    bool up = false;
+    for (char c : d.name) {
+      if (c == '.' || c == '_') {
+        up = true;
+        continue;
+      }
+      camel += up ? static_cast<char>(std::toupper(static_cast<unsigned char>(c))) : c;
+      up = false;
+    }
+    if (camel == inputName) return &d;
+    camel[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(camel[0])));
+    if (camel == inputName) return &d;
   }
   return nullptr;
 }
@@ -135,11 +149,15 @@ FragmentInterface reflectFragmentSource(const std::string& source, const std::st
     in.name = r.name;
     in.loc = findDeclaration(source, fileName, r.name);
     if (r.block)
-      throw InputError(in.loc, fmt::format("fragment input '{}' is in an interface block; declare plain 'in' variables", r.name));
-    if (!r.type || isMatrix(*r.type))
-      throw InputError(in.loc, fmt::format("fragment input '{}' has type '{}'; only scalars and vectors are supported",
+      throw InputError(in.loc, fmt::format("fragment input '{}' is in an interface block; declare plain 'in' variables "
+                                           "(matrices and arrays are supported)",
+                                           r.name));
+    if (!r.type)
+      throw InputError(in.loc, fmt::format("fragment input '{}' has type '{}'; supported: scalars, vectors, mat3, mat4 "
+                                           "and 1-D arrays of them",
                                            r.name, r.typeText));
     in.type = *r.type;
+    in.arraySize = r.arraySize;
     if (r.location < 0)
       throw InputError(in.loc, fmt::format("fragment input '{}' has no layout(location = N)", r.name));
     in.location = r.location;
@@ -148,15 +166,126 @@ FragmentInterface reflectFragmentSource(const std::string& source, const std::st
   }
   std::sort(fi.inputs.begin(), fi.inputs.end(),
             [](const FragmentInput& a, const FragmentInput& b) { return a.location < b.location; });
-  for (size_t i = 1; i < fi.inputs.size(); ++i)
-    if (fi.inputs[i].location == fi.inputs[i - 1].location)
-      throw InputError(fi.inputs[i].loc, fmt::format("fragment inputs '{}' and '{}' share location {}",
-                                                     fi.inputs[i - 1].name, fi.inputs[i].name, fi.inputs[i].location));
+  for (size_t i = 1; i < fi.inputs.size(); ++i) {
+    const FragmentInput& a = fi.inputs[i - 1];
+    const FragmentInput& b = fi.inputs[i];
+    int aEnd = a.location + locationCount(a.type, a.arraySize);
+    if (b.location == a.location)
+      throw InputError(b.loc, fmt::format("fragment inputs '{}' and '{}' share location {}", a.name, b.name, b.location));
+    if (b.location < aEnd)  // a mat3 takes three locations, an array one per element (per column)
+      throw InputError(b.loc, fmt::format("fragment input '{}' at location {} overlaps '{}' ({}{} takes locations {}..{})",
+                                          b.name, b.location, a.name, glslName(a.type),
+                                          a.arraySize ? fmt::format("[{}]", a.arraySize) : "", a.location, aEnd - 1));
+  }
   return fi;
 }
 
-std::vector<Varying> bindVaryings(const FragmentInterface& frag, const RuleSet& rules,
-                                  const std::vector<VaryingOverride>& overrides) {
+int locationCount(Type type, int arraySize) {
+  int columns = type == Type::Mat3 ? 3 : type == Type::Mat4 ? 4 : 1;
+  return columns * std::max(1, arraySize);
+}
+
+namespace {
+
+std::string typeText(Type t, int arraySize) {
+  return arraySize ? fmt::format("{}[{}]", glslName(t), arraySize) : std::string(glslName(t));
+}
+
+// "did you mean ...?" for an input no mapping names, with what the conventions say.
+std::string unmappedMessage(const FragmentInput& in, const RuleSet& rules, const ConventionMatch& conv) {
+  std::string msg = fmt::format("fragment input '{}' does not name a semantic; map it in the rules' 'varyings:' or "
+                                "with --map {}=<semantic>",
+                                in.name, in.name);
+  std::vector<std::string> close = closestSemantics(rules, in.name, in.type);
+  if (!close.empty()) {
+    std::string list;
+    for (size_t i = 0; i < close.size(); ++i) {
+      const SemanticDecl* d = rules.findSemantic(close[i]);
+      list += fmt::format("{}{} ({})", i == 0 ? "" : i + 1 == close.size() ? " or " : ", ", close[i], glslName(d->type));
+    }
+    msg += fmt::format("; did you mean {}?", list);
+  }
+  for (const auto& n : conv.notes) msg += "; " + n;
+  return msg;
+}
+
+// One input's mapping and its checks. Throws InputError.
+Varying bindOne(const FragmentInput& in, const RuleSet& rules, const std::vector<VaryingOverride>& overrides,
+                const std::vector<std::string>& conventions) {
+  if (const char* why = reservedNameUse(in.name))
+    throw InputError(in.loc, fmt::format("fragment input '{}' {}; rename it", in.name, why));
+  Varying v;
+  v.name = in.name;
+  v.type = in.type;
+  v.arraySize = in.arraySize;
+  v.location = in.location;
+  v.flat = in.flat;
+  v.loc = in.loc;
+  SourceLoc mapLoc = in.loc;
+  std::string how;
+  auto ov = std::find_if(overrides.begin(), overrides.end(), [&](const VaryingOverride& o) { return o.name == in.name; });
+  if (ov != overrides.end()) {
+    v.semantics = ov->semantics;
+    how = "the --map option";
+    v.via = "--map";
+  } else if (const VaryingMapping* m = rules.findVarying(in.name)) {
+    v.semantics = m->semantics;
+    mapLoc = m->loc;
+    how = fmt::format("the mapping at {}:{}", m->loc.file, m->loc.line);
+    v.via = fmt::format("varyings: at {}:{}", m->loc.file, m->loc.line);
+  } else if (const SemanticDecl* d = in.arraySize ? nullptr : semanticNamed(rules, in.name)) {
+    v.semantics = {d->name};
+    how = "its name";
+    v.via = "its name";
+  } else {
+    ConventionMatch conv = matchConvention(rules, in.name, in.type, in.arraySize, conventions);
+    if (conv.semantics.empty()) throw InputError(in.loc, unmappedMessage(in, rules, conv));
+    v.semantics = conv.semantics;
+    mapLoc = conv.loc;
+    how = fmt::format("naming convention '{}' at {}:{}", conv.convention, conv.loc.file, conv.loc.line);
+    v.via = fmt::format("naming convention '{}'", conv.convention);
+  }
+  int comps = 0;
+  for (const auto& s : v.semantics) {
+    const SemanticDecl* d = rules.findSemantic(s);
+    if (!d) throw InputError(mapLoc, fmt::format("fragment input '{}' maps to unknown semantic '{}' (via {})", in.name, s, how));
+    if (isMatrix(d->type) || d->arraySize || !d->arrayParam.empty())
+      throw InputError(mapLoc, fmt::format("semantic '{}' ({}) cannot be passed as a varying", s, glslName(d->type)));
+    if (scalarKind(d->type) != scalarKind(in.type))
+      throw InputError(in.loc, fmt::format("fragment input '{}' is {} but semantic '{}' is {}", in.name,
+                                           typeText(in.type, in.arraySize), s, glslName(d->type)));
+    if (in.arraySize && componentCount(d->type) != componentCount(in.type))
+      throw InputError(in.loc, fmt::format("fragment input '{}' is {}: each element takes one {} semantic, but '{}' is {}",
+                                           in.name, typeText(in.type, in.arraySize), glslName(in.type), s,
+                                           glslName(d->type)));
+    comps += componentCount(d->type);
+  }
+  if (in.arraySize) {
+    if (static_cast<int>(v.semantics.size()) != in.arraySize)
+      throw InputError(in.loc, fmt::format("fragment input '{}' is {}: map it to {} semantics, one per element (got {}, "
+                                           "via {})",
+                                           in.name, typeText(in.type, in.arraySize), in.arraySize, v.semantics.size(), how));
+  } else if (comps != componentCount(in.type)) {
+    if (v.semantics.size() == 1)
+      throw InputError(in.loc, fmt::format("fragment input '{}' is {} but semantic '{}' is {}", in.name,
+                                           glslName(in.type), v.semantics[0],
+                                           glslName(rules.findSemantic(v.semantics[0])->type)));
+    throw InputError(in.loc, fmt::format("fragment input '{}' is {} ({} components{}) but its packed semantics have {} "
+                                         "components (via {})",
+                                         in.name, glslName(in.type), componentCount(in.type),
+                                         isMatrix(in.type) ? ", filled column by column" : "", comps, how));
+  }
+  if (scalarKind(in.type) != ScalarKind::Float && !in.flat)
+    throw InputError(in.loc, fmt::format("integer fragment input '{}' must be 'flat'", in.name));
+  return v;
+}
+
+}  // namespace
+
+VaryingBinding bindVaryingsCollect(const FragmentInterface& frag, const RuleSet& rules,
+                                   const std::vector<VaryingOverride>& overrides,
+                                   const std::vector<std::string>& conventions) {
+  checkConventionNames(rules, conventions);
   for (const auto& o : overrides) {
     bool found = std::any_of(frag.inputs.begin(), frag.inputs.end(), [&](const FragmentInput& in) { return in.name == o.name; });
     if (!found) {
@@ -167,66 +296,33 @@ std::vector<Varying> bindVaryings(const FragmentInterface& frag, const RuleSet& 
                                    o.name, names.empty() ? "none" : names));
     }
   }
-  std::vector<Varying> out;
+  VaryingBinding out;
   Varying pos;
   pos.name = "gl_Position";
   pos.type = Type::Vec4;
   pos.semantics = {"clip.position"};
   pos.loc = SourceLoc{frag.file, 0, 0};
-  out.push_back(pos);
-
+  out.varyings.push_back(pos);
   for (const auto& in : frag.inputs) {
-    if (const char* why = reservedNameUse(in.name))
-      throw InputError(in.loc, fmt::format("fragment input '{}' {}; rename it", in.name, why));
-    Varying v;
-    v.name = in.name;
-    v.type = in.type;
-    v.location = in.location;
-    v.flat = in.flat;
-    v.loc = in.loc;
-    SourceLoc mapLoc = in.loc;
-    std::string how;
-    auto ov = std::find_if(overrides.begin(), overrides.end(), [&](const VaryingOverride& o) { return o.name == in.name; });
-    if (ov != overrides.end()) {
-      v.semantics = ov->semantics;
-      how = "the --map option";
-    } else if (const VaryingMapping* m = rules.findVarying(in.name)) {
-      v.semantics = m->semantics;
-      mapLoc = m->loc;
-      how = fmt::format("the mapping at {}:{}", m->loc.file, m->loc.line);
-    } else if (const SemanticDecl* d = semanticNamed(rules, in.name)) {
-      v.semantics = {d->name};
-      how = "its name";
-    } else {
-      throw InputError(in.loc, fmt::format("fragment input '{}' does not name a semantic; map it in the rules' "
-                                           "'varyings:' or with --map {}=<semantic>",
-                                           in.name, in.name));
+    try {
+      out.varyings.push_back(bindOne(in, rules, overrides, conventions));
+    } catch (const InputError& e) {
+      out.errors.push_back(e.diagnostic());
     }
-    int comps = 0;
-    for (const auto& s : v.semantics) {
-      const SemanticDecl* d = rules.findSemantic(s);
-      if (!d) throw InputError(mapLoc, fmt::format("fragment input '{}' maps to unknown semantic '{}' (via {})", in.name, s, how));
-      if (isMatrix(d->type) || d->arraySize || !d->arrayParam.empty())
-        throw InputError(mapLoc, fmt::format("semantic '{}' ({}) cannot be passed as a varying", s, glslName(d->type)));
-      if (scalarKind(d->type) != scalarKind(in.type))
-        throw InputError(in.loc, fmt::format("fragment input '{}' is {} but semantic '{}' is {}", in.name,
-                                             glslName(in.type), s, glslName(d->type)));
-      comps += componentCount(d->type);
-    }
-    if (comps != componentCount(in.type)) {
-      if (v.semantics.size() == 1)
-        throw InputError(in.loc, fmt::format("fragment input '{}' is {} but semantic '{}' is {}", in.name,
-                                             glslName(in.type), v.semantics[0],
-                                             glslName(rules.findSemantic(v.semantics[0])->type)));
-      throw InputError(in.loc, fmt::format("fragment input '{}' is {} ({} components) but its packed semantics have {} "
-                                           "components (via {})",
-                                           in.name, glslName(in.type), componentCount(in.type), comps, how));
-    }
-    if (scalarKind(in.type) != ScalarKind::Float && !in.flat)
-      throw InputError(in.loc, fmt::format("integer fragment input '{}' must be 'flat'", in.name));
-    out.push_back(std::move(v));
   }
   return out;
+}
+
+std::vector<Varying> bindVaryings(const FragmentInterface& frag, const RuleSet& rules,
+                                  const std::vector<VaryingOverride>& overrides,
+                                  const std::vector<std::string>& conventions) {
+  VaryingBinding b = bindVaryingsCollect(frag, rules, overrides, conventions);
+  if (!b.errors.empty()) {
+    InputError e(b.errors[0]);
+    e.related.assign(b.errors.begin() + 1, b.errors.end());
+    throw e;
+  }
+  return std::move(b.varyings);
 }
 
 }  // namespace sg

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <tuple>
 
 #include "analysis/cost.h"
 #include "analysis/explain.h"
@@ -27,15 +28,55 @@ TemplateSet loadTemplatesStage(const std::string& dir) {
   return TemplateSet::load(dir.empty() ? defaultTemplateDir() : dir);
 }
 
+namespace {
+
+// One error per fragment input whose semantics no plan can produce, at its declaration,
+// with the smallest sets of missing rig inputs (analysis/explain.h). Empty if all are reachable.
+std::vector<Diagnostic> unreachableInputs(const LoadedInputs& in) {
+  const Problem& p = in.problem;
+  std::vector<UnreachableGoal> goals = analyzeUnreachable(p, in.rules, in.varyings);
+  std::vector<Diagnostic> out;
+  for (const auto& v : in.varyings) {
+    std::vector<UnreachableGoal> mine;
+    for (const auto& g : goals)
+      if (std::find(v.semantics.begin(), v.semantics.end(), p.facts[g.fact].name) != v.semantics.end()) mine.push_back(g);
+    if (mine.empty()) continue;
+    std::string why = formatUnreachable(p, mine);
+    if (!why.empty() && why.back() == '\n') why.pop_back();
+    SourceLoc at = v.loc.line ? v.loc : SourceLoc{in.fragment.file, 0, 0};
+    out.push_back(Diagnostic{Severity::Error, at, fmt::format("the request cannot be met for rig '{}': {}", in.rig.name, why)});
+  }
+  return out;
+}
+
+// Several located errors as one InputError, in source order (the first is the primary one).
+[[noreturn]] void throwAll(std::vector<Diagnostic> errors) {
+  std::stable_sort(errors.begin(), errors.end(), [](const Diagnostic& a, const Diagnostic& b) {
+    return std::tie(a.loc.file, a.loc.line, a.loc.col) < std::tie(b.loc.file, b.loc.line, b.loc.col);
+  });
+  InputError e(errors[0]);
+  e.related.assign(errors.begin() + 1, errors.end());
+  throw e;
+}
+
+}  // namespace
+
 LoadedInputs instantiateStage(Rig rig, RuleSet rules, FragmentInterface fragment,
-                              const std::vector<VaryingOverride>& overrides) {
+                              const std::vector<VaryingOverride>& overrides, const std::vector<std::string>& conventions) {
   LoadedInputs in;
   in.rig = std::move(rig);
   in.rules = std::move(rules);
   in.fragment = std::move(fragment);
-  in.varyings = bindVaryings(in.fragment, in.rules, overrides);
+  VaryingBinding bound = bindVaryingsCollect(in.fragment, in.rules, overrides, conventions);
+  in.varyings = std::move(bound.varyings);
   resolveAutoCosts(in.rules, in.rig);  // `cost: auto`: measured for this rig
   in.problem = buildProblem(in.rig, in.rules, in.varyings);
+  if (!bound.errors.empty()) {
+    // Every problem in one run: the unmapped inputs, and those mapped but unproducible.
+    std::vector<Diagnostic> all = std::move(bound.errors);
+    for (auto& d : unreachableInputs(in)) all.push_back(std::move(d));
+    throwAll(std::move(all));
+  }
   return in;
 }
 
@@ -97,6 +138,7 @@ Plan searchStage(const LoadedInputs& in, const SearchOptions& opts, SearchStats*
                                  "from storage buffers) stays within them",
                                  in.rig.name, broken.empty() ? "more than the limits allow" : broken));
   }
+  if (std::vector<Diagnostic> all = unreachableInputs(in); !all.empty()) throwAll(std::move(all));
   std::string why = formatUnreachable(p, analyzeUnreachable(p, in.rules, in.varyings));
   // Point at the first fragment input whose request cannot be met.
   SourceLoc at{in.fragment.file, 0, 0};
@@ -175,7 +217,8 @@ LoadedInputs loadInputs(const GenerateOptions& opts) {
   Rig rig = loadRigStage(opts.rigPath);
   if (!opts.rigParams.empty()) rig = rigWithParameters(rig, opts.rigParams, SourceLoc{});
   LoadedInputs in = instantiateStage(std::move(rig), loadRulesStage(opts.rulesPaths),
-                                     loadFragmentStage(opts.fragmentPath, opts.targetEnv), opts.overrides);
+                                     loadFragmentStage(opts.fragmentPath, opts.targetEnv), opts.overrides,
+                                     opts.conventions);
   for (const auto& b : opts.bannedRules)  // a misspelt --ban would otherwise change nothing silently
     if (std::none_of(in.rules.rules.begin(), in.rules.rules.end(), [&](const Rule& r) { return r.name == b; }))
       throw InputError(SourceLoc{}, fmt::format("--ban {}: no rule of that name in the rules files", b));

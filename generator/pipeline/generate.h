@@ -29,6 +29,7 @@ struct GenerateOptions {
   std::string fragmentPath;
   std::vector<std::string> rulesPaths;
   std::vector<VaryingOverride> overrides;
+  std::vector<std::string> conventions;  // naming conventions (--conventions): empty = all, unambiguous names
   std::map<std::string, int64_t> rigParams;  // deformer parameters set on the rig (--set)
   std::vector<std::string> bannedRules;  // force alternatives (cross-check, explain)
   std::string heuristic = "lmcut";

@@ -35,14 +35,17 @@ FragmentInterface loadFragmentStage(const std::string& path, TargetEnv env);
 TemplateSet loadTemplatesStage(const std::string& dir);  // "" = defaultTemplateDir()
 
 // ---- instantiate ------------------------------------------------------------------------
-// Varyings from the fragment inputs (overrides first), `cost: auto` measured for the rig,
-// the Problem built. The inputs are copied into the context (auto costs are per rig).
+// Varyings from the fragment inputs (overrides first, naming conventions last: see
+// bindVaryings), `cost: auto` measured for the rig, the Problem built. The inputs are copied
+// into the context (auto costs are per rig). Throws one InputError carrying every unmapped
+// input and every mapped one that cannot be produced, each at its declaration.
 LoadedInputs instantiateStage(Rig rig, RuleSet rules, FragmentInterface fragment,
-                              const std::vector<VaryingOverride>& overrides);
+                              const std::vector<VaryingOverride>& overrides,
+                              const std::vector<std::string>& conventions = {});
 
 // ---- search -----------------------------------------------------------------------------
 // The optimal plan (to force alternatives, remove rules first: withoutRules). Throws
-// InputError at the first fragment input whose request cannot be met, explaining why;
+// InputError at every fragment input whose request cannot be met, explaining why;
 // and for an unknown engine or heuristic name.
 Plan searchStage(const LoadedInputs& in, const SearchOptions& opts, SearchStats* stats = nullptr);
 

@@ -45,6 +45,9 @@ RigShape shapeOfRig(const Rig& rig, const RuleSet& rules) {
   RigShape s;
   s.name = rig.name;
   s.params = rig.params;
+  // A rig that does not declare uniform_scale may scale bones and models per axis
+  // (docs/rig-format.md): rules using mat3(M) as the normal matrix need uniform_scale.
+  s.params.emplace("uniform_scale", 0);
   evalFamilies(s, rules, true);
   for (const auto& a : rig.attributes) {
     int targets = a.perMorphTarget ? rig.morphTargets() : 1;

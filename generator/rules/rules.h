@@ -10,6 +10,7 @@
 
 #include "common/diagnostics.h"
 #include "common/types.h"
+#include "rules/definition.h"
 #include "rules/expr.h"
 
 namespace sg {
@@ -33,6 +34,16 @@ struct SemanticDecl {
   std::vector<std::string> bufferOf;
   std::string doc;
   SourceLoc loc;
+  // What the value is (docs/validation.md, "Definitions"): a formula over other semantics,
+  // evaluated by validate's reference interpreter. Null = no definition (outputs carrying it
+  // are reported unchecked).
+  DefNodeP definition;
+  std::string definitionText;
+  // Uniforms: how validation draws values (docs/validation.md, "Poses"): "" (by the
+  // standard pose, or unknown), rigid, affine, projection, unit, point, weight, int.
+  std::string kind;
+  double rangeLo = 0, rangeHi = 1;  // weight / int / scalar kinds
+  SourceLoc kindLoc;
 };
 
 // A reference to a semantic in `needs:`: "world.position", "morph.position[*]", "skin.joints[k/4]".
@@ -68,14 +79,40 @@ struct VaryingMapping {
   SourceLoc loc;
 };
 
+// A naming convention (`conventions:`, rules/conventions.yaml): the varying names one
+// ecosystem (three.js, the glTF Sample Viewer, Filament...) gives to semantics.
+struct ConventionEntry {
+  std::string name;  // "vNormal"
+  std::string type;  // "" = any input type, else the GLSL type this meaning applies to ("vec4")
+  std::vector<std::string> semantics;  // one, or several packed in component order
+  SourceLoc loc;
+};
+struct NamingConvention {
+  std::string name;  // "threejs"
+  std::string doc;
+  std::vector<ConventionEntry> entries;
+  SourceLoc loc;
+};
+
+// A rule a later file replaced (`override: true`) or removed (`disable:`).
+struct RuleChange {
+  std::string rule;
+  bool disabled = false;  // false: replaced
+  SourceLoc loc;          // the overriding rule's name, or the `disable:` entry
+  SourceLoc original;     // the rule it replaced or removed
+};
+
 struct RuleSet {
   std::vector<std::string> files;  // every file read (includes too), in load order
   std::vector<SemanticDecl> semantics;
   std::vector<Rule> rules;
   std::vector<VaryingMapping> varyings;
+  std::vector<NamingConvention> conventions;
+  std::vector<RuleChange> changes;  // overrides and disables, in load order
 
   const SemanticDecl* findSemantic(const std::string& name) const;
   const VaryingMapping* findVarying(const std::string& name) const;
+  const NamingConvention* findConvention(const std::string& name) const;
 };
 
 // Loads rule files (and their `include:`s, relative to the including file) into one set.

@@ -1,11 +1,14 @@
 // Loads rules YAML (format: docs/rules-format.md) with located diagnostics.
 #include <fmt/format.h>
 
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <set>
 #include <sstream>
 
 #include "common/yaml_util.h"
+#include "rules/loader_parts.h"
 #include "rules/rules.h"
 
 namespace sg {
@@ -64,6 +67,37 @@ SemanticRef parseRef(const YamlCtx& y, const YAML::Node& n) {
   return r;
 }
 
+double finiteNumber(const YamlCtx& y, const YAML::Node& n, const char* what) {
+  std::string s = y.scalar(n, what);
+  char* end = nullptr;
+  double v = std::strtod(s.c_str(), &end);
+  if (s.empty() || end != s.c_str() + s.size() || !std::isfinite(v)) y.fail(n, fmt::format("{} must be a finite number, got '{}'", what, s));
+  return v;
+}
+
+// The `definition:`, `kind:` and `range:` keys of a semantic (rules/definition.h).
+void loadSemanticDefinition(SemanticDecl& d, const YamlCtx& y, const YAML::Node& body) {
+  if (body["definition"]) {
+    d.definitionText = y.scalar(body["definition"], "'definition'");
+    d.definition = parseDefinition(d.definitionText, exprLoc(body["definition"], y.file));
+  }
+  if (body["kind"]) {
+    d.kind = y.scalar(body["kind"], "'kind'");
+    d.kindLoc = locOf(body["kind"], y.file);
+    static const std::set<std::string> kinds = {"rigid", "affine", "projection", "unit", "point", "weight", "int"};
+    if (!kinds.count(d.kind))
+      y.fail(body["kind"], fmt::format("unknown kind '{}' (rigid, affine, projection, unit, point, weight, int)", d.kind));
+  }
+  if (body["range"]) {
+    YAML::Node r = body["range"];
+    y.expectSeq(r, "'range' ([low, high])");
+    if (r.size() != 2) y.fail(r, "'range' is [low, high]");
+    d.rangeLo = finiteNumber(y, r[0], "the low end of 'range'");
+    d.rangeHi = finiteNumber(y, r[1], "the high end of 'range'");
+    if (!(d.rangeLo <= d.rangeHi)) y.fail(r, "'range' is [low, high] with low <= high");
+  }
+}
+
 void loadSemantics(RuleSet& set, const YamlCtx& y, const YAML::Node& sems) {
   y.expectMap(sems, "'semantics'");
   for (auto it = sems.begin(); it != sems.end(); ++it) {
@@ -83,7 +117,7 @@ void loadSemantics(RuleSet& set, const YamlCtx& y, const YAML::Node& sems) {
       typeName = body.Scalar();
     } else {
       y.expectMap(body, "a semantic declaration");
-      y.checkKeys(body, {"type", "count", "array", "doc", "buffer_of"});
+      y.checkKeys(body, {"type", "count", "array", "doc", "definition", "kind", "range", "buffer_of"});
       if (!body["type"]) y.fail(body, fmt::format("semantic '{}' has no 'type'", d.name));
       typeName = y.scalar(body["type"], "'type'");
       if (body["count"]) d.count = Expr::parse(y.scalar(body["count"], "'count'"), exprLoc(body["count"], y.file));
@@ -97,6 +131,7 @@ void loadSemantics(RuleSet& set, const YamlCtx& y, const YAML::Node& sems) {
         }
         if (d.bufferOf.empty()) y.fail(b, fmt::format("semantic '{}': 'buffer_of' lists no semantic", d.name));
       }
+      loadSemanticDefinition(d, y, body);
     }
     auto t = parseType(typeName);
     if (!t) y.fail(body.IsMap() ? body["type"] : body, fmt::format("unknown type '{}' for semantic '{}'", typeName, d.name));
@@ -165,17 +200,21 @@ std::vector<TemplateLine> snippetLines(const YamlCtx& y, const YAML::Node& n, co
 
 void loadRule(RuleSet& set, const YamlCtx& y, const YAML::Node& r, const std::vector<std::string>& raw) {
   y.expectMap(r, "a rule");
-  y.checkKeys(r, {"name", "produces", "needs", "when", "cost", "glsl", "doc"});
+  y.checkKeys(r, {"name", "produces", "needs", "when", "cost", "glsl", "doc", "override"});
   Rule rule;
   if (!r["name"]) y.fail(r, "rule has no 'name'");
   rule.name = y.scalar(r["name"], "'name'");
   rule.loc = locOf(r["name"], y.file);
   if (!validRuleName(rule.name)) y.fail(r["name"], fmt::format("'{}' is not a valid rule name", rule.name));
-  for (const auto& other : set.rules)
-    if (other.name == rule.name) {
+  bool overrides = r["override"] && y.boolean(r["override"], "'override'");
+  std::optional<size_t> existing;
+  for (size_t i = 0; i < set.rules.size(); ++i)
+    if (set.rules[i].name == rule.name) {
+      const Rule& other = set.rules[i];
       if (other.loc.file == rule.loc.file && other.loc.line == rule.loc.line) return;  // same file included twice
-      y.fail(r["name"], fmt::format("rule '{}' is defined twice (first at {}:{})", rule.name, other.loc.file, other.loc.line));
+      existing = i;
     }
+  if (overrides && !existing) failNothingToOverride(set, y, r["name"], rule.name);
   if (!r["produces"]) y.fail(r, fmt::format("rule '{}' has no 'produces'", rule.name));
   rule.produces = y.scalar(r["produces"], "'produces'");
   rule.producesLoc = locOf(r["produces"], y.file);
@@ -197,17 +236,32 @@ void loadRule(RuleSet& set, const YamlCtx& y, const YAML::Node& r, const std::ve
   if (!r["glsl"]) y.fail(r, fmt::format("rule '{}' has no 'glsl' snippet", rule.name));
   rule.glsl = snippetLines(y, r["glsl"], raw);
   if (r["doc"]) rule.doc = y.scalar(r["doc"], "'doc'");
-  set.rules.push_back(std::move(rule));
+  if (existing) replaceRule(set, y, r["name"], *existing, std::move(rule), overrides);
+  else set.rules.push_back(std::move(rule));
 }
 
 void loadFile(RuleSet& set, const std::string& path, std::vector<std::string>& stack);
+
+// The same file under another spelling (relative from two places, or absolute) is the
+// same file: loading it twice would declare everything twice.
+bool alreadyLoaded(const RuleSet& set, const std::string& path) {
+  if (std::find(set.files.begin(), set.files.end(), path) != set.files.end()) return true;
+  std::error_code ec;
+  auto canon = std::filesystem::weakly_canonical(path, ec);
+  if (ec) return false;
+  for (const auto& f : set.files) {
+    std::error_code ec2;
+    if (std::filesystem::weakly_canonical(f, ec2) == canon && !ec2) return true;
+  }
+  return false;
+}
 
 void loadParsed(RuleSet& set, const std::string& text, const std::string& path, std::vector<std::string>& stack) {
   YamlCtx y{path};
   YAML::Node root = parseYaml(text, path);
   if (!root.IsDefined() || root.IsNull()) throw InputError(SourceLoc{path, 1, 1}, "empty rules file");
   y.expectMap(root, "a rules file");
-  y.checkKeys(root, {"include", "semantics", "varyings", "rules", "doc"});
+  y.checkKeys(root, {"include", "semantics", "varyings", "conventions", "disable", "rules", "doc"});
   set.files.push_back(path);
   std::vector<std::string> raw = splitLines(text);
   if (auto inc = root["include"]) {
@@ -218,7 +272,7 @@ void loadParsed(RuleSet& set, const std::string& text, const std::string& path, 
       std::string incPath = p.lexically_normal().string();
       if (std::find(stack.begin(), stack.end(), incPath) != stack.end())
         y.fail(i, fmt::format("include cycle: '{}' includes itself", incPath));
-      if (std::find(set.files.begin(), set.files.end(), incPath) != set.files.end()) continue;  // already loaded
+      if (alreadyLoaded(set, incPath)) continue;
       std::error_code ec;
       if (!std::filesystem::exists(p, ec)) y.fail(i, fmt::format("included file '{}' does not exist", incPath));
       if (stack.size() >= kMaxIncludeDepth) y.fail(i, fmt::format("includes nest deeper than {} files", kMaxIncludeDepth));
@@ -233,6 +287,8 @@ void loadParsed(RuleSet& set, const std::string& text, const std::string& path, 
   }
   if (auto s = root["semantics"]) loadSemantics(set, y, s);
   if (auto v = root["varyings"]) loadVaryings(set, y, v);
+  if (auto c = root["conventions"]) loadConventions(set, y, c);
+  if (auto d = root["disable"]) applyDisable(set, y, d);
   if (auto rs = root["rules"]) {
     y.expectSeq(rs, "'rules'");
     for (const auto& r : rs) {
@@ -264,7 +320,7 @@ const VaryingMapping* RuleSet::findVarying(const std::string& name) const {
 
 void loadRulesInto(RuleSet& set, const std::string& path) {
   std::string norm = std::filesystem::path(path).lexically_normal().string();
-  if (std::find(set.files.begin(), set.files.end(), norm) != set.files.end()) return;
+  if (alreadyLoaded(set, norm)) return;
   std::vector<std::string> stack;
   loadFile(set, norm, stack);
 }
@@ -277,6 +333,7 @@ void loadRulesText(RuleSet& set, const std::string& text, const std::string& fil
 RuleSet loadRules(const std::vector<std::string>& paths) {
   RuleSet set;
   for (const auto& p : paths) loadRulesInto(set, p);
+  checkDefinitions(set);
   return set;
 }
 

@@ -251,6 +251,7 @@ ValidationScene gltfScene(const GltfImport& model, const GltfSceneOptions& opts,
   s.shape.influences = static_cast<int>(model.rig.param("influences"));
   s.shape.morphTargets = model.rig.morphTargets();
   s.shape.hasModelMatrix = d.skin < 0;
+  s.shape.uniformScale = model.rig.param("uniform_scale") != 0;
   GltfSceneInfo inf;
   if (anim >= 0) {
     const GltfAnimation& a = d.animations[static_cast<size_t>(anim)];

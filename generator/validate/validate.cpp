@@ -11,7 +11,8 @@
 #include <set>
 
 #include "runtime/procedural.h"
-#include "runtime/reference.h"
+#include "validate/interpreter.h"
+#include "validate/poses.h"
 
 namespace sg {
 namespace {
@@ -124,24 +125,20 @@ void putMat4(std::vector<uint8_t>& block, uint32_t offset, const glm::mat4& m, u
 }
 
 // The sparse-morph protocol (docs/buffers.md): the targets with a non-zero weight, in
-// increasing order, and their count.
-void putActiveTargets(std::vector<uint8_t>& block, const UniformLayout& l, const RigUniform& ru, const rt::Pose& pose) {
-  std::vector<uint32_t> active;
+// increasing order, and their count, for rigs that read them.
+void addActiveTargets(const Rig& rig, const rt::Pose& pose, UniformValues& values) {
+  std::vector<double> active;
   for (size_t i = 0; i < pose.morphWeights.size(); ++i)
-    if (pose.morphWeights[i] != 0.0f) active.push_back(static_cast<uint32_t>(i));
-  if (ru.semantic == "morph.active_count") {
-    uint32_t n = static_cast<uint32_t>(active.size());
-    if (l.offset + 4 > block.size()) throw std::logic_error("uniform write past the block");
-    std::memcpy(block.data() + l.offset, &n, 4);
-    return;
-  }
-  if (active.size() > static_cast<size_t>(ru.arraySize))
-    throw InputError(ru.loc, fmt::format("the pose has {} targets with a non-zero weight; the active-target list "
-                                         "holds {}", active.size(), ru.arraySize));
-  for (size_t i = 0; i < active.size(); ++i) {
-    uint32_t off = l.offset + static_cast<uint32_t>(i) * l.arrayStride;
-    if (off + 4 > block.size()) throw std::logic_error("uniform write past the block");
-    std::memcpy(block.data() + off, &active[i], 4);
+    if (pose.morphWeights[i] != 0.0f) active.push_back(static_cast<double>(i));
+  for (const auto& u : rig.uniforms) {
+    if (u.semantic == "morph.active_count") values[u.semantic] = {static_cast<double>(active.size())};
+    if (u.semantic != "morph.active_targets") continue;
+    if (active.size() > static_cast<size_t>(u.arraySize))
+      throw InputError(u.loc, fmt::format("the pose has {} targets with a non-zero weight; the active-target list "
+                                          "holds {}", active.size(), u.arraySize));
+    std::vector<double> list = active;
+    list.resize(static_cast<size_t>(u.arraySize), 0.0);
+    values[u.semantic] = std::move(list);
   }
 }
 
@@ -197,41 +194,62 @@ std::vector<rt::StorageBufferData> buildStorageBuffers(const Problem& p, const E
 
 namespace {
 
+// The uniform block of one pose: every uniform of the rig from its semantic's values
+// (UniformValues: flat column-major, arrays element after element), laid out as reflected.
 std::vector<uint8_t> buildUniforms(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spv,
-                                   const rt::Pose& pose) {
+                                   const UniformValues& values) {
   std::vector<uint8_t> block(spv.uniformBlockSize, 0);
   for (const auto& u : glsl.uniforms) {
     const RigUniform& ru = rig.uniforms[u.uniform];
     auto layout = std::find_if(spv.uniforms.begin(), spv.uniforms.end(), [&](const UniformLayout& l) { return l.name == u.name; });
     if (layout == spv.uniforms.end()) throw std::logic_error("no reflected layout for uniform " + u.name);
     const UniformLayout& l = *layout;
-    const std::string& s = ru.semantic;
-    uint32_t ms = l.matrixStride ? l.matrixStride : 16;
-    if (s == "skin.bones") {
-      if (pose.bones.size() < static_cast<size_t>(ru.arraySize))
-        throw InputError(ru.loc, fmt::format("the pose has {} bones, the rig's palette {}", pose.bones.size(), ru.arraySize));
-      for (int i = 0; i < ru.arraySize; ++i) putMat4(block, l.offset + static_cast<uint32_t>(i) * l.arrayStride, pose.bones[i], ms);
-    } else if (s == "morph.weights") {
-      for (int i = 0; i < ru.arraySize; ++i) {
-        float w = i < static_cast<int>(pose.morphWeights.size()) ? pose.morphWeights[i] : 0.0f;
-        putFloats(block, l.offset + static_cast<uint32_t>(i) * l.arrayStride, &w, 1);
-      }
-    } else if (s == "morph.active_targets" || s == "morph.active_count") {
-      putActiveTargets(block, l, ru, pose);
-    } else if (s == "camera.position") {
-      putFloats(block, l.offset, &pose.cameraPosition[0], 3);
-    } else {
-      glm::mat4 m;
-      if (s == "camera.view") m = pose.view;
-      else if (s == "camera.projection") m = pose.projection;
-      else if (s == "camera.view_projection") m = pose.viewProjection();
-      else if (s == "model.matrix") m = pose.model;
-      else if (s == "dapple.matrix") m = pose.dapple;
-      else throw InputError(ru.loc, fmt::format("validation has no value for uniform semantic '{}'", s));
-      putMat4(block, l.offset, m, ms);
-    }
+    auto v = values.find(ru.semantic);
+    if (v == values.end())
+      throw InputError(ru.loc, fmt::format("validation has no value for uniform semantic '{}'", ru.semantic));
+    const int comps = componentCount(ru.type);
+    const int elements = std::max(1, ru.arraySize);
+    if (v->second.size() < static_cast<size_t>(elements * comps))
+      throw InputError(ru.loc, fmt::format("the pose has {} values for uniform '{}' ({}), the rig needs {}", v->second.size(),
+                                           ru.name, ru.semantic, elements * comps));
+    const int cols = ru.type == Type::Mat3 ? 3 : ru.type == Type::Mat4 ? 4 : 1;
+    const int rows = comps / cols;
+    const uint32_t colStride = l.matrixStride ? l.matrixStride : 16;
+    for (int e = 0; e < elements; ++e)
+      for (int c = 0; c < cols; ++c)
+        for (int r = 0; r < rows; ++r) {
+          double x = v->second[static_cast<size_t>(e * comps + c * rows + r)];
+          uint32_t off = l.offset + static_cast<uint32_t>(e) * l.arrayStride + static_cast<uint32_t>(c) * colStride +
+                         static_cast<uint32_t>(r) * 4;
+          if (off + 4 > block.size()) throw std::logic_error("uniform write past the block");
+          if (scalarKind(ru.type) == ScalarKind::Float) {
+            float f = static_cast<float>(x);
+            std::memcpy(block.data() + off, &f, 4);
+          } else {
+            int32_t i = static_cast<int32_t>(x);
+            std::memcpy(block.data() + off, &i, 4);
+          }
+        }
   }
   return block;
+}
+
+// Which side produced a NaN or infinity, where, and the provided values it was computed from.
+std::string nonFiniteReport(Interpreter& reference, const EmittedOutput& o, size_t v, int c, double gpu, double ref) {
+  bool g = !std::isfinite(gpu), r = !std::isfinite(ref);
+  std::string side = g && r ? "GPU and reference" : g ? "GPU" : "reference";
+  auto show = [](double x) { return std::isnan(x) ? std::string("nan") : fmt::format("{}", x); };  // no "-nan"
+  std::string s = fmt::format("{} gives {} at vertex {}, output {} component {} (GPU {}, reference {})", side,
+                              show(g ? gpu : ref), v, o.name, c, show(gpu), show(ref));
+  for (const auto& sem : o.semantics) {
+    try {
+      auto inputs = reference.inputsAt(sem, v);
+      s += fmt::format("\n      inputs of {}:", sem);
+      for (const auto& in : inputs) s += "\n        " + in;
+    } catch (const std::exception&) {
+    }
+  }
+  return s;
 }
 
 }  // namespace
@@ -275,7 +293,10 @@ ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_
   s.shape = rt::rigShapeFor(mo);
   for (const auto& u : rig.uniforms)
     if (u.semantic == "model.matrix") s.shape.hasModelMatrix = true;
-  for (int i = 0; i < poses; ++i) s.poses.push_back(rt::makeRandomPose(s.shape, seed + static_cast<uint32_t>(i)));
+  s.shape.uniformScale = rig.param("uniform_scale") != 0;
+  // Hostile by default: non-uniform scale unless the rig declares it never scales so.
+  const rt::PoseOptions po = rt::hostilePoseOptions(rig.param("uniform_scale") != 0);
+  for (int i = 0; i < poses; ++i) s.poses.push_back(rt::makeRandomPose(s.shape, seed + static_cast<uint32_t>(i), po));
   limitActiveTargets(rig, s.poses, seed);
   return s;
 }
@@ -290,11 +311,14 @@ Validator::Validator(const ValidateOptions& opts) : opts_(opts) {
 Validator::~Validator() = default;
 
 RunReport Validator::runOne(const GenerateResult& r, const ValidationScene& scene, const std::string& label) {
-  return runQuantized(r, quantizedMesh(r.in.rig, scene.mesh), scene, label);
+  std::vector<rt::Pose> poses = scene.poses;
+  drawDeclaredUniforms(poses, r.in.rig, r.in.rules);
+  return runQuantized(r, quantizedMesh(r.in.rig, scene.mesh), scene, poses, label);
 }
 
 RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh, const ValidationScene& scene,
-                                  const std::string& label) {
+                                  const std::vector<rt::Pose>& poses, const std::string& label) {
+  (void)scene;
   RunReport rep;
   rep.label = label;
   rep.planCost = r.plan.cost;
@@ -318,8 +342,27 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
   }
   // Messages since the last run, so those of the harness setup (instance, device) count too.
   size_t before = reportedMessages_;
-  for (const rt::Pose& pose : scene.poses) {
-    req.uniformData = buildUniforms(rig, r.glsl, r.spirv, pose);
+  const RigShape shape = shapeOfRig(rig, r.in.rules);
+  const RuleSet& rules = r.in.rules;
+  for (const rt::Pose& pose : poses) {
+    // Uniforms: the pose's values, then those defined by a formula over them (a normal
+    // matrix), rounded to float as the GPU gets them.
+    UniformValues uniforms = poseUniforms(rig, pose);
+    for (const auto& u : rig.uniforms) {
+      const SemanticDecl* d = rules.findSemantic(u.semantic);
+      if (uniforms.count(u.semantic) || !d || !d->definition) continue;
+      Interpreter ui(rules, shape, mesh, uniforms);
+      std::vector<double> v;
+      try {
+        v = ui.evaluateUniform(u.semantic);
+      } catch (const std::exception& e) {
+        throw InputError(u.loc, fmt::format("cannot compute uniform '{}' ({}) from its definition: {}", u.name, u.semantic, e.what()));
+      }
+      for (double& x : v) x = static_cast<float>(x);
+      uniforms[u.semantic] = std::move(v);
+    }
+    addActiveTargets(rig, pose, uniforms);
+    req.uniformData = buildUniforms(rig, r.glsl, r.spirv, uniforms);
     req.storageBuffers = perVertexBuffers;
     for (auto& sb : buildStorageBuffers(r.in.problem, r.glsl, mesh, pose, false)) req.storageBuffers.push_back(std::move(sb));
     std::sort(req.storageBuffers.begin(), req.storageBuffers.end(),
@@ -329,30 +372,45 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
     rep.timings.uploadMs += res.timings.uploadMs;
     rep.timings.runMs += res.timings.runMs;
     rep.timings.readbackMs += res.timings.readbackMs;
-    rt::ReferenceEvaluator reference(mesh, pose, scene.shape);  // shares intermediates across outputs
+    Interpreter reference(rules, shape, mesh, uniforms);  // shares intermediates across outputs
     for (size_t oi = 0; oi < r.glsl.outputs.size(); ++oi) {
       const EmittedOutput& o = r.glsl.outputs[oi];
       OutputReport& out = rep.outputs[oi];
       // Reference of each packed semantic, laid out component after component.
       auto t0 = Clock::now();
-      std::vector<std::pair<std::vector<glm::vec4>, int>> refs;
+      std::vector<int> widths;
       for (const auto& sem : o.semantics) {
-        const SemanticDecl* d = r.in.rules.findSemantic(sem);
-        int n = d ? componentCount(d->type) : rt::referenceComponents(sem);
+        std::string why;
         try {
-          refs.emplace_back(reference.values(sem), n);
+          why = reference.uncheckedReason(sem);
+          if (why.empty()) widths.push_back(reference.components(sem));
         } catch (const std::exception& e) {
           throw InputError(SourceLoc{}, fmt::format("cannot validate output '{}': {}", o.name, e.what()));
         }
+        if (!why.empty() && !out.unchecked) {
+          out.unchecked = true;
+          out.uncheckedReason = why;
+        }
+      }
+      if (out.unchecked) {
+        rep.referenceMs += msSince(t0);
+        continue;
+      }
+      std::vector<std::vector<double>> refs;
+      try {
+        refs = reference.evaluate(o.semantics);
+      } catch (const std::exception& e) {
+        throw InputError(SourceLoc{}, fmt::format("cannot validate output '{}': {}", o.name, e.what()));
       }
       rep.referenceMs += msSince(t0);
-      int comps = componentCount(o.type);
+      // Matrices: columns in order; arrays: elements in order (both as their semantics list them).
+      int comps = componentCount(o.type) * std::max(1, o.arraySize);
       bool isFloat = scalarKind(o.type) == ScalarKind::Float;
       std::vector<double> ref(static_cast<size_t>(comps)), gpu(static_cast<size_t>(comps));
       for (size_t v = 0; v < mesh.vertexCount; ++v) {
         size_t k = 0;
-        for (const auto& [vals, n] : refs)
-          for (int c = 0; c < n; ++c) ref[k++] = vals[v][c];
+        for (size_t si = 0; si < refs.size(); ++si)
+          for (int c = 0; c < widths[si] && k < ref.size(); ++c) ref[k++] = refs[si][v * static_cast<size_t>(widths[si]) + static_cast<size_t>(c)];
         const uint8_t* rec = res.captured.data() + v * r.glsl.captureStride + o.captureOffset;
         double scale = 1.0;
         for (int c = 0; c < comps; ++c) {
@@ -365,11 +423,15 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
             std::memcpy(&u, rec + 4 * c, 4);
             gpu[static_cast<size_t>(c)] = scalarKind(o.type) == ScalarKind::Int ? static_cast<int32_t>(u) : u;
           }
-          scale = std::max(scale, std::abs(ref[static_cast<size_t>(c)]));
+          if (std::isfinite(ref[static_cast<size_t>(c)])) scale = std::max(scale, std::abs(ref[static_cast<size_t>(c)]));
         }
         for (int c = 0; c < comps; ++c) {
-          double err = std::abs(gpu[static_cast<size_t>(c)] - ref[static_cast<size_t>(c)]);
-          if (std::isnan(gpu[static_cast<size_t>(c)]) || std::isnan(ref[static_cast<size_t>(c)])) err = INFINITY;
+          const double g = gpu[static_cast<size_t>(c)], x = ref[static_cast<size_t>(c)];
+          double err = std::abs(g - x);
+          if (!std::isfinite(g) || !std::isfinite(x)) {
+            err = INFINITY;
+            if (out.nonFinite.empty()) out.nonFinite = nonFiniteReport(reference, o, v, c, g, x);
+          }
           double rel = err / scale;
           if (rel > out.maxRelError || (err > out.maxAbsError && out.maxRelError == 0)) {
             out.worstVertex = v;
@@ -386,6 +448,8 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
   rep.validationMessages.assign(msgs.begin() + static_cast<long>(before), msgs.end());
   reportedMessages_ = msgs.size();
   rep.pass = rep.validationMessages.empty();
+  for (auto& o : rep.outputs)
+    if (o.unchecked && opts_.strict) o.pass = false;
   for (const auto& o : rep.outputs) rep.pass = rep.pass && o.pass;
   return rep;
 }
@@ -404,7 +468,9 @@ ValidateReport Validator::run(const ValidationScene& scene) {
   double genMs = msSince(t0);
   // Every run shares the rig's attribute formats: quantize the mesh once.
   const rt::Mesh mesh = quantizedMesh(chosen.in.rig, scene.mesh);
-  report.runs.push_back(runQuantized(chosen, mesh, scene, "chosen plan"));
+  report.poses = scene.poses;
+  drawDeclaredUniforms(report.poses, chosen.in.rig, chosen.in.rules);
+  report.runs.push_back(runQuantized(chosen, mesh, scene, report.poses, "chosen plan"));
   report.runs.back().generateMs = genMs;
 
   if (opts_.crossCheck) {
@@ -430,7 +496,7 @@ ValidateReport Validator::run(const ValidationScene& scene) {
           continue;  // the alternative needs something this rig cannot provide
         }
         double ms = msSince(tg);
-        RunReport rr = runQuantized(r, mesh, scene, fmt::format("forced {} for {}", alt, p.facts[fact].name));
+        RunReport rr = runQuantized(r, mesh, scene, report.poses, fmt::format("forced {} for {}", alt, p.facts[fact].name));
         rr.generateMs = ms;
         if (!seenPlans.insert(rr.rules).second) continue;
         report.runs.push_back(std::move(rr));
@@ -450,8 +516,14 @@ std::string formatReport(const ValidateReport& report) {
     for (const auto& o : run.outputs) {
       std::string sems;
       for (const auto& x : o.semantics) sems += (sems.empty() ? "" : ", ") + x;
+      if (o.unchecked) {
+        s += fmt::format("  {:<4} {:<20} unchecked: {}  ({})\n", o.pass ? "--" : "FAIL", o.name,
+                         o.uncheckedReason, sems);
+        continue;
+      }
       s += fmt::format("  {:<4} {:<20} max abs {:.3e}  max rel {:.3e}  worst vertex {} [{}]  ({})\n",
                        o.pass ? "ok" : "FAIL", o.name, o.maxAbsError, o.maxRelError, o.worstVertex, o.worstComponent, sems);
+      if (!o.nonFinite.empty()) s += "       " + o.nonFinite + "\n";
     }
     for (const auto& m : run.validationMessages) s += "  validation layer: " + m + "\n";
     s += fmt::format("  time: generate {:.1f} ms, setup {:.1f} ms, upload {:.1f} ms, run {:.1f} ms, readback {:.1f} ms, "

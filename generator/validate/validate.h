@@ -28,6 +28,11 @@ struct OutputReport {
   size_t worstVertex = 0;
   int worstComponent = 0;
   bool pass = true;
+  // A semantic it carries has no definition (and the rig does not provide it): not compared.
+  bool unchecked = false;
+  std::string uncheckedReason;
+  // The first NaN or infinity seen, on which side, where, and the inputs that produced it.
+  std::string nonFinite;
 };
 
 struct RunReport {
@@ -47,6 +52,7 @@ struct ValidateReport {
   std::string device;
   bool validationLayers = false;
   std::vector<RunReport> runs;
+  std::vector<rt::Pose> poses;  // as run (declared uniforms drawn): what --save-poses writes
   bool pass = true;
 };
 
@@ -76,6 +82,7 @@ struct ValidateOptions {
   Tolerance tolerance;
   std::string device;       // "" = lavapipe
   bool validationLayers = true;
+  bool strict = false;  // an unchecked output (no definition) fails the run
 };
 
 class Validator {
@@ -91,7 +98,7 @@ class Validator {
  private:
   // runOne on a mesh already quantized to the rig's attribute formats.
   RunReport runQuantized(const GenerateResult& r, const rt::Mesh& mesh, const ValidationScene& scene,
-                         const std::string& label);
+                         const std::vector<rt::Pose>& poses, const std::string& label);
 
   ValidateOptions opts_;
   std::unique_ptr<rt::Harness> harness_;
