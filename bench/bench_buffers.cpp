@@ -95,7 +95,7 @@ void BM_Plan(benchmark::State& state, const std::string& name) {
 
 const bool registered = [] {
   for (const auto& [name, plan] : plans())
-    benchmark::RegisterBenchmark(("BM_Plan/" + name).c_str(), BM_Plan, name)->UseManualTime()->Iterations(3)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("BM_Plan/" + name).c_str(), BM_Plan, name)->UseManualTime()->Iterations(2)->Unit(benchmark::kMillisecond);
   return true;
 }();
 

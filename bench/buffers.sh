@@ -26,7 +26,7 @@ data = json.load(open(sys.argv[1]))
 ctx = data["context"]
 load = ", ".join(f"{x:.1f}" for x in ctx.get("load_avg", []))
 lines = [f"Machine: {ctx['num_cpus']} CPUs at {ctx['mhz_per_cpu']} MHz, load average at start {load}; lavapipe, "
-         "validation layer off; median of 3 runs of one 180,000-vertex draw per plan.", "",
+         "validation layer off; mean of 2 runs of one 180,000-vertex draw per plan.", "",
          "| plan | attributes | storage buffers | plan cost | SPIR-V bytes | run ms | ns / vertex | vs Dawn attributes |",
          "|---|---:|---:|---:|---:|---:|---:|---:|"]
 for b in data["benchmarks"]:
