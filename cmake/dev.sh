@@ -21,6 +21,7 @@ packages=(
   clang-14 libclang-rt-14-dev
   libglpk-dev
   libembree-dev
+  libpng-dev
 )
 missing=()
 for p in "${packages[@]}"; do

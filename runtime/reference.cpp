@@ -209,7 +209,7 @@ struct ReferenceEvaluator::State {
   }
 
   // object.tangent = normalize(t − dot(t, N)·N), t = vertex.tangent + Σ_i w_i·morph.tangent[i],
-  // N = object.normal
+  // N = object.normal; degenerate (|g|² <= 1e-6·|t|²): the orthonormal basis of N
   const std::vector<dvec3>& objectTangent() {
     if (objTangent) return *objTangent;
     const auto& base = stream("vertex.tangent");
@@ -220,7 +220,13 @@ struct ReferenceEvaluator::State {
       dvec3 t = xyz(base[v]);
       for (const auto& [w, s] : terms) t += w * xyz((*s)[v]);
       const dvec3& N = normals[v];
-      out[v] = glm::normalize(t - glm::dot(t, N) * N);
+      const dvec3 g = t - glm::dot(t, N) * N;
+      if (glm::dot(g, g) > 1e-6 * glm::dot(t, t)) {
+        out[v] = glm::normalize(g);
+      } else {  // degenerate: the tangent of the orthonormal basis of N (Duff et al. 2017)
+        const double s = N.z >= 0.0 ? 1.0 : -1.0, a = -1.0 / (s + N.z);
+        out[v] = dvec3(1.0 + s * N.x * N.x * a, s * N.x * N.y * a, -s * N.x);
+      }
     }
     objTangent = std::move(out);
     return *objTangent;

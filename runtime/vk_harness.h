@@ -74,6 +74,15 @@ class Harness {
   std::string deviceName() const;
   bool validationEnabled() const;  // whether the layer was found and enabled
 
+  // The device the harness set up, for code that draws with it (runtime/vk_render.h).
+  struct Handles {
+    VkPhysicalDevice physicalDevice;
+    VkDevice device;
+    uint32_t queueFamily;
+    VkQueue queue;
+  };
+  Handles handles() const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -100,6 +100,7 @@ class Checker {
     structural_.assign(rules_.rules.size(), false);
     for (size_t r = 0; r < rules_.rules.size(); ++r) checkRuleNames(static_cast<int>(r));
     checkVaryings();
+    checkConventions();
     checkGraph();
     bool clean = std::none_of(structural_.begin(), structural_.end(), [](bool b) { return b; }) && !varyingErrors_;
     std::vector<std::optional<int64_t>> measured(rules_.rules.size());
@@ -197,6 +198,28 @@ class Checker {
         varyingErrors_ = true;
       }
     }
+  }
+
+  // Naming-convention entries: known semantics whose sizes fill the entry's type.
+  void checkConventions() {
+    for (const auto& c : rules_.conventions)
+      for (const auto& e : c.entries) {
+        int components = 0;
+        bool known = true;
+        for (const auto& s : e.semantics) {
+          const SemanticDecl* d = rules_.findSemantic(s);
+          if (!d) {
+            error(e.loc, fmt::format("convention '{}' maps '{}' to unknown semantic '{}'{}", c.name, e.name, s, didYouMean(s)));
+            known = false;
+            continue;
+          }
+          components += componentCount(d->type);
+        }
+        std::optional<Type> t = e.type.empty() ? std::nullopt : parseType(e.type);
+        if (known && t && components != componentCount(*t))
+          error(e.loc, fmt::format("convention '{}' maps {} '{}' to {} components; a {} has {}", c.name, e.type, e.name,
+                                   components, e.type, componentCount(*t)));
+      }
   }
 
   // ---- the semantic graph: cycles, derivability, dead products ------------------------

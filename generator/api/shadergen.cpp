@@ -36,6 +36,7 @@ Result generate(const Options& options) {
     o.rulesPaths = options.rules;
     o.rigParams = options.rigParameters;
     for (const auto& [name, sems] : options.maps) o.overrides.push_back(sg::VaryingOverride{name, sems});
+    o.conventions = options.conventions;
     if (!sg::parseTargetEnv(options.targetEnv, o.targetEnv))
       throw sg::InputError(sg::SourceLoc{}, fmt::format("unknown target environment '{}' (vulkan1.0 .. vulkan1.3)",
                                                         options.targetEnv));

@@ -21,6 +21,7 @@ struct Options {
   std::vector<std::string> rules;    // rules files
   std::map<std::string, int64_t> rigParameters;  // deformer parameters to set (LODs)
   std::map<std::string, std::vector<std::string>> maps;  // fragment input -> semantics
+  std::vector<std::string> conventions;  // naming conventions (like --conventions): empty = all where they agree
   std::string targetEnv = "vulkan1.0";  // .. "vulkan1.3"
   bool optimize = false;             // spirv-opt -O
   std::string templates;             // "" = the templates installed with shadergen

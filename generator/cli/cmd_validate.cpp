@@ -60,7 +60,8 @@ struct ValidateCommand {
     } else {
       bool count = !poses.empty() && poses.find_first_not_of("0123456789") == std::string::npos && poses.size() < 4;
       int n = count ? std::stoi(poses) : 1;
-      if (count && (n < 1 || n > 100)) throw InputError(SourceLoc{}, fmt::format("--poses {}: a count is 1..100", poses));
+      if (count && (n < 1 || n > 100))  // a usage error (exit 2), like every other bad option value
+        throw CLI::ValidationError("--poses", fmt::format("{}: a count is 1..100", poses));
       scene = proceduralScene(loadRigFile(vo.gen.rigPath), mesh, seed, n);
       if (count) {
         what = fmt::format("mesh '{}' ({} vertices), {} pose(s) from seed {}\n", scene.mesh.name,

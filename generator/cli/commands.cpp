@@ -29,6 +29,7 @@ void registerCommands(CLI::App& app, CliState& state) {
   registerExplain(app, state);
   registerRig(app, state);
   registerBake(app, state);
+  registerRender(app, state);
   registerBuild(app, state);
 }
 

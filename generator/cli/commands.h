@@ -46,5 +46,6 @@ void registerExplain(CLI::App& app, CliState& state);  // cmd_explain.cpp: expla
 void registerRig(CLI::App& app, CliState& state);      // cmd_rig.cpp: rig import
 void registerBuild(CLI::App& app, CliState& state);    // cmd_build.cpp: variant manifests
 void registerBake(CLI::App& app, CliState& state);     // cmd_bake.cpp: bake occlusion
+void registerRender(CLI::App& app, CliState& state);   // cmd_render.cpp: render + bench (GPU timing)
 
 }  // namespace sg

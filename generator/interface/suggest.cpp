@@ -56,8 +56,8 @@ std::vector<std::string> nameWords(const std::string& name, bool isSemantic) {
       flush();
       continue;
     }
-    if (isUpper(c) && !cur.empty() && (isLower(cur.back()) || isDigit(cur.back()) ||
-                                       (i + 1 < s.size() && isLower(s[i + 1]))))
+    char prev = i > 0 ? s[i - 1] : '_';
+    if (isUpper(c) && !cur.empty() && (isLower(prev) || isDigit(prev) || (i + 1 < s.size() && isLower(s[i + 1]))))
       flush();  // camelCase and "TBNMatrix" boundaries
     cur += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   }

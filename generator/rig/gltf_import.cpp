@@ -321,6 +321,72 @@ bool parseSelection(const std::string& s, int& mesh, int& prim) {
   return num(s.substr(0, slash), mesh) && num(s.substr(slash + 1), prim);
 }
 
+// Is the upper 3x3 of a column-major matrix a similarity (rotation times a uniform scale)?
+// Columns of equal length and mutually orthogonal, to 1e-4 relative.
+bool isSimilarity(const double* m, int stride) {
+  double c[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int r = 0; r < 3; ++r) c[i][r] = m[i * stride + r];
+  auto dot = [&](int a, int b) { return c[a][0] * c[b][0] + c[a][1] * c[b][1] + c[a][2] * c[b][2]; };
+  double l = std::max({dot(0, 0), dot(1, 1), dot(2, 2)});
+  if (l == 0) return true;
+  const double tol = 2e-4 * l;
+  return std::abs(dot(0, 0) - dot(1, 1)) <= tol && std::abs(dot(1, 1) - dot(2, 2)) <= tol && std::abs(dot(0, 1)) <= tol &&
+         std::abs(dot(1, 2)) <= tol && std::abs(dot(0, 2)) <= tol;
+}
+
+bool uniformScale3(double x, double y, double z) {
+  double m = std::max({std::abs(x), std::abs(y), std::abs(z)});
+  return std::abs(x - y) <= 1e-4 * m && std::abs(y - z) <= 1e-4 * m;
+}
+
+// uniform_scale (docs/rig-format.md) when no node, scale animation or inverse bind matrix of
+// the model scales per axis: then mat3(M) is a valid normal matrix.
+bool modelScalesUniformly(const GltfModelData& d) {
+  for (const auto& n : d.nodes) {
+    if (n.hasMatrix ? !isSimilarity(n.matrix.data(), 4) : !uniformScale3(n.scale[0], n.scale[1], n.scale[2])) return false;
+  }
+  for (const auto& a : d.animations)
+    for (const auto& ch : a.channels)
+      if (ch.path == GltfPath::Scale)
+        for (size_t i = 0; i + 2 < ch.values.size(); i += 3)
+          if (!uniformScale3(ch.values[i], ch.values[i + 1], ch.values[i + 2])) return false;
+  for (const auto& sk : d.skins)
+    for (const auto& ib : sk.inverseBind) {
+      double m[16];
+      for (int i = 0; i < 16; ++i) m[i] = ib[static_cast<size_t>(i)];
+      if (!isSimilarity(m, 4)) return false;
+    }
+  return true;
+}
+
+// Warnings for vertices whose frame is degenerate (docs/semantics.md, object.tangent).
+void noteDegenerateFrames(GltfImport& imp) {
+  const auto& st = imp.data.streams;
+  auto n = st.find("vertex.normal");
+  if (n == st.end()) return;
+  size_t zeroNormals = 0, badTangents = 0;
+  auto t = st.find("vertex.tangent");
+  for (size_t v = 0; v < n->second.size(); ++v) {
+    const auto& N = n->second[v];
+    double nn = double(N[0]) * N[0] + double(N[1]) * N[1] + double(N[2]) * N[2];
+    if (nn < 1e-12) ++zeroNormals;
+    if (t == st.end() || v >= t->second.size()) continue;
+    const auto& T = t->second[v];
+    double tt = double(T[0]) * T[0] + double(T[1]) * T[1] + double(T[2]) * T[2];
+    double tn = nn > 0 ? (double(T[0]) * N[0] + double(T[1]) * N[1] + double(T[2]) * N[2]) / std::sqrt(nn) : 0;
+    if (tt - tn * tn <= 1e-6 * tt || tt == 0) ++badTangents;
+  }
+  const size_t total = n->second.size();
+  if (zeroNormals)
+    imp.notes.push_back(fmt::format("{} of {} vertices have a zero-length NORMAL: their normal (and frame) is NaN",
+                                    zeroNormals, total));
+  if (badTangents)
+    imp.notes.push_back(fmt::format("{} of {} vertices have a TANGENT that is zero or parallel to the NORMAL: the "
+                                    "shader falls back to the orthonormal basis of the normal there",
+                                    badTangents, total));
+}
+
 GltfImport importModel(const tinygltf::Model& model, const std::string& file, const GltfImportOptions& opts) {
   GltfImport imp;
   GltfModelData& data = imp.data;
@@ -550,6 +616,25 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
     imp.notes.push_back(fmt::format("{} ({}) is not carried by the rig: {}", name,
                                     formatText(imp.attributes[infoIndex.at(name)]), why));
   };
+
+  // Indices, for drawing (shadergen render). Shaders run per vertex, so generation and
+  // validation never needed them: a bad index accessor is recorded, not an import error.
+  if (prim.indices >= 0) {
+    try {
+      AccessorData idx = reader.read(prim.indices, where + " indices");
+      if (idx.components != 1 || (idx.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+                                  idx.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                                  idx.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+        fail(file, fmt::format("{}: indices must be unsigned byte, short or int scalars", where));
+      for (float v : idx.values)
+        if (!(v >= 0.0f) || static_cast<size_t>(v) >= data.vertexCount)
+          fail(file, fmt::format("{}: index {} is out of range ({} vertices)", where, v, data.vertexCount));
+      data.indices.assign(idx.values.begin(), idx.values.end());
+    } catch (const InputError& e) {
+      data.indices.clear();
+      data.indicesError = e.diagnostic().message;
+    }
+  }
 
   // POSITION
   if (!isFloat(posAcc, TINYGLTF_TYPE_VEC3))
@@ -838,6 +923,8 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   rig.uniforms.push_back(makeUniform("view", "camera.view", Type::Mat4, "", 0, file));
   rig.uniforms.push_back(makeUniform("projection", "camera.projection", Type::Mat4, "", 0, file));
   if (sets == 0) rig.uniforms.push_back(makeUniform("model", "model.matrix", Type::Mat4, "", 0, file));
+  noteDegenerateFrames(imp);
+  if (modelScalesUniformly(imp.data)) rig.params["uniform_scale"] = 1;
   checkRig(rig);
   return imp;
 }

@@ -119,6 +119,8 @@ struct GltfModelData {
   std::string meshName;  // name, or the index as text when unnamed
   int mode = 4;          // primitive mode (any mode is fine: shaders run per vertex)
   size_t vertexCount = 0;
+  std::vector<uint32_t> indices;  // the primitive's indices as stored (empty: none)
+  std::string indicesError;       // why they could not be read ("": fine); only drawing needs them
   // Per-vertex values by semantic (docs/semantics.md), with sparse accessors applied and
   // normalized integers dequantized as the GPU reads them: "vertex.position", "vertex.normal",
   // "vertex.tangent" (xyz), "vertex.handedness" (.x = TANGENT.w), "vertex.texcoord0/1",

@@ -52,7 +52,7 @@ int matN(DefType t) { return t == DefType::Mat3 ? 3 : 4; }
 
 class Parser {
  public:
-  Parser(const std::string& s, const SourceLoc& loc) : s_(s), loc_(loc) {}
+  Parser(const std::string& s, std::vector<std::pair<size_t, SourceLoc>> segments) : s_(s), segments_(std::move(segments)) {}
 
   DefNodeP parseAll() {
     if (s_.size() > kMaxDefinitionChars)
@@ -65,8 +65,10 @@ class Parser {
 
  private:
   SourceLoc at(size_t p) const {
-    SourceLoc l = loc_;
-    if (l.col > 0) l.col += static_cast<int>(p);
+    size_t k = 0;
+    while (k + 1 < segments_.size() && segments_[k + 1].first <= p) ++k;
+    SourceLoc l = segments_[k].second;
+    if (l.col > 0) l.col += static_cast<int>(p - segments_[k].first);
     return l;
   }
   [[noreturn]] void fail(size_t p, const std::string& msg) const { throw InputError(at(p), msg); }
@@ -269,7 +271,7 @@ class Parser {
   }
 
   const std::string& s_;
-  SourceLoc loc_;
+  std::vector<std::pair<size_t, SourceLoc>> segments_;
   size_t pos_ = 0;
   int nesting_ = 0;
 };
@@ -338,6 +340,16 @@ class Checker {
       return;
     }
     std::string base = n.text.substr(0, dot), sw = n.text.substr(dot + 1);
+    if (locals_.count(base) && swizzleLetters(sw)) {  // a local's swizzle: "N.z"
+      auto inner = std::make_shared<DefNode>(n);
+      inner->text = base;
+      inner->ref = DefNode::Local;
+      n.kind = DefNode::Swizzle;
+      n.text = sw;
+      n.args = {inner};
+      n.loc.col = n.loc.col > 0 ? n.loc.col + static_cast<int>(dot) + 1 : 0;
+      return;
+    }
     if (int s = find(base); s >= 0 && swizzleLetters(sw)) {
       auto inner = std::make_shared<DefNode>(n);
       inner->text = base;
@@ -579,7 +591,11 @@ void collectReads(const DefNode& n, std::vector<int>& out) {
 
 }  // namespace
 
-DefNodeP parseDefinition(const std::string& text, const SourceLoc& loc) { return Parser(text, loc).parseAll(); }
+DefNodeP parseDefinition(const std::string& text, const SourceLoc& loc) { return Parser(text, {{0, loc}}).parseAll(); }
+
+DefNodeP parseDefinition(const std::string& text, const std::vector<std::pair<size_t, SourceLoc>>& segments) {
+  return Parser(text, segments).parseAll();
+}
 
 std::vector<int> definitionReads(const DefNode& root) {
   std::vector<int> out;

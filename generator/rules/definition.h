@@ -47,6 +47,9 @@ using DefNodeP = std::shared_ptr<DefNode>;
 
 // Parses `text` (starting at `loc` in its file). Throws InputError located inside the text.
 DefNodeP parseDefinition(const std::string& text, const SourceLoc& loc);
+// Same, for text spread over several source lines (a folded YAML block): segment k starts at
+// text offset segments[k].first, which sits at segments[k].second in the file.
+DefNodeP parseDefinition(const std::string& text, const std::vector<std::pair<size_t, SourceLoc>>& segments);
 
 // Resolves names and types of every definition in `set`: unknown semantics (with a
 // did-you-mean), type errors, family/array misuse, cycles between definitions, a

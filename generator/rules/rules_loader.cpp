@@ -76,10 +76,29 @@ double finiteNumber(const YamlCtx& y, const YAML::Node& n, const char* what) {
 }
 
 // The `definition:`, `kind:` and `range:` keys of a semantic (rules/definition.h).
-void loadSemanticDefinition(SemanticDecl& d, const YamlCtx& y, const YAML::Node& body) {
+void loadSemanticDefinition(SemanticDecl& d, const YamlCtx& y, const YAML::Node& body, const std::vector<std::string>& raw) {
   if (body["definition"]) {
     d.definitionText = y.scalar(body["definition"], "'definition'");
-    d.definition = parseDefinition(d.definitionText, exprLoc(body["definition"], y.file));
+    SourceLoc at = exprLoc(body["definition"], y.file);
+    SourceLoc mark = locOf(body["definition"], y.file);
+    // A block scalar ('>' or '|'): map each source line's text to its place in the value.
+    std::vector<std::pair<size_t, SourceLoc>> segments{{0, at}};
+    if (mark.line > 0 && mark.line <= static_cast<int>(raw.size()) && mark.col > 0 &&
+        raw[mark.line - 1].size() >= static_cast<size_t>(mark.col) &&
+        (raw[mark.line - 1][mark.col - 1] == '>' || raw[mark.line - 1][mark.col - 1] == '|')) {
+      segments.clear();
+      size_t off = 0;
+      for (size_t l = static_cast<size_t>(at.line); l < raw.size() && off < d.definitionText.size(); ++l) {
+        size_t first = raw[l].find_first_not_of(' ');
+        if (first == std::string::npos) continue;
+        std::string content = raw[l].substr(first);
+        if (d.definitionText.compare(off, content.size(), content) != 0) break;
+        segments.push_back({off, SourceLoc{y.file, static_cast<int>(l) + 1, static_cast<int>(first) + 1}});
+        off += content.size() + 1;
+      }
+      if (segments.empty()) segments.push_back({0, SourceLoc{y.file, at.line + 1, 0}});
+    }
+    d.definition = parseDefinition(d.definitionText, segments);
   }
   if (body["kind"]) {
     d.kind = y.scalar(body["kind"], "'kind'");
@@ -98,7 +117,7 @@ void loadSemanticDefinition(SemanticDecl& d, const YamlCtx& y, const YAML::Node&
   }
 }
 
-void loadSemantics(RuleSet& set, const YamlCtx& y, const YAML::Node& sems) {
+void loadSemantics(RuleSet& set, const YamlCtx& y, const YAML::Node& sems, const std::vector<std::string>& raw) {
   y.expectMap(sems, "'semantics'");
   for (auto it = sems.begin(); it != sems.end(); ++it) {
     if (set.semantics.size() >= kMaxSemantics) y.fail(it->first, fmt::format("more than {} semantics", kMaxSemantics));
@@ -131,7 +150,7 @@ void loadSemantics(RuleSet& set, const YamlCtx& y, const YAML::Node& sems) {
         }
         if (d.bufferOf.empty()) y.fail(b, fmt::format("semantic '{}': 'buffer_of' lists no semantic", d.name));
       }
-      loadSemanticDefinition(d, y, body);
+      loadSemanticDefinition(d, y, body, raw);
     }
     auto t = parseType(typeName);
     if (!t) y.fail(body.IsMap() ? body["type"] : body, fmt::format("unknown type '{}' for semantic '{}'", typeName, d.name));
@@ -285,7 +304,7 @@ void loadParsed(RuleSet& set, const std::string& text, const std::string& path, 
       }
     }
   }
-  if (auto s = root["semantics"]) loadSemantics(set, y, s);
+  if (auto s = root["semantics"]) loadSemantics(set, y, s, raw);
   if (auto v = root["varyings"]) loadVaryings(set, y, v);
   if (auto c = root["conventions"]) loadConventions(set, y, c);
   if (auto d = root["disable"]) applyDisable(set, y, d);

@@ -279,8 +279,17 @@ struct Interpreter::State {
       bool has = shape.provided.count(name) || shape.provided.count(indexedName(name, 0));
       return scalar(has ? 1.0 : 0.0, DefType::Bool);
     }
-    std::vector<Val> a;
-    for (const auto& x : n.args) a.push_back(eval(*x));
+    // At most 4 arguments once checked (mat4 of 4 columns, vec4 of 4 scalars): no allocation.
+    if (n.args.size() > 4) fail(n, fmt::format("'{}' has {} arguments", f, n.args.size()));
+    struct Args {
+      Val v[4];
+      size_t count = 0;
+      size_t size() const { return count; }
+      Val& operator[](size_t i) { return v[i]; }
+      Val* begin() { return v; }
+      Val* end() { return v + count; }
+    } a;
+    for (const auto& x : n.args) a.v[a.count++] = eval(*x);
     for (auto& x : a)
       if (x.t == DefType::Int) x.t = DefType::Float;
     auto v3 = [](const Val& v) { return dvec3(v.m[0]); };

@@ -234,6 +234,27 @@ std::vector<uint8_t> buildUniforms(const Rig& rig, const EmittedGlsl& glsl, cons
   return block;
 }
 
+// A pose's uniform values: the pose's own, then those defined by a formula over them (a
+// normal matrix), rounded to float as the GPU gets them.
+UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape& shape, const rt::Mesh& mesh,
+                            const rt::Pose& pose) {
+  UniformValues uniforms = poseUniforms(rig, pose);
+  for (const auto& u : rig.uniforms) {
+    const SemanticDecl* d = rules.findSemantic(u.semantic);
+    if (uniforms.count(u.semantic) || !d || !d->definition) continue;
+    Interpreter ui(rules, shape, mesh, uniforms);
+    std::vector<double> v;
+    try {
+      v = ui.evaluateUniform(u.semantic);
+    } catch (const std::exception& e) {
+      throw InputError(u.loc, fmt::format("cannot compute uniform '{}' ({}) from its definition: {}", u.name, u.semantic, e.what()));
+    }
+    for (double& x : v) x = static_cast<float>(x);
+    uniforms[u.semantic] = std::move(v);
+  }
+  return uniforms;
+}
+
 // Which side produced a NaN or infinity, where, and the provided values it was computed from.
 std::string nonFiniteReport(Interpreter& reference, const EmittedOutput& o, size_t v, int c, double gpu, double ref) {
   bool g = !std::isfinite(gpu), r = !std::isfinite(ref);
@@ -252,6 +273,27 @@ std::string nonFiniteReport(Interpreter& reference, const EmittedOutput& o, size
   return s;
 }
 
+// Uniforms: the pose's values, then those defined by a formula over them (a normal
+// matrix), rounded to float as the GPU gets them.
+UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape& shape, const rt::Mesh& mesh,
+                            const rt::Pose& pose) {
+  UniformValues uniforms = poseUniforms(rig, pose);
+  for (const auto& u : rig.uniforms) {
+    const SemanticDecl* d = rules.findSemantic(u.semantic);
+    if (uniforms.count(u.semantic) || !d || !d->definition) continue;
+    Interpreter ui(rules, shape, mesh, uniforms);
+    std::vector<double> v;
+    try {
+      v = ui.evaluateUniform(u.semantic);
+    } catch (const std::exception& e) {
+      throw InputError(u.loc, fmt::format("cannot compute uniform '{}' ({}) from its definition: {}", u.name, u.semantic, e.what()));
+    }
+    for (double& x : v) x = static_cast<float>(x);
+    uniforms[u.semantic] = std::move(v);
+  }
+  return uniforms;
+}
+
 }  // namespace
 
 void limitActiveTargets(const Rig& rig, std::vector<rt::Pose>& poses, uint32_t seed) {
@@ -267,6 +309,21 @@ void limitActiveTargets(const Rig& rig, std::vector<rt::Pose>& poses, uint32_t s
       for (size_t i = keep; i < order.size(); ++i) w[order[i]] = 0.0f;
     }
   }
+}
+
+rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh) { return quantizedMesh(rig, mesh); }
+
+rt::VertexStream vertexStream(const Rig& rig, const EmittedInput& in, const rt::Mesh& mesh) {
+  return buildStream(rig, in, mesh);
+}
+
+std::vector<uint8_t> uniformBlock(const Rig& rig, const RuleSet& rules, const EmittedGlsl& glsl, const SpirvModule& spv,
+                                  const rt::Mesh& mesh, const rt::Pose& pose) {
+  std::vector<rt::Pose> poses{pose};
+  drawDeclaredUniforms(poses, rig, rules);
+  UniformValues values = uniformValues(rig, rules, shapeOfRig(rig, rules), mesh, poses[0]);
+  addActiveTargets(rig, poses[0], values);
+  return buildUniforms(rig, glsl, spv, values);
 }
 
 ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_t seed, int poses) {
@@ -347,20 +404,7 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
   for (const rt::Pose& pose : poses) {
     // Uniforms: the pose's values, then those defined by a formula over them (a normal
     // matrix), rounded to float as the GPU gets them.
-    UniformValues uniforms = poseUniforms(rig, pose);
-    for (const auto& u : rig.uniforms) {
-      const SemanticDecl* d = rules.findSemantic(u.semantic);
-      if (uniforms.count(u.semantic) || !d || !d->definition) continue;
-      Interpreter ui(rules, shape, mesh, uniforms);
-      std::vector<double> v;
-      try {
-        v = ui.evaluateUniform(u.semantic);
-      } catch (const std::exception& e) {
-        throw InputError(u.loc, fmt::format("cannot compute uniform '{}' ({}) from its definition: {}", u.name, u.semantic, e.what()));
-      }
-      for (double& x : v) x = static_cast<float>(x);
-      uniforms[u.semantic] = std::move(v);
-    }
+    UniformValues uniforms = uniformValues(rig, rules, shape, mesh, pose);
     addActiveTargets(rig, pose, uniforms);
     req.uniformData = buildUniforms(rig, r.glsl, r.spirv, uniforms);
     req.storageBuffers = perVertexBuffers;

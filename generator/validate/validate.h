@@ -76,6 +76,15 @@ void limitActiveTargets(const Rig& rig, std::vector<rt::Pose>& poses, uint32_t s
 std::vector<rt::StorageBufferData> buildStorageBuffers(const Problem& p, const EmittedGlsl& glsl, const rt::Mesh& mesh,
                                                        const rt::Pose& pose, bool perVertex);
 
+// The data a run feeds the GPU, for other users of the device (render, GPU timing):
+// the mesh with every integer/normalized stream rounded as its attribute format stores it,
+// one input's vertex stream, and the uniform block for a pose (uniforms with a definition,
+// such as a normal matrix, computed from the pose's).
+rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh);
+rt::VertexStream vertexStream(const Rig& rig, const EmittedInput& in, const rt::Mesh& mesh);
+std::vector<uint8_t> uniformBlock(const Rig& rig, const RuleSet& rules, const EmittedGlsl& glsl, const SpirvModule& spv,
+                                  const rt::Mesh& mesh, const rt::Pose& pose);
+
 struct ValidateOptions {
   GenerateOptions gen;
   bool crossCheck = false;  // also force each alternative derivation and check it

@@ -86,6 +86,10 @@ std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v,
     h.field(ov.name);
     for (const auto& sem : ov.semantics) h.field(sem);
   }
+  if (!v.pass->conventions.empty()) {  // only then: earlier manifests keep their cache keys
+    h.field("conventions");
+    for (const auto& c : v.pass->conventions) h.field(c);
+  }
   h.field("inputs");
   for (const auto& f : inputs) h.field(f).field(s.digests.at(f));
   return h.hex();
@@ -162,7 +166,8 @@ void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v,
       break;
     }
   Rig rig = v.params.empty() ? base : rigWithParameters(base, v.params, paramsAt);
-  LoadedInputs in = instantiateStage(std::move(rig), s.rules, s.fragments.at(v.pass->fragment), v.pass->maps);
+  LoadedInputs in = instantiateStage(std::move(rig), s.rules, s.fragments.at(v.pass->fragment), v.pass->maps,
+                                     v.pass->conventions);
   GenerateOptions o;
   o.heuristic = m.heuristic;
   o.targetEnv = m.targetEnv;

@@ -91,7 +91,7 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
     p.loc = locOf(kv.first, file);
     if (!safeStem(p.name)) y.fail(kv.first, fmt::format("pass name '{}' must be letters, digits, '-', '_' or '.'", p.name));
     if (kv.second.IsMap()) {
-      y.checkKeys(kv.second, {"fragment", "map"});
+      y.checkKeys(kv.second, {"fragment", "map", "conventions"});
       if (!kv.second["fragment"]) y.fail(kv.second, fmt::format("pass '{}' needs 'fragment'", p.name));
       p.fragment = resolvePath(file, y.scalar(kv.second["fragment"], "'fragment'"));
       if (kv.second["map"]) {
@@ -103,6 +103,7 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
           p.maps.push_back(ov);
         }
       }
+      if (kv.second["conventions"]) p.conventions = scalarOrList(y, kv.second["conventions"], "a convention or a list");
     } else {
       p.fragment = resolvePath(file, y.scalar(kv.second, "a fragment shader"));
     }

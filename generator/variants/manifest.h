@@ -17,6 +17,7 @@ struct ManifestPass {
   std::string name;
   std::string fragment;                  // path
   std::vector<VaryingOverride> maps;     // like --map
+  std::vector<std::string> conventions;  // like --conventions (empty = all, where they agree)
   SourceLoc loc;
 };
 

@@ -14,6 +14,7 @@ set(layers
   variants   # manifests, the content cache, batch builds
   api        # the public shadergen::core facade
   validate   # lavapipe runs against the GLM reference
+  render     # images and GPU timing of generated shaders (runtime/vk_render)
   bake       # offline rig data (occlusion with Embree); poses glTF models as validation does
   cli)       # the command line
 set(external runtime)  # separate library (no generator dependency), usable from validate up

@@ -65,6 +65,11 @@ TEST(Definitions, BadFormulasAreLocated) {
   EXPECT_EQ(loadError("semantics:\n  a.b: { type: float, definition: \"(((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((1)))))))))))))))))))))))))))))))))))))))))))))))))))))))))))))))))\" }\n"),
             "user.yaml:2:68: error: definition is nested deeper than 64 levels");
   EXPECT_EQ(loadError("semantics:\n  a.b: { type: vec3, definition: \"let n = world.normal; n * view.ndotv\" }\n"), "");
+  // A folded block: the error is located on its own source line.
+  EXPECT_EQ(loadError("semantics:\n  a.b:\n    type: vec3\n    definition: >-\n      let n = world.normal;\n      n * camera.view\n"),
+            "user.yaml:6:9: error: cannot apply '*' to vec3 and mat4");
+  EXPECT_EQ(loadError("semantics:\n  a.b: { type: float, definition: \"let n = world.normal; n.z + n.w\" }\n"),
+            "user.yaml:2:66: error: '.w' reaches past the end of a vec3");
 }
 
 // The hand-written reference and the interpreter, on one mesh in one pose: every computed
@@ -477,6 +482,54 @@ TEST(Docs, SemanticsListsEveryDefinition) {
   ASSERT_NE(b, std::string::npos);
   ASSERT_NE(e, std::string::npos);
   EXPECT_EQ(doc.substr(b + begin.size(), e - b - begin.size()), table);
+}
+
+}  // namespace
+
+namespace {
+
+// tests/validate/data/parallel_tangents.gltf: a ramp under node scale (1, 4, 1) whose
+// vertices 0, 4 and 8 have TANGENT parallel (or antiparallel) to NORMAL.
+sg::ValidateReport validateRamp(const std::string& rulesPath) {
+  sg::ValidateOptions vo;
+  vo.gen.rigPath = sgtest::dataPath("parallel_tangents.gltf");
+  vo.gen.fragmentPath = sgtest::dataPath("frame.frag");
+  vo.gen.rulesPaths = {rulesPath};
+  sg::ValidationScene scene = sg::gltfScene(vo.gen.rigPath, sg::GltfSceneOptions{});
+  sg::Validator v(vo);
+  sg::ValidateReport rep = v.run(scene);
+  std::cout << sg::formatReport(rep);
+  return rep;
+}
+
+TEST(Degenerate, ImportWarnsAndDerivesScale) {
+  sg::GltfImport imp = sg::importGltf(sgtest::dataPath("parallel_tangents.gltf"));
+  std::vector<std::string> warned;
+  for (const auto& n : imp.notes)
+    if (n.find("TANGENT") != std::string::npos) warned.push_back(n);
+  ASSERT_EQ(warned.size(), 1u);
+  EXPECT_EQ(warned[0].rfind("3 of 9 vertices have a TANGENT that is zero or parallel to the NORMAL", 0), 0u) << warned[0];
+  EXPECT_EQ(imp.rig.param("uniform_scale"), 0);  // the node scales (1, 4, 1)
+  // The Fox's skeleton scales uniformly: it may use mat3(M).
+  EXPECT_EQ(sg::importGltf(sg::test::modelPath("Fox/Fox.glb")).rig.param("uniform_scale"), 1);
+}
+
+TEST(Degenerate, FallbackValidatesAndSkippingItIsCaught) {
+  sg::ValidateReport ok = validateRamp(sourcePath("rules/standard.yaml"));
+  EXPECT_TRUE(ok.pass);
+  EXPECT_TRUE(sgtest::planHas(ok.runs.at(0), "world_normal_inverse_transpose"));
+  // The fallback skipped: Gram-Schmidt normalizes a zero vector on the GPU.
+  RulesCopy rules("no_fallback");
+  ASSERT_TRUE(rules.edit("morph.yaml", "      if (dot(${out}, ${out}) > 1e-6 * dot(${vertex.tangent}, ${vertex.tangent})) {",
+                         "      if (true) {"));
+  sg::ValidateReport broken = validateRamp(rules.rulesFile("standard.yaml").string());
+  EXPECT_FALSE(broken.pass);
+  EXPECT_EQ(failing(broken), (std::set<std::string>{"world_tangent", "world_binormal"}));
+  for (const auto& o : broken.runs.at(0).outputs)
+    if (o.name == "world_tangent") {
+      EXPECT_EQ(o.nonFinite.rfind("GPU gives nan at vertex 0, output world_tangent", 0), 0u) << o.nonFinite;
+      EXPECT_NE(o.nonFinite.find("vertex.tangent = (0, 0, 1)"), std::string::npos) << o.nonFinite;
+    }
 }
 
 }  // namespace

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Packs `shadergen bench` for a machine without a package registry (docs/performance.md):
+# the stripped shadergen, the shared libraries it needs beyond glibc/libstdc++ and the
+# Vulkan loader (the target brings those; its GPU driver brings the ICD), the rules,
+# templates and the Dawn example, and bench/gpu_run.sh.
+# Usage: bash bench/gpu_bundle.sh [BUILD_DIR=build] [OUT=build/shadergen-gpu.tar.gz]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${1:-$root/build}
+out=${2:-$build/shadergen-gpu.tar.gz}
+stage=$(mktemp -d)
+trap 'rm -rf "$stage"' EXIT
+mkdir -p "$stage/sg/bin" "$stage/sg/lib" "$stage/sg/examples"
+strip -o "$stage/sg/bin/shadergen" "$build/generator/cli/shadergen"
+# Libraries the target may lack; the C/C++ runtime and the Vulkan loader are the target's.
+ldd "$build/generator/cli/shadergen" | awk '$3 ~ /^\// {print $3}' | while read -r lib; do
+  case "$(basename "$lib")" in
+    libc.so.*|libm.so.*|libgcc_s.so.*|libstdc++.so.*|ld-linux*|libvulkan.so.*|libpthread.so.*|libdl.so.*|librt.so.*) ;;
+    *) cp -L "$lib" "$stage/sg/lib/" ;;
+  esac
+done
+cp -r "$root/rules" "$root/templates" "$stage/sg/"
+cp -r "$root/examples/dawn" "$stage/sg/examples/"
+cp "$root/bench/gpu_run.sh" "$stage/sg/"
+tar -C "$stage" -czf "$out" sg
+echo "$out: $(du -h "$out" | cut -f1)"

@@ -1,0 +1,155 @@
+// `shadergen render`: generate, then draw the rig with the generated vertex shader and the
+// fragment shader into a PNG (docs/render.md).
+#include <fmt/format.h>
+
+#include <iostream>
+
+#include "cli/commands.h"
+#include "render/gpu_bench.h"
+#include "render/render.h"
+
+namespace sg {
+namespace {
+
+// "x,y,z" → vec3 (finite numbers only).
+glm::vec3 parseVec3(const std::string& option, const std::string& text) {
+  glm::vec3 v(0.0f);
+  size_t start = 0;
+  for (int i = 0; i < 3; ++i) {
+    size_t comma = text.find(',', start);
+    if ((i < 2) == (comma == std::string::npos))
+      throw CLI::ValidationError(option, "expected x,y,z, got '" + text + "'");
+    std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    size_t used = 0;
+    float f = 0;
+    try {
+      f = std::stof(part, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (part.empty() || used != part.size() || !std::isfinite(f))
+      throw CLI::ValidationError(option, "expected three finite numbers x,y,z, got '" + text + "'");
+    v[i] = f;
+    start = comma + 1;
+  }
+  return v;
+}
+
+struct RenderCommand {
+  GenerateArgs args;
+  RenderOptions ro;
+  std::string output;
+  std::string size = "512x512";
+  std::string light, rim;
+  bool noLayers = false;
+
+  int run() {
+    ro.gen = args.resolve();
+    ro.validationLayers = !noLayers;
+    unsigned w = 0, h = 0;
+    char tail = 0;
+    if (std::sscanf(size.c_str(), "%ux%u%c", &w, &h, &tail) != 2 || w == 0 || h == 0 || w > 8192 || h > 8192)
+      throw CLI::ValidationError("--size", "expected WIDTHxHEIGHT with each in 1..8192, got '" + size + "'");
+    ro.width = w;
+    ro.height = h;
+    if (!light.empty()) ro.lighting.keyDirection = parseVec3("--light", light);
+    if (!rim.empty()) ro.lighting.rimDirection = parseVec3("--rim-light", rim);
+    if (glm::length(ro.lighting.keyDirection) == 0.0f || glm::length(ro.lighting.rimDirection) == 0.0f)
+      throw CLI::ValidationError("--light", "a light direction must not be zero");
+
+    std::vector<InputFile> inputs{{ro.gen.rigPath, "the rig"}, {ro.gen.fragmentPath, "the fragment shader"}};
+    for (const auto& r : ro.gen.rulesPaths) inputs.push_back({r, "a rules file"});
+    refuseClobbering({output}, inputs);
+
+    RenderSession session(ro.device, ro.validationLayers);
+    RenderResult r = session.render(ro);
+    std::string png = encodePng(r.image);
+    writeFilesAtomically({{output, png}});
+    size_t covered = 0;
+    for (float d : r.image.depth) covered += d < 1.0f;
+    std::cout << fmt::format("{}: {}x{} on {}, plan cost {}, {} of {} pixels covered\n", output, r.image.width,
+                             r.image.height, r.device, r.planCost, covered, r.image.depth.size());
+    for (const auto& m : r.validationMessages) std::cerr << "shadergen: warning: validation layer: " << m << "\n";
+    return r.validationMessages.empty() ? 0 : 1;
+  }
+};
+
+struct BenchCommand {
+  GenerateArgs args;
+  GpuBenchOptions bo;
+  std::string size = "256x256";
+  std::string raster = "both";
+  bool noLayers = false;
+  bool noAlternatives = false, noFloor = false;
+
+  int run() {
+    bo.render.gen = args.resolve();
+    bo.render.validationLayers = !noLayers;
+    unsigned w = 0, h = 0;
+    char tail = 0;
+    if (std::sscanf(size.c_str(), "%ux%u%c", &w, &h, &tail) != 2 || w == 0 || h == 0 || w > 8192 || h > 8192)
+      throw CLI::ValidationError("--size", "expected WIDTHxHEIGHT with each in 1..8192, got '" + size + "'");
+    bo.render.width = w;
+    bo.render.height = h;
+    bo.rasterOn = raster != "off";
+    bo.rasterOff = raster != "on";
+    bo.alternatives = !noAlternatives;
+    bo.floor = !noFloor;
+    GpuBenchReport rep = runGpuBench(bo);
+    std::cout << formatGpuBench(rep);
+    return 0;
+  }
+};
+
+}  // namespace
+
+void registerRender(CLI::App& app, CliState& state) {
+  auto cmd = std::make_shared<RenderCommand>();
+  CLI::App* sub = app.add_subcommand("render", "Draw the rig with the generated vertex shader and the fragment shader into a PNG");
+  cmd->args.add(*sub);
+  sub->add_option("-o,--output", cmd->output, "PNG file to write")->required();
+  sub->add_option("--mesh", cmd->ro.mesh, "Procedural mesh: head (default), limb, dawn (180k vertices)")
+      ->check(CLI::IsMember({"head", "limb", "dawn"}));
+  sub->add_option("--size", cmd->size, "Image size WIDTHxHEIGHT (default 512x512)");
+  sub->add_option("--device", cmd->ro.device, "Vulkan device name (substring); default lavapipe");
+  sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer");
+  sub->add_option("--time", cmd->ro.time, "glTF rig (MODEL.glb#m/p): animation time in seconds (default 0)")
+      ->check(finiteNumber(false));
+  sub->add_option("--animation", cmd->ro.animation, "glTF rig: animation name or index (default: the first)");
+  sub->add_option("--pose-seed", cmd->ro.poseSeed, "0 (default): rest pose; N: the random pose of seed N");
+  sub->add_option("--morph-weight", cmd->ro.morphWeight, "Rest pose: weight of every morph target (default 0.5)")
+      ->check(finiteNumber(false));
+  sub->add_option("--yaw", cmd->ro.camera.yawDegrees, "Camera yaw in degrees around +Y (0: the face)")
+      ->check(CLI::Range(-360.0f, 360.0f));
+  sub->add_option("--pitch", cmd->ro.camera.pitchDegrees, "Camera pitch in degrees")->check(CLI::Range(-89.0f, 89.0f));
+  sub->add_option("--zoom", cmd->ro.camera.zoom, "Closer (> 1) or farther (< 1) than the framing distance")
+      ->check(CLI::Range(0.1f, 10.0f));
+  sub->add_option("--light", cmd->light, "Direction towards the key light, x,y,z (world space)");
+  sub->add_option("--rim-light", cmd->rim, "Direction of the hilight cube map's rim light, x,y,z");
+  sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
+
+  auto bench = std::make_shared<BenchCommand>();
+  bench->bo.render.mesh = "dawn";
+  CLI::App* b = app.add_subcommand("bench", "Time the generated vertex program, its forced alternatives, a hand-written "
+                                            "port and a pass-through floor on the GPU (timestamp queries)");
+  bench->args.add(*b);
+  b->add_option("--hand-port", bench->bo.handPortPath, "A hand-written vertex shader with the same interface "
+                                                       "(a_<attribute>, u_<uniform>), e.g. examples/dawn/listing-3-3.vert");
+  b->add_option("--mesh", bench->bo.render.mesh, "Procedural mesh: dawn (default, 180k vertices), head, limb")
+      ->check(CLI::IsMember({"head", "limb", "dawn"}));
+  b->add_option("--size", bench->size, "Render target WIDTHxHEIGHT with rasterization on (default 256x256)");
+  b->add_option("--draws", bench->bo.drawsPerFrame, "Draws of the mesh between two timestamps (default 8)")
+      ->check(CLI::Range(1, 100000));
+  b->add_option("--frames", bench->bo.frames, "Timed frames; the median is reported (default 7)")->check(CLI::Range(1, 1000));
+  b->add_option("--rounds", bench->bo.rounds, "Passes over every program, order rotated; the best counts (default 3)")
+      ->check(CLI::Range(1, 100));
+  b->add_option("--raster", bench->raster, "on, off (rasterizer discard + transform feedback) or both (default)")
+      ->check(CLI::IsMember({"on", "off", "both"}));
+  b->add_flag("--no-alternatives", bench->noAlternatives, "Only the generated plan (and the hand port and floor)");
+  b->add_flag("--no-floor", bench->noFloor, "Leave out the pass-through floor");
+  b->add_option("--device", bench->bo.render.device, "Vulkan device name (substring); default lavapipe");
+  b->add_flag("--no-validation-layers", bench->noLayers, "Run without the Khronos validation layer (use for timings)");
+  b->callback([bench, &state] { state.run = [bench] { return bench->run(); }; });
+}
+
+}  // namespace sg

@@ -1,0 +1,369 @@
+#include "render/gpu_bench.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <numeric>
+#include <regex>
+#include <set>
+
+#include "common/input_file.h"
+#include "runtime/vk_render.h"
+
+namespace sg {
+namespace {
+
+// One program to time: its SPIR-V for both modes and what feeds it.
+struct Program {
+  GpuBenchRow row;
+  std::vector<uint32_t> renderSpirv, captureSpirv;
+  uint32_t captureStride = 0;
+  std::vector<rt::VertexStream> streams;
+  std::vector<uint8_t> uniforms;
+};
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+std::vector<double> ranks(const std::vector<double>& v) {
+  std::vector<size_t> order(v.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return v[a] < v[b]; });
+  std::vector<double> r(v.size());
+  for (size_t i = 0; i < order.size();) {  // ties share their mean rank
+    size_t j = i;
+    while (j + 1 < order.size() && v[order[j + 1]] == v[order[i]]) ++j;
+    for (size_t k = i; k <= j; ++k) r[order[k]] = 0.5 * double(i + j);
+    i = j + 1;
+  }
+  return r;
+}
+
+GlslShader parseVertex(const std::string& text, const std::string& path, TargetEnv env) {
+  GlslShader s(GlslUnit{Stage::Vertex, text, path, {}}, env);
+  if (!s.ok()) throwDiagnostics(s.diagnostics(), path, "the vertex shader does not compile");
+  return s;
+}
+
+// Streams and uniforms of a hand-written shader that follows the emitter's naming
+// (a_<attribute>[<target>], u_<uniform>), from its own reflection.
+void feedHandWritten(const GlslShader& s, const std::string& path, const Rig& rig, const RuleSet& rules, const rt::Mesh& mesh,
+                     const rt::Pose& pose, std::vector<rt::VertexStream>& streams, std::vector<uint8_t>& uniforms) {
+  for (const auto& in : s.inputs()) {
+    EmittedInput e;
+    e.name = in.name;
+    e.location = in.location;
+    for (size_t a = 0; a < rig.attributes.size() && e.attribute < 0; ++a) {
+      const RigAttribute& ra = rig.attributes[a];
+      const std::string base = "a_" + ra.name;
+      if (!ra.perMorphTarget && in.name == base) e.attribute = static_cast<int>(a);
+      if (ra.perMorphTarget && in.name.size() > base.size() && in.name.compare(0, base.size(), base) == 0 &&
+          in.name.find_first_not_of("0123456789", base.size()) == std::string::npos) {
+        e.attribute = static_cast<int>(a);
+        e.target = std::stoi(in.name.substr(base.size()));
+      }
+    }
+    if (e.attribute < 0 || in.location < 0)
+      throw InputError(SourceLoc{path, 0, 0}, fmt::format("input '{}' names no attribute of rig '{}' (a_<attribute>[target] "
+                                                          "with a location)", in.name, rig.name));
+    streams.push_back(vertexStream(rig, e, mesh));
+  }
+  EmittedGlsl glsl;
+  SpirvModule spv;
+  for (const auto& b : s.uniformBlocks()) spv.uniformBlockSize = std::max(spv.uniformBlockSize, b.size);
+  for (const auto& m : s.uniformMembers()) {
+    spv.uniforms.push_back(UniformLayout{m.name, m.offset, m.arrayStride, m.matrixStride, m.size});
+    for (size_t u = 0; u < rig.uniforms.size(); ++u)
+      if (m.name == "u_" + rig.uniforms[u].name) glsl.uniforms.push_back(EmittedUniform{m.name, static_cast<int>(u)});
+  }
+  if (spv.uniformBlockSize) uniforms = uniformBlock(rig, rules, glsl, spv, mesh, pose);
+}
+
+// The floor: reads the position, writes it as gl_Position and a constant to every other
+// output of the generated program's interface.
+// With allInputs, it also reads every input the generated program reads (summed into
+// gl_Position with a factor the compiler cannot fold away), separating the cost of vertex
+// fetch from the cost of the arithmetic.
+std::string floorShader(const GenerateResult& g, bool capture, bool allInputs) {
+  std::string pos;
+  int location = -1;
+  for (const auto& in : g.glsl.inputs)
+    for (const auto& part : g.in.rig.attributes[in.attribute].provides)
+      if (part.semantic == "vertex.position" && location < 0) {
+        location = in.location;
+        pos = in.name + (componentCount(in.type) > 3 ? ".xyz" : "");
+        if (componentCount(in.type) < 3) pos = "";
+      }
+  std::string text = "#version 450\n";
+  for (const auto& in : g.glsl.inputs)
+    if (in.location == location || allInputs)
+      text += fmt::format("layout(location = {}) in {} {};\n", in.location, glslName(in.type), in.name);
+  std::string body = pos.empty() ? "  gl_Position = vec4(0.0, 0.0, 0.5, 1.0);\n"
+                                 : fmt::format("  gl_Position = vec4({}, 1.0);\n", pos);
+  if (allInputs) {
+    body += "  vec4 fetched = vec4(0.0);\n";
+    for (const auto& in : g.glsl.inputs) {
+      const int n = componentCount(in.type);
+      const char* pad = n == 1 ? "" : n == 2 ? ", 0.0, 0.0" : n == 3 ? ", 0.0" : "";
+      std::string v = scalarKind(in.type) == ScalarKind::Float ? in.name : fmt::format("{}({})", n == 1 ? "float" : fmt::format("vec{}", n), in.name);
+      body += n == 1 ? fmt::format("  fetched += vec4({});\n", v) : fmt::format("  fetched += vec4({}{});\n", v, pad);
+    }
+    body += "  gl_Position += 1e-30 * fetched;\n";
+  }
+  for (const auto& o : g.glsl.outputs) {
+    if (o.location < 0) {
+      if (capture)
+        text += fmt::format("out gl_PerVertex {{\n  layout(xfb_buffer = 0, xfb_offset = 0, xfb_stride = {}) vec4 gl_Position;\n}};\n",
+                            g.glsl.captureStride);
+      continue;
+    }
+    std::string xfb = capture ? fmt::format(", xfb_buffer = 0, xfb_offset = {}, xfb_stride = {}", o.captureOffset, g.glsl.captureStride) : "";
+    bool integral = scalarKind(o.type) != ScalarKind::Float;
+    text += fmt::format("layout(location = {}{}) {}out {} {};\n", o.location, xfb, integral ? "flat " : "", glslName(o.type), o.name);
+    body += fmt::format("  {} = {}(0);\n", o.name, glslName(o.type));
+  }
+  return text + "void main() {\n" + body + "}\n";
+}
+
+}  // namespace
+
+std::string addCaptureQualifiers(const std::string& glsl, const std::string& path, const EmittedGlsl& capture) {
+  static const std::regex out(R"(layout\s*\(\s*location\s*=\s*(\d+)\s*\)(\s*(?:flat\s+)?out\s+\w+\s+(\w+)\s*;))");
+  std::string result;
+  auto begin = std::sregex_iterator(glsl.begin(), glsl.end(), out);
+  size_t last = 0;
+  for (auto it = begin; it != std::sregex_iterator(); ++it) {
+    const std::smatch& m = *it;
+    auto o = std::find_if(capture.outputs.begin(), capture.outputs.end(), [&](const EmittedOutput& e) { return e.name == m[3].str(); });
+    if (o == capture.outputs.end()) {
+      int line = 1 + static_cast<int>(std::count(glsl.begin(), glsl.begin() + m.position(0), '\n'));
+      throw InputError(SourceLoc{path, line, 1}, fmt::format("output '{}' is not an output of the generated shader", m[3].str()));
+    }
+    result += glsl.substr(last, static_cast<size_t>(m.position(0)) - last);
+    result += fmt::format("layout(location = {}, xfb_buffer = 0, xfb_offset = {}, xfb_stride = {}){}", m[1].str(),
+                          o->captureOffset, capture.captureStride, m[2].str());
+    last = static_cast<size_t>(m.position(0) + m.length(0));
+  }
+  result += glsl.substr(last);
+  size_t main = result.find("void main(");
+  if (main == std::string::npos) throw InputError(SourceLoc{path, 0, 0}, "no 'void main(' in the vertex shader");
+  result.insert(main, fmt::format("out gl_PerVertex {{\n  layout(xfb_buffer = 0, xfb_offset = 0, xfb_stride = {}) vec4 gl_Position;\n}};\n",
+                                  capture.captureStride));
+  return result;
+}
+
+HandWrittenRun prepareHandWritten(const std::string& path, const Rig& rig, const RuleSet& rules, const rt::Mesh& mesh,
+                                  const rt::Pose& pose, const EmittedGlsl& capture, TargetEnv env) {
+  std::string text = readInputFile(path);
+  GlslShader s = parseVertex(text, path, env);
+  HandWrittenRun h;
+  h.renderSpirv = s.spirv();
+  h.captureSpirv = parseVertex(addCaptureQualifiers(text, path, capture), path, env).spirv();
+  feedHandWritten(s, path, rig, rules, mesh, pose, h.streams, h.uniforms);
+  return h;
+}
+
+double pearson(const std::vector<double>& x, const std::vector<double>& y) {
+  const size_t n = std::min(x.size(), y.size());
+  if (n < 3) return NAN;
+  double mx = std::accumulate(x.begin(), x.begin() + long(n), 0.0) / double(n);
+  double my = std::accumulate(y.begin(), y.begin() + long(n), 0.0) / double(n);
+  double sxy = 0, sxx = 0, syy = 0;
+  for (size_t i = 0; i < n; ++i) {
+    sxy += (x[i] - mx) * (y[i] - my);
+    sxx += (x[i] - mx) * (x[i] - mx);
+    syy += (y[i] - my) * (y[i] - my);
+  }
+  if (sxx == 0 || syy == 0) return NAN;
+  return sxy / std::sqrt(sxx * syy);
+}
+
+double spearman(const std::vector<double>& x, const std::vector<double>& y) { return pearson(ranks(x), ranks(y)); }
+
+GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
+  const TargetEnv env = opts.render.gen.targetEnv;
+  GenerateOptions gen = opts.render.gen;
+  gen.capture = false;
+  LoadedInputs in = loadInputs(gen);
+  const Rig& rig = in.rig;
+  RenderScene scene = renderScene(rig, opts.render);
+  std::vector<uint32_t> frag = compileFragmentFile(gen.fragmentPath, env);
+  std::vector<rt::Texture> textures = texturesFor(frag, gen.fragmentPath, opts.render.lighting);
+
+  // The programs: generated, its forced alternatives, the hand port, the floor.
+  std::vector<Program> programs;
+  auto addGenerated = [&](const GenerateOptions& g, const std::string& label) -> bool {
+    GenerateOptions render = g, capture = g;
+    render.capture = false;
+    capture.capture = true;
+    GenerateResult r = generateFrom(in, render), c = generateFrom(in, capture);
+    Program p;
+    p.row.label = label;
+    for (int a : r.plan.actions) p.row.rules.push_back(r.in.problem.actions[a].name);
+    for (const auto& q : programs)
+      if (q.row.hasCost && q.row.rules == p.row.rules) return false;  // the same plan again
+    p.row.hasCost = true;
+    p.row.planCost = r.plan.cost;
+    p.row.spirvInstructions = countInstructions(r.spirv.words);
+    p.renderSpirv = r.spirv.words;
+    p.captureSpirv = c.spirv.words;
+    p.captureStride = c.glsl.captureStride;
+    for (const auto& i : r.glsl.inputs) p.streams.push_back(vertexStream(rig, i, scene.mesh));
+    p.uniforms = uniformBlock(rig, r.in.rules, r.glsl, r.spirv, scene.mesh, scene.pose);
+    programs.push_back(std::move(p));
+    return true;
+  };
+  addGenerated(gen, "generated");
+  GenerateResult chosen = generateFrom(in, gen);
+  GenerateOptions captureGen = gen;
+  captureGen.capture = true;
+  GenerateResult chosenCapture = generateFrom(in, captureGen);
+  if (opts.alternatives) {
+    const Problem& p = chosen.in.problem;
+    for (int a : chosen.plan.actions) {
+      std::vector<std::string> producers;
+      for (const auto& act : p.actions)
+        if (act.add == p.actions[a].add) producers.push_back(act.name);
+      for (const auto& alt : producers) {
+        if (alt == p.actions[a].name) continue;
+        GenerateOptions forced = gen;
+        for (const auto& other : producers)
+          if (other != alt) forced.bannedRules.push_back(other);
+        try {
+          addGenerated(forced, fmt::format("forced {} for {}", alt, p.facts[p.actions[a].add].name));
+        } catch (const InputError&) {
+          // the alternative needs something this rig cannot provide
+        }
+      }
+    }
+  }
+  if (!opts.handPortPath.empty()) {
+    HandWrittenRun h = prepareHandWritten(opts.handPortPath, rig, in.rules, scene.mesh, scene.pose, chosenCapture.glsl, env);
+    Program p;
+    p.row.label = "hand port (" + std::filesystem::path(opts.handPortPath).filename().string() + ")";
+    p.renderSpirv = std::move(h.renderSpirv);
+    p.row.spirvInstructions = countInstructions(p.renderSpirv);
+    p.captureSpirv = std::move(h.captureSpirv);
+    p.captureStride = chosenCapture.glsl.captureStride;
+    p.streams = std::move(h.streams);
+    p.uniforms = std::move(h.uniforms);
+    programs.push_back(std::move(p));
+  }
+  for (bool allInputs : {false, true}) {
+    if (!opts.floor) break;
+    Program p;
+    p.row.label = allInputs ? "floor + every input fetched" : "floor (pass-through)";
+    GlslShader s = parseVertex(floorShader(chosen, false, allInputs), "floor.vert", env);
+    p.renderSpirv = s.spirv();
+    p.row.spirvInstructions = countInstructions(p.renderSpirv);
+    p.captureSpirv = parseVertex(floorShader(chosenCapture, true, allInputs), "floor.vert", env).spirv();
+    p.captureStride = chosenCapture.glsl.captureStride;
+    feedHandWritten(s, "floor.vert", rig, in.rules, scene.mesh, scene.pose, p.streams, p.uniforms);
+    programs.push_back(std::move(p));
+  }
+
+  RenderSession session(opts.render.device, opts.render.validationLayers);
+  rt::Renderer renderer(session.harness());
+  GpuBenchReport rep;
+  rep.device = session.deviceName();
+  rep.driver = renderer.driver();
+  rep.vertices = scene.mesh.vertexCount;
+  rep.triangles = scene.indices.size() / 3;
+  rep.drawsPerFrame = opts.drawsPerFrame;
+  rep.frames = opts.frames;
+  rep.rounds = std::max<uint32_t>(1, opts.rounds);
+  rep.width = opts.render.width;
+  rep.height = opts.render.height;
+  // Rounds over all programs, the order rotated each round; a program's number is its best
+  // round's median frame, so another process stealing a round (lavapipe shares the CPU)
+  // does not pick the winner.
+  auto best = [](double& slot, double v) { slot = slot < 0 ? v : std::min(slot, v); };
+  const size_t n = programs.size();
+  for (uint32_t round = 0; round < std::max<uint32_t>(1, opts.rounds); ++round)
+    for (size_t k = 0; k < n; ++k) {
+      Program& p = programs[(k + round) % n];
+      rt::DrawRequest req;
+      req.fragmentSpirv = frag;
+      req.streams = p.streams;
+      req.vertexCount = static_cast<uint32_t>(scene.mesh.vertexCount);
+      req.indices = scene.indices;
+      req.uniformData = p.uniforms;
+      req.textures = textures;
+      req.width = opts.render.width;
+      req.height = opts.render.height;
+      rt::TimingRequest t;
+      t.drawsPerFrame = opts.drawsPerFrame;
+      t.frames = opts.frames + 1;
+      auto perVertex = [&](const std::vector<double>& ns, uint32_t vertices) {
+        std::vector<double> frames(ns.begin() + 1, ns.end());  // the first warms up
+        return median(frames) / (double(opts.drawsPerFrame) * double(vertices));
+      };
+      if (opts.rasterOn) {
+        req.vertexSpirv = p.renderSpirv;
+        t.rasterize = true;
+        rt::Timing tm = renderer.time(req, t);
+        best(p.row.rasterOnNsPerVertex, perVertex(tm.frameNs, tm.verticesPerDraw));
+        best(p.row.rasterOnWallNsPerVertex, perVertex(tm.wallNs, tm.verticesPerDraw));
+      }
+      if (opts.rasterOff) {
+        req.vertexSpirv = p.captureSpirv;
+        t.rasterize = false;
+        t.captureStride = p.captureStride;
+        rt::Timing tm = renderer.time(req, t);
+        best(p.row.rasterOffNsPerVertex, perVertex(tm.frameNs, tm.verticesPerDraw));
+        best(p.row.rasterOffWallNsPerVertex, perVertex(tm.wallNs, tm.verticesPerDraw));
+      }
+    }
+  for (const auto& p : programs) rep.rows.push_back(p.row);
+  std::vector<double> cost, on, off, offWall;
+  for (const auto& r : rep.rows)
+    if (r.hasCost) {
+      cost.push_back(double(r.planCost));
+      on.push_back(r.rasterOnNsPerVertex);
+      off.push_back(r.rasterOffNsPerVertex);
+      offWall.push_back(r.rasterOffWallNsPerVertex);
+    }
+  rep.pearsonOffWall = pearson(cost, offWall);
+  rep.spearmanOffWall = spearman(cost, offWall);
+  rep.pearsonOn = pearson(cost, on);
+  rep.spearmanOn = spearman(cost, on);
+  rep.pearsonOff = pearson(cost, off);
+  rep.spearmanOff = spearman(cost, off);
+  const auto& msgs = session.harness().validationMessages();
+  if (!msgs.empty()) throw std::runtime_error("validation layer: " + msgs.front());
+  return rep;
+}
+
+std::string formatGpuBench(const GpuBenchReport& r) {
+  std::string s = fmt::format("device: {} (driver: {})\nmesh: {} vertices, {} triangles; {} draws per frame, median of {} frames, best of {} rounds; "
+                              "rasterization on: {}x{} target\n\n",
+                              r.device, r.driver, r.vertices, r.triangles, r.drawsPerFrame, r.frames, r.rounds, r.width, r.height);
+  const GpuBenchRow* gen = nullptr;
+  for (const auto& row : r.rows)
+    if (row.label == "generated") gen = &row;
+  auto cell = [](double ns, double ref) {
+    if (ns < 0) return std::string("—");
+    return ref > 0 ? fmt::format("{:.4f} ({:.2f}x)", ns, ns / ref) : fmt::format("{:.4f}", ns);
+  };
+  s += "ns per vertex (x: relative to the generated program); timestamps = GPU timestamp queries, "
+       "host = submit-to-fence wall time\n\n";
+  s += "| program | plan cost | SPIR-V instr. | raster on, timestamps | raster off (xfb), timestamps | raster on, host | raster off, host |\n";
+  s += "|---|---:|---:|---:|---:|---:|---:|\n";
+  for (const auto& row : r.rows)
+    s += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", row.label, row.hasCost ? std::to_string(row.planCost) : "—",
+                     row.spirvInstructions, cell(row.rasterOnNsPerVertex, gen ? gen->rasterOnNsPerVertex : -1),
+                     cell(row.rasterOffNsPerVertex, gen ? gen->rasterOffNsPerVertex : -1),
+                     cell(row.rasterOnWallNsPerVertex, gen ? gen->rasterOnWallNsPerVertex : -1),
+                     cell(row.rasterOffWallNsPerVertex, gen ? gen->rasterOffWallNsPerVertex : -1));
+  s += fmt::format("\nplan cost vs time over the {} generated programs: raster on (timestamps) Pearson {:.2f}, Spearman {:.2f}; "
+                   "raster off (timestamps) Pearson {:.2f}, Spearman {:.2f}; raster off (host) Pearson {:.2f}, Spearman {:.2f}\n",
+                   std::count_if(r.rows.begin(), r.rows.end(), [](const GpuBenchRow& x) { return x.hasCost; }), r.pearsonOn,
+                   r.spearmanOn, r.pearsonOff, r.spearmanOff, r.pearsonOffWall, r.spearmanOffWall);
+  return s;
+}
+
+}  // namespace sg

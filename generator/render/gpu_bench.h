@@ -1,0 +1,76 @@
+// GPU timing of vertex programs (shadergen bench): the generated plan, every forced
+// alternative, a hand-written shader with the same interface (the port of listing 3-3),
+// and a pass-through floor, each drawn over the same mesh many times per frame with
+// Vulkan timestamp queries, with rasterization on (indexed triangles + the fragment
+// shader) and off (rasterizer discard + transform feedback, so nothing is optimised
+// away). docs/performance.md has the tables and what they say about the cost model.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "render/render.h"
+
+namespace sg {
+
+struct GpuBenchOptions {
+  RenderOptions render;        // gen, device, size, mesh ("dawn"), lighting
+  std::string handPortPath;    // "" = none; GLSL with the generated shader's interface
+  bool floor = true;           // the pass-through program
+  bool alternatives = true;    // every forced alternative (as validate --cross-check)
+  bool rasterOn = true, rasterOff = true;
+  uint32_t drawsPerFrame = 8;
+  uint32_t frames = 7;         // + 1 warm-up frame, not counted
+  uint32_t rounds = 3;         // passes over every program; the best pass counts
+};
+
+struct GpuBenchRow {
+  std::string label;               // "generated", "forced <rule> for <fact>", "hand port", "floor"
+  std::vector<std::string> rules;  // plan rules (generated programs)
+  bool hasCost = false;
+  int64_t planCost = 0;
+  size_t spirvInstructions = 0;    // of the render build
+  double rasterOnNsPerVertex = -1;   // median frame / (draws x vertices); -1 = not measured
+  double rasterOffNsPerVertex = -1;
+  double rasterOnWallNsPerVertex = -1;   // host submit-to-fence time (see rt::Timing::wallNs)
+  double rasterOffWallNsPerVertex = -1;
+};
+
+struct GpuBenchReport {
+  std::string device, driver;
+  size_t vertices = 0, triangles = 0;
+  uint32_t drawsPerFrame = 0, frames = 0, rounds = 0, width = 0, height = 0;
+  std::vector<GpuBenchRow> rows;
+  // Over the generated plan and its alternatives (rows with a cost): Pearson correlation of
+  // plan cost with time per vertex, and Spearman (rank) correlation; NaN if < 3 rows.
+  double pearsonOn = 0, spearmanOn = 0, pearsonOff = 0, spearmanOff = 0;
+  double pearsonOffWall = 0, spearmanOffWall = 0;  // the same against host time, raster off
+};
+
+GpuBenchReport runGpuBench(const GpuBenchOptions& opts);
+
+// Markdown table + summary lines.
+std::string formatGpuBench(const GpuBenchReport& report);
+
+// Correlations (exposed for tests): NaN if fewer than 3 points or no variance.
+double pearson(const std::vector<double>& x, const std::vector<double>& y);
+double spearman(const std::vector<double>& x, const std::vector<double>& y);
+
+// Adds transform-feedback qualifiers to a hand-written vertex shader whose outputs are
+// `layout(location = N) out TYPE NAME;` lines, at the offsets of `capture` (a capture build
+// with the same outputs), and redeclares gl_PerVertex. Throws InputError for an output the
+// capture layout lacks.
+std::string addCaptureQualifiers(const std::string& glsl, const std::string& path, const EmittedGlsl& capture);
+
+// A hand-written vertex shader (emitter naming: a_<attribute>[target], u_<uniform>) fed
+// the way the generated one is: its capture build (xfb at the offsets of `capture`), its
+// vertex streams from `mesh` and its uniform block for `pose`.
+struct HandWrittenRun {
+  std::vector<uint32_t> renderSpirv, captureSpirv;
+  std::vector<rt::VertexStream> streams;
+  std::vector<uint8_t> uniforms;
+};
+HandWrittenRun prepareHandWritten(const std::string& path, const Rig& rig, const RuleSet& rules, const rt::Mesh& mesh,
+                                  const rt::Pose& pose, const EmittedGlsl& capture, TargetEnv env);
+
+}  // namespace sg

@@ -1,0 +1,83 @@
+// Headless drawing on the harness's device: a vertex + fragment pipeline into a colour and
+// a depth image read back to the host (shadergen render), and GPU timing of vertex
+// programs with timestamp queries (shadergen bench). Like the harness it knows bytes,
+// formats and bindings, never semantics.
+#pragma once
+#include <vulkan/vulkan.h>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "runtime/vk_harness.h"
+
+namespace sg::rt {
+
+// A sampled texture at set 1, `binding` (combined image sampler, linear filtering).
+struct Texture {
+  uint32_t binding = 0;
+  bool cube = false;  // 6 faces in Vulkan order +X, -X, +Y, -Y, +Z, -Z
+  uint32_t size = 0;  // width = height
+  VkFormat format = VK_FORMAT_R8G8B8A8_UNORM;  // or VK_FORMAT_R16G16B16A16_SFLOAT (HDR)
+  std::vector<uint8_t> data;  // faces x size x size texels, rows top to bottom
+};
+
+struct DrawRequest {
+  std::vector<uint32_t> vertexSpirv;
+  std::vector<uint32_t> fragmentSpirv;  // writes location 0 (vec4)
+  std::vector<VertexStream> streams;
+  uint32_t vertexCount = 0;
+  std::vector<uint32_t> indices;     // triangle list
+  std::vector<uint8_t> uniformData;  // set 0, binding 0 (vertex stage); empty = none
+  std::vector<Texture> textures;     // set 1 (fragment stage)
+  uint32_t width = 256, height = 256;
+  std::array<float, 4> clearColor{0, 0, 0, 1};
+};
+
+// The colour attachment (RGBA8 UNORM, row 0 at the top) and the depth (1 = nothing drawn).
+struct Image {
+  uint32_t width = 0, height = 0;
+  std::vector<uint8_t> rgba;
+  std::vector<float> depth;
+};
+
+struct TimingRequest {
+  uint32_t drawsPerFrame = 16;  // the mesh drawn this many times between two timestamps
+  uint32_t frames = 5;
+  // true: indexed triangles into the colour/depth targets (depth test LESS, so repeated draws
+  // are rejected early and the vertex stage dominates). false: rasterizer discard, every
+  // vertex once with its outputs captured by transform feedback (the vertex shader must be a
+  // capture build with this xfb stride), so no output can be optimised away.
+  bool rasterize = true;
+  uint32_t captureStride = 0;
+};
+
+struct Timing {
+  std::vector<double> frameNs;  // GPU time of each frame's draws (timestamps)
+  // Host time of each frame's submit + wait: on a CPU device (lavapipe) work may run outside
+  // the timestamps' reach (deferred binning, rasterizer threads), so this is the honest one there.
+  std::vector<double> wallNs;
+  uint32_t verticesPerDraw = 0;  // vertex shader invocations asked for per draw (unique vertices)
+};
+
+class Renderer {
+ public:
+  // Draws with the harness's device and queue; the harness must outlive the renderer.
+  explicit Renderer(const Harness& harness);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Throws std::runtime_error on a bad request or a Vulkan error.
+  Image draw(const DrawRequest& request);
+  Timing time(const DrawRequest& request, const TimingRequest& timing);
+  // "<driver name> <driver info>" (VkPhysicalDeviceDriverProperties), or the driver version number.
+  std::string driver() const;
+
+ private:
+  struct Impl;
+  Impl* impl_;
+};
+
+}  // namespace sg::rt

@@ -1,0 +1,95 @@
+// shadergen bench's parts that decide what its numbers mean: the correlations against
+// independent textbook values, and the hand port's capture build, whose outputs on lavapipe
+// must equal the generated shader's (otherwise the hand port row times something else).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "render/gpu_bench.h"
+#include "runtime/procedural.h"
+#include "test_util.h"
+
+namespace {
+
+using namespace sgtest;
+
+TEST(GpuBench, CorrelationsMatchHandComputedValues) {
+  // x = 1..5, y = 2, 4, 5, 4, 5: Pearson r = 6 / sqrt(10 * 6) = 0.7746 (by hand).
+  EXPECT_NEAR(sg::pearson({1, 2, 3, 4, 5}, {2, 4, 5, 4, 5}), 6.0 / std::sqrt(60.0), 1e-12);
+  // Spearman with ties: ranks of y are 0, 1.5, 3.5, 1.5, 3.5 (mean ranks).
+  EXPECT_NEAR(sg::spearman({1, 2, 3, 4, 5}, {2, 4, 5, 4, 5}), sg::pearson({0, 1, 2, 3, 4}, {0, 1.5, 3.5, 1.5, 3.5}), 1e-12);
+  EXPECT_NEAR(sg::spearman({1, 2, 3, 4}, {1, 8, 27, 64}), 1.0, 1e-12);  // monotone, not linear
+  EXPECT_LT(sg::pearson({1, 2, 3, 4}, {1, 8, 27, 64}), 1.0);
+  EXPECT_NEAR(sg::pearson({1, 2, 3}, {3, 2, 1}), -1.0, 1e-12);
+  EXPECT_TRUE(std::isnan(sg::pearson({1, 2}, {1, 2})));        // too few points
+  EXPECT_TRUE(std::isnan(sg::pearson({1, 1, 1}, {1, 2, 3})));  // no variance
+}
+
+TEST(GpuBench, CaptureQualifiersGoOnEveryOutputAndUnknownOutputsAreErrors) {
+  sg::EmittedGlsl capture;
+  capture.captureStride = 32;
+  auto output = [](const char* name, int location, uint32_t offset) {
+    sg::EmittedOutput o;
+    o.name = name;
+    o.location = location;
+    o.captureOffset = offset;
+    return o;
+  };
+  capture.outputs = {output("gl_Position", -1, 0), output("A", 0, 16), output("B", 1, 28)};
+  std::string text = "#version 450\nlayout(location = 0) out vec3 A;\nlayout(location=1) flat out float B;\nvoid main() {}\n";
+  std::string out = sg::addCaptureQualifiers(text, "h.vert", capture);
+  EXPECT_NE(out.find("layout(location = 0, xfb_buffer = 0, xfb_offset = 16, xfb_stride = 32) out vec3 A;"), std::string::npos) << out;
+  EXPECT_NE(out.find("layout(location = 1, xfb_buffer = 0, xfb_offset = 28, xfb_stride = 32) flat out float B;"), std::string::npos) << out;
+  EXPECT_NE(out.find("xfb_offset = 0, xfb_stride = 32) vec4 gl_Position;"), std::string::npos) << out;
+  try {
+    sg::addCaptureQualifiers("#version 450\n\nlayout(location = 2) out vec4 C;\nvoid main() {}\n", "h.vert", capture);
+    ADD_FAILURE() << "no error";
+  } catch (const sg::InputError& e) {
+    EXPECT_EQ(e.diagnostic().loc.line, 3);
+  }
+}
+
+TEST(GpuBench, HandPortOfListing33ComputesWhatTheGeneratedShaderComputes) {
+  sg::GenerateOptions g;
+  g.rigPath = sourcePath("examples/dawn/face.rig.yaml");
+  g.fragmentPath = sourcePath("examples/dawn/face.frag");
+  g.rulesPaths = {sourcePath("examples/dawn/rules.yaml")};
+  g.capture = true;
+  sg::GenerateResult gen = sg::generate(g);
+  sg::ValidationScene scene = sg::proceduralScene(gen.in.rig, "head", 3, 1);
+  sg::rt::Mesh mesh = sg::quantizeForRig(gen.in.rig, scene.mesh);
+  const sg::rt::Pose& pose = scene.poses.front();
+  sg::HandWrittenRun hand =
+      sg::prepareHandWritten(sourcePath("examples/dawn/listing-3-3.vert"), gen.in.rig, gen.in.rules, mesh, pose, gen.glsl,
+                             g.targetEnv);
+
+  sg::rt::Harness harness;
+  sg::rt::RunRequest a;
+  a.spirv = gen.spirv.words;
+  a.vertexCount = static_cast<uint32_t>(mesh.vertexCount);
+  a.capture.strideBytes = gen.glsl.captureStride;
+  for (const auto& in : gen.glsl.inputs) a.streams.push_back(sg::vertexStream(gen.in.rig, in, mesh));
+  a.uniformData = sg::uniformBlock(gen.in.rig, gen.in.rules, gen.glsl, gen.spirv, mesh, pose);
+  sg::rt::RunRequest b = a;
+  b.spirv = hand.captureSpirv;
+  b.streams = hand.streams;
+  b.uniformData = hand.uniforms;
+  std::vector<uint8_t> ga = harness.run(a).captured, gb = harness.run(b).captured;
+  ASSERT_EQ(ga.size(), gb.size());
+  EXPECT_TRUE(harness.validationMessages().empty()) << harness.validationMessages().front();
+  // Same values up to float rounding (the two programs order their arithmetic differently).
+  size_t floats = ga.size() / 4, differ = 0;
+  double worst = 0;
+  for (size_t i = 0; i < floats; ++i) {
+    float x, y;
+    std::memcpy(&x, &ga[i * 4], 4);
+    std::memcpy(&y, &gb[i * 4], 4);
+    double d = std::abs(double(x) - double(y)) / std::max(1.0, std::abs(double(x)));
+    worst = std::max(worst, d);
+    differ += d > 1e-4;
+  }
+  EXPECT_EQ(differ, 0u) << "worst relative difference " << worst;
+}
+
+}  // namespace
