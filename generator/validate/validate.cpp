@@ -273,27 +273,6 @@ std::string nonFiniteReport(Interpreter& reference, const EmittedOutput& o, size
   return s;
 }
 
-// Uniforms: the pose's values, then those defined by a formula over them (a normal
-// matrix), rounded to float as the GPU gets them.
-UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape& shape, const rt::Mesh& mesh,
-                            const rt::Pose& pose) {
-  UniformValues uniforms = poseUniforms(rig, pose);
-  for (const auto& u : rig.uniforms) {
-    const SemanticDecl* d = rules.findSemantic(u.semantic);
-    if (uniforms.count(u.semantic) || !d || !d->definition) continue;
-    Interpreter ui(rules, shape, mesh, uniforms);
-    std::vector<double> v;
-    try {
-      v = ui.evaluateUniform(u.semantic);
-    } catch (const std::exception& e) {
-      throw InputError(u.loc, fmt::format("cannot compute uniform '{}' ({}) from its definition: {}", u.name, u.semantic, e.what()));
-    }
-    for (double& x : v) x = static_cast<float>(x);
-    uniforms[u.semantic] = std::move(v);
-  }
-  return uniforms;
-}
-
 }  // namespace
 
 void limitActiveTargets(const Rig& rig, std::vector<rt::Pose>& poses, uint32_t seed) {
