@@ -370,6 +370,58 @@ struct RunObjects {
   }
 };
 
+
+// Set 0: the uniform block at binding 0 (if any) and each storage buffer at its binding;
+// VK_NULL_HANDLE when the shader reads neither.
+VkDescriptorSet createDescriptorSet(VkDevice device, VkDescriptorSetLayout& layout, VkDescriptorPool& pool,
+                                    VkBuffer uniform, const std::vector<StorageBufferData>& storageData,
+                                    const std::vector<RunObjects::Buffer*>& storage) {
+  std::vector<VkDescriptorSetLayoutBinding> bindings;
+  std::vector<VkDescriptorPoolSize> sizes;
+  if (uniform) {
+    bindings.push_back({0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT, nullptr});
+    sizes.push_back({VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1});
+  }
+  for (const auto& sb : storageData)
+    bindings.push_back({sb.binding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT, nullptr});
+  if (!storageData.empty())
+    sizes.push_back({VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, static_cast<uint32_t>(storageData.size())});
+  if (bindings.empty()) return VK_NULL_HANDLE;
+  VkDescriptorSetLayoutCreateInfo dslci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  dslci.bindingCount = static_cast<uint32_t>(bindings.size());
+  dslci.pBindings = bindings.data();
+  check(vkCreateDescriptorSetLayout(device, &dslci, nullptr, &layout), "vkCreateDescriptorSetLayout");
+  VkDescriptorPoolCreateInfo dpci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  dpci.maxSets = 1;
+  dpci.poolSizeCount = static_cast<uint32_t>(sizes.size());
+  dpci.pPoolSizes = sizes.data();
+  check(vkCreateDescriptorPool(device, &dpci, nullptr, &pool), "vkCreateDescriptorPool");
+  VkDescriptorSetAllocateInfo dsai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  dsai.descriptorPool = pool;
+  dsai.descriptorSetCount = 1;
+  dsai.pSetLayouts = &layout;
+  VkDescriptorSet set = VK_NULL_HANDLE;
+  check(vkAllocateDescriptorSets(device, &dsai, &set), "vkAllocateDescriptorSets");
+  std::vector<VkDescriptorBufferInfo> infos;
+  infos.reserve(bindings.size());
+  std::vector<VkWriteDescriptorSet> writes;
+  auto write = [&](uint32_t binding, VkDescriptorType type, VkBuffer buffer) {
+    infos.push_back({buffer, 0, VK_WHOLE_SIZE});
+    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    w.dstSet = set;
+    w.dstBinding = binding;
+    w.descriptorCount = 1;
+    w.descriptorType = type;
+    w.pBufferInfo = &infos.back();
+    writes.push_back(w);
+  };
+  if (uniform) write(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniform);
+  for (size_t i = 0; i < storageData.size(); ++i)
+    write(storageData[i].binding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, storage[i]->buffer);
+  vkUpdateDescriptorSets(device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  return set;
+}
+
 }  // namespace
 
 Harness::Harness(const HarnessOptions& options) : impl_(std::make_unique<Impl>()) {
@@ -471,7 +523,7 @@ RunResult Harness::run(const RunRequest& req) {
   constexpr VkMemoryPropertyFlags hostCoherent = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
 
   // Reserved up front: makeBuffer hands out references into o.buffers.
-  o.buffers.reserve(req.streams.size() + 3);
+  o.buffers.reserve(req.streams.size() + req.storageBuffers.size() + 3);
   std::vector<VkBuffer> vertexBuffers;
   for (const VertexStream& s : req.streams)
     vertexBuffers.push_back(makeBuffer(std::max<VkDeviceSize>(s.data.size(), VkDeviceSize(drawCount) * s.stride),
@@ -480,6 +532,15 @@ RunResult Harness::run(const RunRequest& req) {
   RunObjects::Buffer* uniform = nullptr;
   if (!req.uniformData.empty())
     uniform = &makeBuffer(req.uniformData.size(), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, hostCoherent, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  std::vector<RunObjects::Buffer*> storage;
+  for (const StorageBufferData& sb : req.storageBuffers) {
+    if (sb.data.empty() || sb.binding == 0 || sb.data.size() > limits.maxStorageBufferRange)
+      throw std::runtime_error(fmt::format("vk harness: storage buffer at binding {} has {} bytes (1..{} allowed, "
+                                           "binding 0 is the uniform block's)",
+                                           sb.binding, sb.data.size(), limits.maxStorageBufferRange));
+    storage.push_back(&makeBuffer(sb.data.size(), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, hostCoherent,
+                                  VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT));
+  }
   RunObjects::Buffer& capture = makeBuffer(
       xfbSize, VK_BUFFER_USAGE_TRANSFORM_FEEDBACK_BUFFER_BIT_EXT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
       0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
@@ -491,36 +552,9 @@ RunResult Harness::run(const RunRequest& req) {
   smci.pCode = req.spirv.data();
   check(vkCreateShaderModule(h.device, &smci, nullptr, &o.shader), "vkCreateShaderModule");
 
-  VkDescriptorSet descriptorSet = VK_NULL_HANDLE;
-  if (uniform) {
-    VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT, nullptr};
-    VkDescriptorSetLayoutCreateInfo dslci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-    dslci.bindingCount = 1;
-    dslci.pBindings = &binding;
-    check(vkCreateDescriptorSetLayout(h.device, &dslci, nullptr, &o.setLayout), "vkCreateDescriptorSetLayout");
-
-    VkDescriptorPoolSize poolSize{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1};
-    VkDescriptorPoolCreateInfo dpci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-    dpci.maxSets = 1;
-    dpci.poolSizeCount = 1;
-    dpci.pPoolSizes = &poolSize;
-    check(vkCreateDescriptorPool(h.device, &dpci, nullptr, &o.descriptorPool), "vkCreateDescriptorPool");
-
-    VkDescriptorSetAllocateInfo dsai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-    dsai.descriptorPool = o.descriptorPool;
-    dsai.descriptorSetCount = 1;
-    dsai.pSetLayouts = &o.setLayout;
-    check(vkAllocateDescriptorSets(h.device, &dsai, &descriptorSet), "vkAllocateDescriptorSets");
-
-    VkDescriptorBufferInfo dbi{uniform->buffer, 0, VK_WHOLE_SIZE};
-    VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    write.dstSet = descriptorSet;
-    write.dstBinding = 0;
-    write.descriptorCount = 1;
-    write.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-    write.pBufferInfo = &dbi;
-    vkUpdateDescriptorSets(h.device, 1, &write, 0, nullptr);
-  }
+  VkDescriptorSet descriptorSet =
+      createDescriptorSet(h.device, o.setLayout, o.descriptorPool, uniform ? uniform->buffer : VK_NULL_HANDLE,
+                          req.storageBuffers, storage);
 
   VkPipelineLayoutCreateInfo plci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
   plci.setLayoutCount = o.setLayout ? 1 : 0;
@@ -673,6 +707,8 @@ RunResult Harness::run(const RunRequest& req) {
       std::memset(static_cast<uint8_t*>(o.buffers[i].mapped) + s.data.size(), 0, padded - s.data.size());
   }
   if (uniform) std::memcpy(uniform->mapped, req.uniformData.data(), req.uniformData.size());
+  for (size_t i = 0; i < storage.size(); ++i)
+    std::memcpy(storage[i]->mapped, req.storageBuffers[i].data.data(), req.storageBuffers[i].data.size());
   result.timings.uploadMs = msSince(t0);
 
   // Run.

@@ -19,6 +19,13 @@ struct VertexStream {
   std::vector<uint8_t> data;  // at least vertexCount * stride bytes
 };
 
+// A read-only storage buffer at set 0, `binding` (std430 data as the shader declares it).
+// Per-vertex buffers must cover the drawn vertices: vertexCount rounded up to even.
+struct StorageBufferData {
+  uint32_t binding = 1;
+  std::vector<uint8_t> data;  // non-empty
+};
+
 // The shader's xfb_stride (a single capture buffer, xfb_buffer 0).
 struct CaptureLayout {
   uint32_t strideBytes = 0;
@@ -31,6 +38,8 @@ struct RunRequest {
   std::vector<VertexStream> streams;
   // Contents of the uniform block at set 0, binding 0; empty = no descriptor set.
   std::vector<uint8_t> uniformData;
+  // Storage buffers at set 0 (bindings distinct from 0, the uniform block's).
+  std::vector<StorageBufferData> storageBuffers;
   uint32_t vertexCount = 0;
   CaptureLayout capture;
 };

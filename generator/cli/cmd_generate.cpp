@@ -34,6 +34,17 @@ void GenerateArgs::add(CLI::App& cmd) {
   cmd.add_option("--max-expansions", opts.searchLimits.maxExpansions,
                  "Give up (error) after this many A* expansions")
       ->check(CLI::PositiveNumber);
+  cmd.add_option("--max-attributes", opts.maxAttributes,
+                 "Vertex input attributes the plan may use (the device's maxVertexInputAttributes; default 16, "
+                 "what every Vulkan device supports). A constraint of the search, not a cost")
+      ->check(CLI::Range(1, 4096));
+  cmd.add_option("--max-uniform-bytes", opts.maxUniformBlockBytes,
+                 "Bytes of the uniform block (the device's maxUniformBufferRange; default 16384)")
+      ->check(CLI::Range(16, 1 << 30));
+  cmd.add_option("--vertices", opts.maxVertices,
+                 "The most vertices one draw has: per-vertex storage buffers that would exceed "
+                 "maxStorageBufferRange (2^27 bytes) at that count are not used (default: unknown, all allowed)")
+      ->check(CLI::Range(int64_t{0}, int64_t{1} << 32));
   cmd.add_option("--target-env", targetEnv, "vulkan1.0 (default), vulkan1.1, vulkan1.2, vulkan1.3")
       ->check(CLI::IsMember({"vulkan", "vulkan1.0", "vulkan1.1", "vulkan1.2", "vulkan1.3"}));
   cmd.add_option("--templates", opts.templateDir, "Directory with vertex.glsl templates");
@@ -138,7 +149,7 @@ struct GenerateCommand {
       for (auto& c : sym)
         if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
       if (sym.empty() || std::isdigit(static_cast<unsigned char>(sym[0]))) sym = "sg_" + sym;
-      files.push_back({pathFor("header"), spirvHeader(r.spirv.words, sym + "_spv")});
+      files.push_back({pathFor("header"), spirvHeader(r.spirv.words, sym + "_spv") + buffersHeader(r.glsl, sym)});
     }
     if (kinds.count("reflection")) files.push_back({pathFor("reflection"), reflectionJson(r.in.rig, r.glsl, r.spirv)});
     if (depfile || !depfilePath.empty()) {

@@ -55,6 +55,7 @@ class Emitter {
     collectUsedFacts();
     declareInputs();
     declareUniforms();
+    declareBuffers();
     std::string outputs = declareOutputs();
     std::string inputs;
     for (const auto& in : out_.inputs)
@@ -73,6 +74,7 @@ class Emitter {
       }
       uniforms = t_.fill("uniform_block", {{"members", members}}) + "\n";
     }
+    uniforms += bufferDeclarations();
     std::string stores;
     for (const auto& o : out_.outputs) {
       if (o.arraySize) {  // one semantic per element
@@ -160,6 +162,60 @@ class Emitter {
     for (int u : needed) out_.uniforms.push_back(EmittedUniform{"u_" + rig_.uniforms[u].name, u});
   }
 
+  void declareBuffers() {
+    int binding = 1;
+    for (size_t f = 0; f < p_.facts.size(); ++f) {
+      if (!used_[f] || p_.facts[f].source != Fact::Source::Buffer) continue;
+      const BufferSource& b = p_.buffers[p_.facts[f].rigIndex];
+      EmittedBuffer e;
+      e.name = "b_" + tempName(p_.facts[f].name).substr(2);
+      e.semantic = p_.facts[f].name;
+      e.binding = binding++;
+      e.buffer = p_.facts[f].rigIndex;
+      e.element = b.element;
+      e.strideBytes = static_cast<uint32_t>(b.strideBytes);
+      e.perVertex = b.kind == BufferSource::Kind::PerVertex;
+      e.count = b.count;
+      if (e.perVertex) {
+        for (const auto& part : b.parts)
+          e.packs.emplace_back(part.family + "[i]", std::string("xyzw").substr(static_cast<size_t>(part.firstComponent),
+                                                                                static_cast<size_t>(part.components)));
+      } else {
+        e.packs.emplace_back(rig_.uniforms[b.uniform].semantic + "[i]", "mat4");
+      }
+      out_.buffers.push_back(e);
+    }
+  }
+
+  // Each buffer: its block, and an accessor returning the semantic's type, so that
+  // snippets read ${semantic}(i) whatever the layout.
+  std::string bufferDeclarations() const {
+    std::string s;
+    for (const auto& e : out_.buffers) {
+      const BufferSource& b = p_.buffers[e.buffer];
+      const Fact& f = p_.facts[b.fact];
+      std::string index = b.kind == BufferSource::Kind::PerVertex
+                              ? fmt::format("uint(gl_VertexIndex) * {}u + uint(i)", b.count)
+                              : std::string("uint(i)");
+      int n = componentCount(f.type);
+      std::string value;
+      if (e.element == Type::Float) {  // tightly packed floats
+        index = fmt::format("({}) * {}u", index, b.components);
+        std::string parts;
+        for (int c = 0; c < n; ++c) parts += fmt::format("{}{}_data[k + {}u]", c ? ", " : "", e.name, c);
+        value = n == 1 ? parts : fmt::format("{}({})", glslName(f.type), parts);
+      } else {
+        std::string swizzle = f.type == e.element ? "" : "." + std::string("xyzw").substr(0, static_cast<size_t>(n));
+        value = fmt::format("{}_data[k]{}", e.name, swizzle);
+      }
+      s += fmt::format(
+          "layout(set = 0, binding = {}, std430) readonly buffer ShadergenBuffer{} {{\n  {} {}_data[];\n}};\n"
+          "{} {}(int i) {{ uint k = {}; return {}; }}\n",
+          e.binding, e.binding, glslName(e.element), e.name, glslName(f.type), e.name, index, value);
+    }
+    return s;
+  }
+
   std::string declareOutputs() {
     uint32_t offset = 0;
     for (const auto& v : varyings_) {
@@ -203,6 +259,8 @@ class Emitter {
         return tempName(fact.name);
       case Fact::Source::Uniform:
         return "u_" + rig_.uniforms[fact.rigIndex].name;
+      case Fact::Source::Buffer:
+        return "b_" + tempName(fact.name).substr(2);
       case Fact::Source::Attribute: {
         for (const auto& in : out_.inputs)
           if (in.attribute == fact.rigIndex && in.target == fact.target)

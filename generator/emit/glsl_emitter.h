@@ -34,6 +34,20 @@ struct EmittedUniform {
   int uniform = -1;  // index in Rig::uniforms
 };
 
+// A storage buffer the shader reads (set 0, std430, readonly; docs/buffers.md).
+struct EmittedBuffer {
+  std::string name;      // accessor function b_<semantic>; the array is <name>_data
+  std::string semantic;  // "morph.position_deltas"
+  int binding = 1;       // set 0; the uniform block has binding 0
+  int buffer = -1;       // index in Problem::buffers
+  Type element = Type::Vec4;  // std430 array element
+  uint32_t strideBytes = 16;  // of one element
+  bool perVertex = true;      // element (v, i) at v * count + i; else element i (a palette)
+  int64_t count = 0;          // instances per vertex, or elements
+  // What each element holds: (semantic with [i], components of the element), in order.
+  std::vector<std::pair<std::string, std::string>> packs;
+};
+
 struct EmittedOutput {
   std::string name;
   int location = -1;  // -1: gl_Position
@@ -48,6 +62,7 @@ struct EmittedGlsl {
   std::vector<std::string> sourceFiles;  // #line source string S → sourceFiles[S-1]
   std::vector<EmittedInput> inputs;      // by location
   std::vector<EmittedUniform> uniforms;  // in block order
+  std::vector<EmittedBuffer> buffers;    // by binding
   std::vector<EmittedOutput> outputs;    // gl_Position first, then by location
   uint32_t captureStride = 0;
 };

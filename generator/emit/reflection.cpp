@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
+
 namespace sg {
 namespace {
 
@@ -18,7 +20,47 @@ std::string quote(const std::string& s) {
   return o + "\"";
 }
 
+// Storage buffers (docs/buffers.md) and, when the plan reads an active-target list, the
+// sparse-morph protocol.
+std::string buffersJson(const EmittedGlsl& glsl) {
+  std::string j = "  \"storage_buffers\": [";
+  for (size_t i = 0; i < glsl.buffers.size(); ++i) {
+    const auto& b = glsl.buffers[i];
+    std::string packs;
+    for (const auto& [sem, comps] : b.packs)
+      packs += fmt::format("{}{{\"semantic\": {}, \"components\": {}}}", packs.empty() ? "" : ", ", quote(sem), quote(comps));
+    j += fmt::format("{}\n    {{\"name\": {}, \"semantic\": {}, \"set\": 0, \"binding\": {}, \"layout\": \"std430\", "
+                     "\"element\": {}, \"stride\": {}, \"indexing\": {}, \"count\": {}, \"element_index\": {}, "
+                     "\"size_bytes\": {}, \"holds\": [{}]}}",
+                     i ? "," : "", quote(b.name + "_data"), quote(b.semantic), b.binding,
+                     quote(std::string(glslName(b.element))), b.strideBytes, quote(b.perVertex ? "per_vertex" : "array"),
+                     b.count, quote(b.perVertex ? fmt::format("vertex * {} + i", b.count) : "i"),
+                     quote(b.perVertex ? fmt::format("vertex_count * {}", b.count * b.strideBytes)
+                                       : std::to_string(b.count * b.strideBytes)),
+                     packs);
+  }
+  j += glsl.buffers.empty() ? "],\n" : "\n  ],\n";
+  return j;
+}
+
 }  // namespace
+
+std::string buffersHeader(const EmittedGlsl& glsl, const std::string& symbol) {
+  std::string h;
+  if (glsl.buffers.empty()) return h;
+  h += "\n// Storage buffers (set 0, std430; docs/buffers.md): binding, element stride in bytes,\n"
+       "// elements per vertex (per-vertex buffers: element (vertex, i) at vertex * COUNT + i)\n"
+       "// or elements (palettes: element i at i).\n";
+  std::string prefix;
+  for (char c : symbol) prefix += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  for (const auto& b : glsl.buffers) {
+    std::string name = prefix + "_";
+    for (char c : b.semantic) name += c == '.' ? '_' : static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    h += fmt::format("#define {}_BINDING {}u\n#define {}_STRIDE {}u\n#define {}_COUNT {}u\n", name, b.binding, name,
+                     b.strideBytes, name, b.count);
+  }
+  return h;
+}
 
 std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spirv) {
   std::string j = "{\n  \"rig\": " + quote(rig.name) + ",\n  \"inputs\": [";
@@ -51,7 +93,9 @@ std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvM
                      i ? "," : "", quote(u.name), quote(ru.semantic), quote(std::string(glslName(ru.type))),
                      ru.arraySize, l ? l->offset : 0, l ? l->arrayStride : 0, l ? l->matrixStride : 0);
   }
-  j += "\n  ]},\n  \"outputs\": [";
+  j += "\n  ]},\n";
+  j += buffersJson(glsl);
+  j += "  \"outputs\": [";
   for (size_t i = 0; i < glsl.outputs.size(); ++i) {
     const auto& o = glsl.outputs[i];
     std::string sems;

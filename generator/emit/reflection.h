@@ -13,5 +13,8 @@ std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvM
 
 // A C/C++ header defining `static const uint32_t <symbol>[]` with the SPIR-V words.
 std::string spirvHeader(const std::vector<uint32_t>& words, const std::string& symbol);
+// #defines of every storage buffer's binding, stride and count ("" when there are none),
+// appended to the SPIR-V header.
+std::string buffersHeader(const EmittedGlsl& glsl, const std::string& symbol);
 
 }  // namespace sg

@@ -91,6 +91,53 @@ Plan searchStage(const LoadedInputs& in, const SearchOptions& opts, SearchStats*
     throw InputError(SourceLoc{}, e.what());
   }
   if (plan) return *plan;
+  std::vector<bool> reachable = reachableFacts(p);
+  if (std::all_of(p.goals.begin(), p.goals.end(), [&](int g) { return reachable[g]; })) {
+    // Every goal can be derived, so the device limits exclude every plan: name the limits
+    // the cheapest plan without them breaks.
+    Problem unlimited = p;
+    for (auto& l : unlimited.limits) l.max = INT64_MAX;
+    std::optional<Plan> best = findPlan(unlimited, opts);
+    std::string broken;
+    SourceLoc at{in.rig.file, 0, 0};
+    if (best) {
+      std::vector<int64_t> use = resourceUsage(p, best->actions);
+      for (size_t l = 0; l < p.limits.size(); ++l) {
+        if (use[l] <= p.limits[l].max) continue;
+        // The rig inputs on this limit, largest first; the error points at the largest.
+        std::vector<int> facts;
+        for (int a : best->actions)
+          for (int q : p.actions[a].pre) facts.push_back(q);
+        facts.insert(facts.end(), p.goals.begin(), p.goals.end());
+        std::vector<std::pair<int64_t, int>> items;  // (amount, fact)
+        std::vector<bool> seen(p.resources.size(), false);
+        for (int f : facts) {
+          int r = p.facts[f].resource;
+          if (r < 0 || seen[r] || p.resources[r].limit != static_cast<int>(l)) continue;
+          seen[r] = true;
+          items.emplace_back(p.resources[r].amount, f);
+        }
+        std::stable_sort(items.begin(), items.end(), [](auto& x, auto& y) { return x.first > y.first; });
+        std::string list;
+        for (size_t i = 0; i < items.size() && i < 4; ++i)
+          list += fmt::format("{}{} {}", i ? ", " : "", p.resources[p.facts[items[i].second].resource].name,
+                              items[i].first);
+        if (items.size() > 4) list += ", ...";
+        if (!items.empty() && at.line == 0) {
+          const Fact& f = p.facts[items[0].second];
+          if (f.source == Fact::Source::Uniform) at = in.rig.uniforms[f.rigIndex].loc;
+          else if (f.source == Fact::Source::Attribute) at = in.rig.attributes[f.rigIndex].loc;
+        }
+        broken += fmt::format("{}{} ({})", broken.empty() ? "" : "; ", describeExceeded(p, use, static_cast<int>(l)),
+                              list);
+      }
+    }
+    throw InputError(at,
+                     fmt::format("no plan for rig '{}' fits the device limits: the cheapest plan reads {}; no "
+                                 "alternative rule (rules/buffers.yaml reads morph targets, influences and bones "
+                                 "from storage buffers) stays within them",
+                                 in.rig.name, broken.empty() ? "more than the limits allow" : broken));
+  }
   if (std::vector<Diagnostic> all = unreachableInputs(in); !all.empty()) throwAll(std::move(all));
   std::string why = formatUnreachable(p, analyzeUnreachable(p, in.rules, in.varyings));
   // Point at the first fragment input whose request cannot be met.
@@ -192,6 +239,8 @@ GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts) {
 GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const GenerateOptions& opts) {
   GenerateResult res;
   if (!opts.bannedRules.empty()) in.problem = withoutRules(in.problem, opts.bannedRules);
+  setDeviceLimits(in.problem, opts.maxAttributes, opts.maxUniformBlockBytes, opts.maxStorageBuffers);
+  dropOversizedBuffers(in.problem, opts.maxVertices, opts.maxStorageBufferBytes);
   res.plan = searchStage(in, SearchOptions{opts.searchEngine, opts.heuristic, opts.searchLimits}, &res.stats);
   EmitOptions eo;
   eo.capture = opts.capture;

@@ -43,6 +43,14 @@ struct GenerateOptions {
   // The uniform block must fit the device's maxUniformBufferRange; 16384 bytes is what
   // every Vulkan device guarantees (docs/limits.md). A known device may raise it.
   uint32_t maxUniformBlockBytes = kVulkanMinUniformBufferRange;
+  // Vertex input attributes the plan may read (maxVertexInputAttributes; 16 guaranteed).
+  // Like the uniform block, a constraint of the search (docs/search.md, "Resource limits").
+  int maxAttributes = static_cast<int>(kVulkanMinVertexAttributes);
+  int maxStorageBuffers = static_cast<int>(kVulkanMinStorageBuffers);  // maxPerStageDescriptorStorageBuffers
+  // The most vertices one draw has (0 = unknown): per-vertex storage buffers larger than
+  // maxStorageBufferBytes for that many vertices are not used (docs/buffers.md).
+  int64_t maxVertices = 0;
+  int64_t maxStorageBufferBytes = int64_t{1} << 27;  // maxStorageBufferRange every device has
 };
 
 struct GenerateResult {

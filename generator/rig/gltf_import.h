@@ -18,11 +18,12 @@ class Model;
 
 namespace sg {
 
-// The bone palette is one uniform array of mat4: 256 × 64 B = 16 KiB, Vulkan's guaranteed
-// maxUniformBufferRange (16384). Skins with more joints are rejected with a diagnostic.
-constexpr int kMaxBonePalette = 256;
-// Influences per vertex the rules serve: two JOINTS_n/WEIGHTS_n sets of 4.
-constexpr int kMaxInfluenceSets = 2;
+// Joints of a skin: kMaxBones (1024). Up to 256 fit the uniform block (16 KiB, Vulkan's
+// guaranteed maxUniformBufferRange); larger palettes go through a storage buffer
+// (rules/buffers.yaml), chosen by the search. Skins with more joints are rejected.
+constexpr int kMaxBonePalette = kMaxBones;
+// Influences per vertex the rules serve: four JOINTS_n/WEIGHTS_n sets of 4 (kMaxInfluences).
+constexpr int kMaxInfluenceSets = kMaxInfluences / 4;
 
 // Hostile-input limits (docs/limits.md), each checked before the memory it guards is used.
 // The model file and each buffer file it names.

@@ -15,6 +15,10 @@ namespace sg {
 // Limits of a rig file (docs/limits.md); deformer parameters are 0..65535.
 constexpr size_t kMaxRigNameBytes = 256;
 constexpr int kMaxMorphTargets = 256;
+// Bone influences per vertex (four JOINTS_n/WEIGHTS_n sets) and joints in a skin: the
+// storage-buffer forms of rules/buffers.yaml serve these (docs/buffers.md).
+constexpr int kMaxInfluences = 16;
+constexpr int kMaxBones = 1024;
 constexpr size_t kMaxRigAttributes = 64;
 constexpr size_t kMaxRigUniforms = 256;
 

@@ -121,8 +121,13 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
   }
   if (rig.morphTargets() > kMaxMorphTargets)
     throw InputError(rig.paramLocs["morph_targets"], fmt::format("at most {} morph targets are supported", kMaxMorphTargets));
-  if (rig.param("influences") > 8)
-    throw InputError(rig.paramLocs["influences"], "at most 8 bone influences per vertex are supported");
+  if (rig.param("influences") > kMaxInfluences)
+    throw InputError(rig.paramLocs["influences"],
+                     fmt::format("at most {} bone influences per vertex are supported, got {} (kMaxInfluences)",
+                                 kMaxInfluences, rig.param("influences")));
+  if (rig.param("bones") > kMaxBones)
+    throw InputError(rig.paramLocs["bones"], fmt::format("at most {} bones are supported, got {} (kMaxBones)",
+                                                         kMaxBones, rig.param("bones")));
 
   if (!root["attributes"]) y.fail(root, "missing 'attributes'");
   y.expectMap(root["attributes"], "'attributes'");

@@ -28,6 +28,10 @@ struct SemanticDecl {
   int arraySize = 0;       // uniform arrays (mat4[bones]): resolved against the rig, 0 = scalar
   std::string arrayParam;  // rig parameter giving the uniform array size
   Expr count;              // indexed family (morph.position[i]): instance count expression
+  // `buffer_of:` (docs/buffers.md): this semantic is a storage buffer holding every instance
+  // of these families (packed per element, in order) or of one uniform array; snippets
+  // read it as a function, ${name}(i).
+  std::vector<std::string> bufferOf;
   std::string doc;
   SourceLoc loc;
   // What the value is (docs/validation.md, "Definitions"): a formula over other semantics,

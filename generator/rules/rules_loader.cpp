@@ -136,12 +136,20 @@ void loadSemantics(RuleSet& set, const YamlCtx& y, const YAML::Node& sems, const
       typeName = body.Scalar();
     } else {
       y.expectMap(body, "a semantic declaration");
-      y.checkKeys(body, {"type", "count", "array", "doc", "definition", "kind", "range"});
+      y.checkKeys(body, {"type", "count", "array", "doc", "definition", "kind", "range", "buffer_of"});
       if (!body["type"]) y.fail(body, fmt::format("semantic '{}' has no 'type'", d.name));
       typeName = y.scalar(body["type"], "'type'");
       if (body["count"]) d.count = Expr::parse(y.scalar(body["count"], "'count'"), exprLoc(body["count"], y.file));
       if (body["array"]) d.arrayParam = y.scalar(body["array"], "'array'");
       if (body["doc"]) d.doc = y.scalar(body["doc"], "'doc'");
+      if (YAML::Node b = body["buffer_of"]) {
+        if (b.IsScalar()) d.bufferOf.push_back(b.Scalar());
+        else {
+          y.expectSeq(b, "'buffer_of'");
+          for (const auto& e : b) d.bufferOf.push_back(y.scalar(e, "a semantic in 'buffer_of'"));
+        }
+        if (d.bufferOf.empty()) y.fail(b, fmt::format("semantic '{}': 'buffer_of' lists no semantic", d.name));
+      }
       loadSemanticDefinition(d, y, body, raw);
     }
     auto t = parseType(typeName);

@@ -91,7 +91,8 @@ std::optional<Plan> integerProgramSearch(const Problem& p, SearchStats* stats, c
       if (!isInit[q]) succ[q].push_back(p.actions[a].add);
     }
   }
-  if (cols == 0) return finish(Plan{});  // every goal provided (GLPK rejects empty programs)
+  if (cols == 0)  // every goal provided (GLPK rejects empty programs)
+    return finish(exceededLimit(p, resourceUsage(p, {})) < 0 ? std::optional<Plan>(Plan{}) : std::nullopt);  // every goal provided (GLPK rejects empty programs)
   std::vector<int> comp = components(nf, succ);
   std::vector<int> compSize(nf + 1, 0);
   for (int f = 0; f < nf; ++f) ++compSize[comp[f]];
@@ -161,6 +162,42 @@ std::optional<Plan> integerProgramSearch(const Problem& p, SearchStats* stats, c
         }
       double big = compSize[comp[q]];
       row(1 - big, {{tCol[act.add], 1}, {tCol[q], -1}, {x, -big}});  // t_add - t_q >= 1 - M(1 - x)
+    }
+  }
+  // Device limits: z_i = 1 if the plan reads resource item i (z_i >= x_a for every action
+  // reading it; 1 for items of pass-through goals); per limit, sum amount_i z_i <= max.
+  // Only when reading every item could break a limit (as in the regression engine).
+  std::vector<int> zCol(p.resources.size(), 0);
+  std::vector<std::vector<int>> readers(p.resources.size());
+  std::vector<bool> goalItem(p.resources.size(), false);
+  for (size_t i = 0; i < acts.size(); ++i)
+    for (int q : p.actions[acts[i]].pre)
+      if (isInit[q] && p.facts[q].resource >= 0) readers[p.facts[q].resource].push_back(static_cast<int>(i) + 1);
+  for (int g : p.goals)
+    if (isInit[g] && p.facts[g].resource >= 0) goalItem[p.facts[g].resource] = true;
+  std::vector<int64_t> all(p.limits.size(), 0);
+  for (size_t r = 0; r < p.resources.size(); ++r)
+    if ((!readers[r].empty() || goalItem[r]) && static_cast<size_t>(p.resources[r].limit) < all.size())
+      all[p.resources[r].limit] += p.resources[r].amount;
+  if (exceededLimit(p, all) >= 0) {
+    for (size_t r = 0; r < p.resources.size(); ++r) {
+      if (readers[r].empty() && !goalItem[r]) continue;
+      zCol[r] = ++cols;
+      glp_add_cols(P, 1);
+      glp_set_col_kind(P, cols, GLP_BV);
+      if (goalItem[r]) glp_set_col_bnds(P, cols, GLP_FX, 1, 1);
+      for (int x : readers[r]) row(0, {{zCol[r], 1}, {x, -1}});
+    }
+    for (size_t l = 0; l < p.limits.size(); ++l) {
+      if (p.limits[l].max == INT64_MAX) continue;
+      glp_add_rows(P, 1);
+      glp_set_row_bnds(P, ++rows, GLP_UP, 0, static_cast<double>(p.limits[l].max));
+      for (size_t r = 0; r < p.resources.size(); ++r)
+        if (zCol[r] && static_cast<size_t>(p.resources[r].limit) == l) {
+          ia.push_back(rows);
+          ja.push_back(zCol[r]);
+          ar.push_back(static_cast<double>(p.resources[r].amount));
+        }
     }
   }
   glp_load_matrix(P, static_cast<int>(ia.size()) - 1, ia.data(), ja.data(), ar.data());

@@ -55,6 +55,7 @@ class Builder {
     std::sort(p_.goals.begin(), p_.goals.end());
     p_.goals.erase(std::unique(p_.goals.begin(), p_.goals.end()), p_.goals.end());
     std::sort(p_.init.begin(), p_.init.end());
+    setDeviceLimits(p_, kVulkanMinVertexAttributes, kVulkanMinUniformBytes, kVulkanMinStorageBuffers);
     return std::move(p_);
   }
 
@@ -122,6 +123,9 @@ class Builder {
           int f = factOrFail(name, attr.loc, fmt::format("attribute '{}' provides", attr.name).c_str());
           provide(f, Fact::Source::Attribute, static_cast<int>(a), attr.perMorphTarget ? t : -1, part.swizzle, *have,
                   attr.loc);
+          p_.facts[f].resource = resourceFor(attr.perMorphTarget ? fmt::format("attribute a_{}{}", attr.name, t)
+                                                                 : "attribute a_" + attr.name,
+                                             kLimitAttributes, 1);
         }
     }
     for (size_t u = 0; u < rig_.uniforms.size(); ++u) {
@@ -134,7 +138,92 @@ class Builder {
                                              fact.arraySize ? fmt::format("an array of {}", fact.arraySize) : "not an array",
                                              un.arraySize ? fmt::format("an array of {}", un.arraySize) : "not an array"));
       provide(f, Fact::Source::Uniform, static_cast<int>(u), -1, "", un.type, un.loc);
+      p_.facts[f].resource = resourceFor("uniform u_" + un.name, kLimitUniformBytes, std140Bytes(un.type, un.arraySize));
     }
+    for (const auto& d : rules_.semantics)
+      if (!d.bufferOf.empty()) provideBuffer(d);
+  }
+
+  // A `buffer_of:` semantic is provided when the rig provides every instance of what it
+  // packs: families of attributes (per-vertex buffers) or one uniform array (a palette).
+  void provideBuffer(const SemanticDecl& d) {
+    BufferSource b;
+    b.fact = index_.at(d.name);
+    const ScalarKind kind = scalarKind(d.type);
+    int components = 0;
+    for (const auto& name : d.bufferOf) {
+      const SemanticDecl* src = rules_.findSemantic(name);
+      if (!src) throw InputError(d.loc, fmt::format("semantic '{}': buffer_of names unknown semantic '{}'", d.name, name));
+      if (scalarKind(src->type) != kind)
+        throw InputError(d.loc, fmt::format("semantic '{}' is {} but '{}' is {}", d.name, glslName(d.type), name,
+                                            glslName(src->type)));
+      if (!src->arrayParam.empty()) {  // a uniform array
+        if (d.bufferOf.size() != 1 || src->type != d.type)
+          throw InputError(d.loc, fmt::format("semantic '{}': a buffer of uniform array '{}' holds only it, as {}",
+                                              d.name, name, glslName(src->type)));
+        int f = index_.at(name);
+        if (p_.facts[f].source != Fact::Source::Uniform) return;
+        b.kind = BufferSource::Kind::Array;
+        b.uniform = p_.facts[f].rigIndex;
+        b.count = p_.facts[f].arraySize;
+        b.element = d.type;
+        break;
+      }
+      auto fam = shape_.families.find(name);
+      if (fam == shape_.families.end())
+        throw InputError(d.loc, fmt::format("semantic '{}': buffer_of '{}' is neither a family (count:) nor a "
+                                            "uniform array", d.name, name));
+      if (!b.parts.empty() && fam->second != b.count)
+        throw InputError(d.loc, fmt::format("semantic '{}': families '{}' and '{}' have different counts", d.name,
+                                            b.parts[0].family, name));
+      b.count = fam->second;
+      BufferSource::Part part{name, componentCount(src->type), components, {}};
+      for (int64_t i = 0; i < fam->second; ++i) {
+        int f = index_.at(indexedName(name, i));
+        if (p_.facts[f].source != Fact::Source::Attribute) return;  // the rig lacks an instance
+        part.facts.push_back(f);
+      }
+      components += part.components;
+      b.parts.push_back(std::move(part));
+    }
+    if (b.kind == BufferSource::Kind::PerVertex) {
+      if (components != componentCount(d.type))
+        throw InputError(d.loc, fmt::format("semantic '{}' is {} but buffer_of packs {} components", d.name,
+                                            glslName(d.type), components));
+      if (b.count == 0) return;
+      b.element = kind == ScalarKind::UInt ? Type::UVec4 : kind == ScalarKind::Int ? Type::IVec4 : Type::Vec4;
+      // Tight floats for vec3/vec2/float: a 52-target face at 180k vertices must stay
+      // within maxStorageBufferRange (2^27 bytes guaranteed).
+      if (kind == ScalarKind::Float && components < 4) b.element = Type::Float;
+      b.components = b.element == Type::Float ? components : 4;
+      b.strideBytes = 4 * b.components;
+    } else {
+      b.components = 16;
+      b.strideBytes = 64;
+    }
+    Fact& fact = p_.facts[b.fact];
+    if (b.kind == BufferSource::Kind::PerVertex && b.element == Type::Float && components == 4) b.element = Type::Vec4;
+    fact.source = Fact::Source::Buffer;
+    fact.rigIndex = static_cast<int>(p_.buffers.size());
+    fact.resource = resourceFor("storage buffer " + d.name, kLimitStorageBuffers, 1);
+    p_.init.push_back(b.fact);
+    p_.buffers.push_back(std::move(b));
+  }
+
+  int resourceFor(const std::string& name, int limit, int64_t amount) {
+    for (size_t i = 0; i < p_.resources.size(); ++i)
+      if (p_.resources[i].name == name) return static_cast<int>(i);
+    p_.resources.push_back(ResourceItem{name, limit, amount});
+    return static_cast<int>(p_.resources.size()) - 1;
+  }
+
+  // Bytes a uniform adds to a std140 block, rounded up to 16: exact for arrays and
+  // matrices (their std140 stride is a multiple of 16), an over-estimate by at most 12
+  // bytes for a lone scalar or vector that could pack after another member. Additive, so
+  // the search and the integer program can sum it (docs/search.md).
+  static int64_t std140Bytes(Type t, int arraySize) {
+    int64_t element = t == Type::Mat4 ? 64 : t == Type::Mat3 ? 48 : 16;
+    return element * std::max(1, arraySize);
   }
 
   void instantiate(int r) {
@@ -173,6 +262,53 @@ class Builder {
 
 Problem buildProblem(const Rig& rig, const RuleSet& rules, const std::vector<Varying>& varyings) {
   return Builder(rig, rules).build(varyings);
+}
+
+void setDeviceLimits(Problem& p, int64_t maxAttributes, int64_t maxUniformBytes, int64_t maxStorageBuffers) {
+  p.limits.assign(3, ResourceLimit{});
+  p.limits[kLimitStorageBuffers] =
+      ResourceLimit{"storage buffers", "maxPerStageDescriptorStorageBuffers", maxStorageBuffers};
+  p.limits[kLimitAttributes] = ResourceLimit{"vertex input attributes", "--max-attributes", maxAttributes};
+  p.limits[kLimitUniformBytes] =
+      ResourceLimit{"uniform block bytes (std140, members rounded to 16)", "maxUniformBufferRange", maxUniformBytes};
+}
+
+void dropOversizedBuffers(Problem& p, int64_t maxVertices, int64_t maxBytes) {
+  if (maxVertices <= 0) return;
+  for (const auto& b : p.buffers) {
+    if (b.kind != BufferSource::Kind::PerVertex) continue;
+    // Checked in long double: vertices x count x stride can pass 2^63 for hostile options.
+    long double bytes = static_cast<long double>(maxVertices) * b.count * b.strideBytes;
+    if (bytes <= static_cast<long double>(maxBytes)) continue;
+    p.facts[b.fact].source = Fact::Source::Computed;
+    p.init.erase(std::remove(p.init.begin(), p.init.end(), b.fact), p.init.end());
+  }
+}
+
+std::vector<int64_t> resourceUsage(const Problem& p, const std::vector<int>& actions) {
+  std::vector<bool> seen(p.resources.size(), false);
+  std::vector<int64_t> usage(p.limits.size(), 0);
+  auto read = [&](int f) {
+    int r = p.facts[f].resource;
+    if (r < 0 || seen[r]) return;
+    seen[r] = true;
+    if (static_cast<size_t>(p.resources[r].limit) < usage.size()) usage[p.resources[r].limit] += p.resources[r].amount;
+  };
+  for (int a : actions)
+    for (int q : p.actions[a].pre) read(q);
+  for (int g : p.goals) read(g);
+  return usage;
+}
+
+int exceededLimit(const Problem& p, const std::vector<int64_t>& usage) {
+  for (size_t l = 0; l < p.limits.size() && l < usage.size(); ++l)
+    if (usage[l] > p.limits[l].max) return static_cast<int>(l);
+  return -1;
+}
+
+std::string describeExceeded(const Problem& p, const std::vector<int64_t>& usage, int limit) {
+  const ResourceLimit& l = p.limits[limit];
+  return fmt::format("{} {}, above the limit of {} ({})", usage[limit], l.what, l.max, l.option);
 }
 
 Problem withoutRules(const Problem& p, const std::vector<std::string>& ruleNames) {

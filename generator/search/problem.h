@@ -17,14 +17,58 @@ struct RuleSet;
 struct Varying;
 
 struct Fact {
-  enum class Source { Computed, Attribute, Uniform };
+  enum class Source { Computed, Attribute, Uniform, Buffer };
   std::string name;  // "world.normal", "morph.position[3]"
   Type type = Type::Vec3;
   int arraySize = 0;  // uniform arrays
   Source source = Source::Computed;
-  int rigIndex = -1;    // attribute or uniform index in the rig
+  int rigIndex = -1;    // attribute or uniform index in the rig; Buffer: index in Problem::buffers
   int target = -1;      // morph target of a per-target attribute
   std::string swizzle;  // part of the attribute ("" = whole)
+  int resource = -1;    // the ResourceItem reading this fact occupies (-1: none)
+};
+
+// Device limits are constraints, not costs (docs/search.md, "Resource limits"). Every rig
+// input a plan reads occupies a resource item (an attribute stream takes vertex input
+// locations, a uniform takes bytes of the uniform block); a plan's usage of a limit is the
+// sum over the distinct items its rules' needs and its pass-through goals read.
+constexpr int64_t kVulkanMinVertexAttributes = 16;  // maxVertexInputAttributes every device has
+constexpr int64_t kVulkanMinUniformBytes = 16384;   // maxUniformBufferRange every device has
+struct ResourceLimit {
+  std::string what;    // "vertex input attributes"
+  std::string option;  // how the user raises it: "--max-attributes"
+  int64_t max = INT64_MAX;
+};
+struct ResourceItem {
+  std::string name;  // "attribute a_coord_morph3", "uniform u_bone_xf"
+  int limit = 0;     // index in Problem::limits
+  int64_t amount = 0;
+};
+enum ResourceLimitIndex { kLimitAttributes = 0, kLimitUniformBytes = 1, kLimitStorageBuffers = 2 };
+constexpr int64_t kVulkanMinStorageBuffers = 4;  // maxPerStageDescriptorStorageBuffers every device has
+
+// A storage buffer the rig's data can fill (a `buffer_of:` semantic, docs/buffers.md).
+// PerVertex: element (vertex v, instance i) at index v * count + i, each element packing
+// one instance of every family in `parts` (facts[i] of each part). Array: the elements
+// of one uniform array (a joint palette), element i at index i.
+struct BufferSource {
+  enum class Kind { PerVertex, Array };
+  Kind kind = Kind::PerVertex;
+  int fact = -1;       // the buffer semantic's fact
+  int64_t count = 0;   // instances per vertex (PerVertex) or elements (Array)
+  // std430 array element: float (1-3 float components packed tightly, `components` floats
+  // per instance), vec4, uvec4, ivec4 or mat4.
+  Type element = Type::Vec4;
+  int components = 4;       // floats (or uints) per instance
+  int64_t strideBytes = 16;  // bytes per instance
+  struct Part {
+    std::string family;      // "morph.normal"
+    int components = 0;      // of the element, from `firstComponent`
+    int firstComponent = 0;
+    std::vector<int> facts;  // the family's instances (rig attribute facts)
+  };
+  std::vector<Part> parts;  // PerVertex
+  int uniform = -1;         // Array: the rig uniform whose values it holds
 };
 
 // One line of instantiated snippet. Fact references are encoded as
@@ -56,6 +100,9 @@ struct Problem {
   std::vector<int> goals;  // requested facts (sorted, unique)
   // Rules skipped at instantiation and why (for explain/check): "when is false", ...
   std::vector<std::pair<int, std::string>> skippedRules;
+  std::vector<ResourceLimit> limits;  // empty: unconstrained (random libraries, tests)
+  std::vector<ResourceItem> resources;
+  std::vector<BufferSource> buffers;
 
   int findFact(const std::string& name) const;  // -1 if absent
 };
@@ -64,6 +111,23 @@ struct Problem {
 // inconsistent inputs (rig semantics unknown to the rules, type mismatches, bad snippet
 // templates, references to semantics not listed in `needs`, negative costs).
 Problem buildProblem(const Rig& rig, const RuleSet& rules, const std::vector<Varying>& varyings);
+
+// The device limits of a generation: vertex input attributes (Vulkan guarantees 16) and
+// uniform block bytes (maxUniformBufferRange, 16384 guaranteed).
+void setDeviceLimits(Problem& p, int64_t maxAttributes, int64_t maxUniformBytes,
+                     int64_t maxStorageBuffers = kVulkanMinStorageBuffers);
+
+// Per-vertex storage buffers larger than `maxBytes` for draws of up to `maxVertices`
+// vertices (maxStorageBufferRange, 2^27 guaranteed) are not offered: their facts stop being
+// provided, so the search uses other forms. maxVertices <= 0: vertex count unknown, keep all.
+void dropOversizedBuffers(Problem& p, int64_t maxVertices, int64_t maxBytes);
+
+// Usage per limit of the rig inputs a set of actions (and the goals) read.
+std::vector<int64_t> resourceUsage(const Problem& p, const std::vector<int>& actions);
+// The first limit the usage exceeds, or -1.
+int exceededLimit(const Problem& p, const std::vector<int64_t>& usage);
+// "21 vertex input attributes, above the limit of 16 (--max-attributes)".
+std::string describeExceeded(const Problem& p, const std::vector<int64_t>& usage, int limit);
 
 // Same problem without the actions of the named rules (to force alternatives).
 Problem withoutRules(const Problem& p, const std::vector<std::string>& ruleNames);

@@ -20,6 +20,7 @@ struct RankedTask {
     int add;     // rank
     int64_t cost;
     int preBegin, preEnd;  // ranks of non-init preconditions in `pre`
+    int itemBegin, itemEnd;  // resource items of its init preconditions in `items`
   };
   int n = 0;      // ranked facts
   int words = 0;  // 64-bit words of an open-set bitset
@@ -32,6 +33,13 @@ struct RankedTask {
   std::vector<int64_t> cheapest, hmax;  // per rank: cheapest achiever, h_max from init
   bool unsolvable = false;
   bool cyclic = false;
+  // Resource items (Problem::resources) that can break a limit; none when no plan could.
+  int itemWords = 0;
+  std::vector<int> items;       // ops' items, by Op::itemBegin/itemEnd
+  std::vector<int> goalItems;   // items of goals the rig provides (read by every plan)
+  // Per rank, itemWords words: items every derivation of the fact reads (resource
+  // landmarks), for pruning partial plans that no completion can keep within the limits.
+  std::vector<uint64_t> itemLandmarks;
 
   const uint64_t* landmarksOf(int r) const { return &landmarks[static_cast<size_t>(r) * words]; }
 };
@@ -98,12 +106,47 @@ RankedTask rankTask(const Problem& p) {
     for (int q : act.pre)
       if (!isInit[q]) t.pre.push_back(rankOf[q]);
     op.preEnd = static_cast<int>(t.pre.size());
+    op.itemBegin = static_cast<int>(t.items.size());
+    for (int q : act.pre)
+      if (isInit[q] && p.facts[q].resource >= 0) t.items.push_back(p.facts[q].resource);
+    std::sort(t.items.begin() + op.itemBegin, t.items.end());
+    t.items.erase(std::unique(t.items.begin() + op.itemBegin, t.items.end()), t.items.end());
+    op.itemEnd = static_cast<int>(t.items.size());
     t.ops.push_back(op);
     ++t.achBegin[op.add + 1];
   }
   for (int r = 0; r < t.n; ++r) t.achBegin[r + 1] += t.achBegin[r];
   for (int g : p.goals)
     if (!isInit[g]) t.goals.push_back(rankOf[g]);
+    else if (p.facts[g].resource >= 0) t.goalItems.push_back(p.facts[g].resource);
+  // Resources join the state only if reading every item of the relevant rules could break
+  // a limit; otherwise the search is the unconstrained one.
+  std::vector<int64_t> all(p.limits.size(), 0);
+  std::vector<bool> counted(p.resources.size(), false);
+  auto count = [&](int i) {
+    if (counted[i]) return;
+    counted[i] = true;
+    if (static_cast<size_t>(p.resources[i].limit) < all.size()) all[p.resources[i].limit] += p.resources[i].amount;
+  };
+  for (int i : t.items) count(i);
+  for (int i : t.goalItems) count(i);
+  if (exceededLimit(p, all) >= 0) t.itemWords = static_cast<int>((p.resources.size() + 63) / 64);
+  if (t.itemWords) {
+    const size_t IW = static_cast<size_t>(t.itemWords);
+    t.itemLandmarks.assign(static_cast<size_t>(t.n) * IW, 0);
+    std::vector<uint64_t> acc(IW);
+    for (int r = 0; r < t.n; ++r) {
+      uint64_t* lm = &t.itemLandmarks[static_cast<size_t>(r) * IW];
+      for (int o = t.achBegin[r]; o < t.achBegin[r + 1]; ++o) {
+        const auto& op = t.ops[o];
+        std::fill(acc.begin(), acc.end(), 0);
+        for (int i = op.itemBegin; i < op.itemEnd; ++i) acc[static_cast<size_t>(t.items[i]) >> 6] |= uint64_t{1} << (t.items[i] & 63);
+        for (int i = op.preBegin; i < op.preEnd; ++i)
+          for (size_t w = 0; w < IW; ++w) acc[w] |= t.itemLandmarks[static_cast<size_t>(t.pre[i]) * IW + w];
+        for (size_t w = 0; w < IW; ++w) lm[w] = o == t.achBegin[r] ? acc[w] : (lm[w] & acc[w]);
+      }
+    }
+  }
   // Per rank, in ascending order (preconditions first): landmarks, cheapest achiever, h_max.
   t.landmarks.assign(static_cast<size_t>(t.n) * t.words, 0);
   t.cheapest.assign(t.n, kInfiniteCost);
@@ -301,9 +344,15 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
   const RankedTask t = rankTask(p);
   if (t.cyclic) throw std::invalid_argument("regression search needs an acyclic relevant rule graph");
   st.relevantActions = static_cast<int64_t>(t.ops.size());
-  std::vector<uint64_t> states;  // node i's open set: words [i * W, (i + 1) * W)
+  // Node i's state: its open set (W words), then the resource items its decisions read
+  // (t.itemWords words, none when no limit can bind) and its usage per limit: two partial
+  // plans with the same open set but different items are different states, since the
+  // items decide which completions still fit (docs/search.md, "Resource limits").
+  std::vector<uint64_t> states;
+  std::vector<int64_t> usage;  // node i's usage: [i * L, (i + 1) * L)
   std::vector<Node> nodes;
-  const size_t W = static_cast<size_t>(t.words);
+  const size_t OW = static_cast<size_t>(t.words), W = OW + static_cast<size_t>(t.itemWords);
+  const size_t L = t.itemWords ? p.limits.size() : 0;
   auto stateOf = [&](int i) { return states.data() + static_cast<size_t>(i) * W; };
   auto hashOf = [&](int i) {
     uint64_t h = 1469598103934665603ull;
@@ -328,6 +377,43 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
   auto estimate = [&](const uint64_t* s) { return timed(st.heuristicSeconds, [&] { return h.estimate(s); }); };
   states.assign(W, 0);
   for (int g : t.goals) states[static_cast<size_t>(g) >> 6] |= uint64_t{1} << (g & 63);
+  usage.assign(L, 0);
+  // Reads `items` into the state words at `s` (resource part) and `use`; false if a limit breaks.
+  auto readItems = [&](uint64_t* s, int64_t* use, const int* begin, const int* end) {
+    if (!L) return true;
+    for (const int* it = begin; it != end; ++it) {
+      uint64_t& w = s[OW + (static_cast<size_t>(*it) >> 6)];
+      const uint64_t bit = uint64_t{1} << (*it & 63);
+      if (w & bit) continue;
+      w |= bit;
+      const ResourceItem& item = p.resources[*it];
+      if (static_cast<size_t>(item.limit) >= L) continue;
+      use[item.limit] += item.amount;
+      if (use[item.limit] > p.limits[item.limit].max) return false;
+    }
+    return true;
+  };
+  // Whether the items every completion must still read (the open facts' resource
+  // landmarks) fit next to those already read.
+  std::vector<uint64_t> extra(static_cast<size_t>(t.itemWords));
+  auto landmarksFit = [&](const uint64_t* s, const int64_t* use) {
+    const size_t IW = static_cast<size_t>(t.itemWords);
+    std::fill(extra.begin(), extra.end(), 0);
+    forEachBit(s, t.words, [&](int r) {
+      for (size_t w = 0; w < IW; ++w) extra[w] |= t.itemLandmarks[static_cast<size_t>(r) * IW + w];
+    });
+    std::vector<int64_t> more(use, use + L);
+    for (size_t w = 0; w < IW; ++w) extra[w] &= ~s[OW + w];
+    bool fits = true;
+    forEachBit(extra.data(), t.itemWords, [&](int i) {
+      const ResourceItem& item = p.resources[i];
+      if (static_cast<size_t>(item.limit) < L && (more[item.limit] += item.amount) > p.limits[item.limit].max)
+        fits = false;
+    });
+    return fits;
+  };
+  if (!readItems(states.data(), usage.data(), t.goalItems.data(), t.goalItems.data() + t.goalItems.size()))
+    return finish(std::nullopt);  // the pass-through inputs alone break a limit
   int64_t h0 = estimate(stateOf(0));
   st.initialH = h0;
   nodes.push_back(Node{0, h0, -1, -1, false});
@@ -335,13 +421,14 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
   int64_t seq = 0;
   open.push(OpenEntry{h0, 0, seq++, 0});
   std::vector<uint64_t> child(W);
+  std::vector<int64_t> childUse(L);
 
   while (!open.empty()) {
     OpenEntry e = open.top();
     open.pop();
     if (nodes[e.node].closed || e.g != nodes[e.node].g) continue;  // stale entry
     nodes[e.node].closed = true;
-    const int top = topOf(stateOf(e.node), t.words);
+    const int top = topOf(stateOf(e.node), t.words);  // the open-set part only
     if (top < 0) {
       // Walking back from the goal lists each decision after those of its preconditions.
       std::vector<int> order;
@@ -356,6 +443,11 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
       child[static_cast<size_t>(top) >> 6] &= ~(uint64_t{1} << (top & 63));
       for (int i = op.preBegin; i < op.preEnd; ++i)
         child[static_cast<size_t>(t.pre[i]) >> 6] |= uint64_t{1} << (t.pre[i] & 63);
+      std::copy(usage.begin() + static_cast<long>(e.node * L), usage.begin() + static_cast<long>((e.node + 1) * L),
+                childUse.begin());
+      if (!readItems(child.data(), childUse.data(), t.items.data() + op.itemBegin, t.items.data() + op.itemEnd))
+        continue;  // over a device limit: no completion of this partial plan is feasible
+      if (L && !landmarksFit(child.data(), childUse.data())) continue;
       const int64_t ng = g + op.cost;
       ++st.generated;
       budget.checkTime(st.expanded);
@@ -367,7 +459,7 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
         Node& old = nodes[*it];
         if (ng >= old.g) continue;
         // Cheaper path to a known open set (LM-cut is admissible, not consistent): reopen.
-        if (old.closed) ++st.reopened;
+        if (old.closed) ++st.reopened;  // same items, so the same usage
         old = Node{ng, old.h, e.node, o, false};
         open.push(OpenEntry{ng + old.h, ng, seq++, *it});
         continue;
@@ -375,6 +467,7 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
       // Pathmax: a child's estimate never drops below its parent's less the step cost.
       int64_t hv = std::max(estimate(stateOf(id)), hParent - op.cost);
       nodes.push_back(Node{ng, hv, e.node, o, false});
+      usage.insert(usage.end(), childUse.begin(), childUse.end());
       index.insert(id);
       open.push(OpenEntry{ng + hv, ng, seq++, id});
     }

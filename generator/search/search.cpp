@@ -18,7 +18,20 @@ std::optional<Plan> findPlan(const Problem& p, const SearchOptions& opts, Search
   if (e != "auto" && e != "forward") throw std::invalid_argument("unknown search engine '" + e + "'");
   auto h = makeHeuristic(opts.heuristic, p);
   if (!h) throw std::invalid_argument("unknown heuristic '" + opts.heuristic + "' for forward search");
-  return astarSearch(p, *h, stats, opts.limits);
+  std::optional<Plan> plan = astarSearch(p, *h, stats, opts.limits);
+  // Forward states are sets of produced facts and know nothing of device limits: its plan
+  // is the cheapest overall. If that breaks a limit, the integer program (which has the
+  // limits as constraints) finds the cheapest feasible one.
+  if (plan && exceededLimit(p, resourceUsage(p, plan->actions)) >= 0) {
+    SearchStats forward = stats ? *stats : SearchStats{};
+    plan = integerProgramSearch(p, stats, opts.limits);
+    if (stats) {
+      stats->engine = "forward, then ip (the forward plan broke a device limit)";
+      stats->expanded = forward.expanded;
+      stats->generated = forward.generated;
+    }
+  }
+  return plan;
 }
 
 std::string describeStats(const SearchStats& st) {

@@ -18,7 +18,9 @@ namespace {
 const std::set<std::string>& standardUniforms() {
   static const std::set<std::string> names = {"skin.bones",   "morph.weights",          "camera.position",
                                               "camera.view",  "camera.projection",      "camera.view_projection",
-                                              "model.matrix", "dapple.matrix"};
+                                              "model.matrix", "dapple.matrix",
+                                              // derived from morph.weights (docs/buffers.md)
+                                              "morph.active_targets", "morph.active_count"};
   return names;
 }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <random>
 #include <set>
 
 #include "runtime/procedural.h"
@@ -123,6 +124,76 @@ void putMat4(std::vector<uint8_t>& block, uint32_t offset, const glm::mat4& m, u
   for (int c = 0; c < 4; ++c) putFloats(block, offset + static_cast<uint32_t>(c) * matrixStride, &m[c][0], 4);
 }
 
+// The sparse-morph protocol (docs/buffers.md): the targets with a non-zero weight, in
+// increasing order, and their count, for rigs that read them.
+void addActiveTargets(const Rig& rig, const rt::Pose& pose, UniformValues& values) {
+  std::vector<double> active;
+  for (size_t i = 0; i < pose.morphWeights.size(); ++i)
+    if (pose.morphWeights[i] != 0.0f) active.push_back(static_cast<double>(i));
+  for (const auto& u : rig.uniforms) {
+    if (u.semantic == "morph.active_count") values[u.semantic] = {static_cast<double>(active.size())};
+    if (u.semantic != "morph.active_targets") continue;
+    if (active.size() > static_cast<size_t>(u.arraySize))
+      throw InputError(u.loc, fmt::format("the pose has {} targets with a non-zero weight; the active-target list "
+                                          "holds {}", active.size(), u.arraySize));
+    std::vector<double> list = active;
+    list.resize(static_cast<size_t>(u.arraySize), 0.0);
+    values[u.semantic] = std::move(list);
+  }
+}
+
+// Element bytes of a buffer element from up to 16 float components.
+void putElement(std::vector<uint8_t>& out, size_t at, Type element, const float* comps, int n) {
+  for (int c = 0; c < n; ++c) {
+    if (element == Type::UVec4 || element == Type::IVec4) {
+      auto u = static_cast<uint32_t>(static_cast<int64_t>(std::lround(comps[c])));
+      std::memcpy(out.data() + at + 4 * static_cast<size_t>(c), &u, 4);
+    } else {
+      std::memcpy(out.data() + at + 4 * static_cast<size_t>(c), &comps[c], 4);
+    }
+  }
+}
+
+}  // namespace
+
+// Storage buffers of a generated shader (docs/buffers.md layout): per-vertex ones from
+// the mesh's streams (one zero vertex of padding: the harness draws an even count), the
+// palette from the pose.
+std::vector<rt::StorageBufferData> buildStorageBuffers(const Problem& p, const EmittedGlsl& glsl, const rt::Mesh& mesh,
+                                                       const rt::Pose& pose, bool perVertex) {
+  std::vector<rt::StorageBufferData> out;
+  for (const auto& e : glsl.buffers) {
+    const BufferSource& b = p.buffers[e.buffer];
+    rt::StorageBufferData sb;
+    sb.binding = static_cast<uint32_t>(e.binding);
+    if (b.kind == BufferSource::Kind::Array) {
+      if (!perVertex) {
+        sb.data.assign(static_cast<size_t>(b.count) * e.strideBytes, 0);
+        for (int64_t j = 0; j < b.count && j < static_cast<int64_t>(pose.bones.size()); ++j)
+          putElement(sb.data, static_cast<size_t>(j) * e.strideBytes, e.element, &pose.bones[static_cast<size_t>(j)][0][0], 16);
+        out.push_back(std::move(sb));
+      }
+      continue;
+    }
+    if (!perVertex) continue;
+    const size_t count = static_cast<size_t>(b.count);
+    sb.data.assign((mesh.vertexCount + 1) * count * e.strideBytes, 0);
+    for (const auto& part : b.parts)
+      for (size_t i = 0; i < count; ++i) {
+        const std::string sem = p.facts[part.facts[i]].name;
+        if (!mesh.has(sem)) throw InputError(SourceLoc{}, fmt::format("mesh '{}' has no data for '{}' (buffer {})", mesh.name, sem, e.name));
+        const auto& src = mesh.at(sem);
+        for (size_t v = 0; v < mesh.vertexCount; ++v)
+          putElement(sb.data, ((v * count + i) * e.strideBytes) + 4 * static_cast<size_t>(part.firstComponent), e.element,
+                     &src[v][0], part.components);
+      }
+    out.push_back(std::move(sb));
+  }
+  return out;
+}
+
+namespace {
+
 // The uniform block of one pose: every uniform of the rig from its semantic's values
 // (UniformValues: flat column-major, arrays element after element), laid out as reflected.
 std::vector<uint8_t> buildUniforms(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spv,
@@ -204,6 +275,21 @@ std::string nonFiniteReport(Interpreter& reference, const EmittedOutput& o, size
 
 }  // namespace
 
+void limitActiveTargets(const Rig& rig, std::vector<rt::Pose>& poses, uint32_t seed) {
+  for (const auto& u : rig.uniforms) {
+    if (u.semantic != "morph.active_targets") continue;
+    for (size_t k = 0; k < poses.size(); ++k) {
+      auto& w = poses[k].morphWeights;
+      std::vector<size_t> order(w.size());
+      for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+      std::mt19937 rng(seed * 7919u + static_cast<uint32_t>(k));
+      for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng() % i]);  // portable shuffle
+      const auto keep = static_cast<size_t>(std::clamp<int64_t>(rig.param("max_active_targets", u.arraySize), 0, u.arraySize));
+      for (size_t i = keep; i < order.size(); ++i) w[order[i]] = 0.0f;
+    }
+  }
+}
+
 rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh) { return quantizedMesh(rig, mesh); }
 
 rt::VertexStream vertexStream(const Rig& rig, const EmittedInput& in, const rt::Mesh& mesh) {
@@ -214,7 +300,9 @@ std::vector<uint8_t> uniformBlock(const Rig& rig, const RuleSet& rules, const Em
                                   const rt::Mesh& mesh, const rt::Pose& pose) {
   std::vector<rt::Pose> poses{pose};
   drawDeclaredUniforms(poses, rig, rules);
-  return buildUniforms(rig, glsl, spv, uniformValues(rig, rules, shapeOfRig(rig, rules), mesh, poses[0]));
+  UniformValues values = uniformValues(rig, rules, shapeOfRig(rig, rules), mesh, poses[0]);
+  addActiveTargets(rig, poses[0], values);
+  return buildUniforms(rig, glsl, spv, values);
 }
 
 ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_t seed, int poses) {
@@ -245,6 +333,7 @@ ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_
   // Hostile by default: non-uniform scale unless the rig declares it never scales so.
   const rt::PoseOptions po = rt::hostilePoseOptions(rig.param("uniform_scale") != 0);
   for (int i = 0; i < poses; ++i) s.poses.push_back(rt::makeRandomPose(s.shape, seed + static_cast<uint32_t>(i), po));
+  limitActiveTargets(rig, s.poses, seed);
   return s;
 }
 
@@ -278,6 +367,8 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
   req.vertexCount = static_cast<uint32_t>(mesh.vertexCount);
   req.capture.strideBytes = r.glsl.captureStride;
   for (const auto& in : r.glsl.inputs) req.streams.push_back(buildStream(rig, in, mesh));
+  const std::vector<rt::StorageBufferData> perVertexBuffers =
+      buildStorageBuffers(r.in.problem, r.glsl, mesh, rt::Pose{}, true);
 
   for (const auto& o : r.glsl.outputs) {
     OutputReport out;
@@ -293,7 +384,12 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
     // Uniforms: the pose's values, then those defined by a formula over them (a normal
     // matrix), rounded to float as the GPU gets them.
     UniformValues uniforms = uniformValues(rig, rules, shape, mesh, pose);
+    addActiveTargets(rig, pose, uniforms);
     req.uniformData = buildUniforms(rig, r.glsl, r.spirv, uniforms);
+    req.storageBuffers = perVertexBuffers;
+    for (auto& sb : buildStorageBuffers(r.in.problem, r.glsl, mesh, pose, false)) req.storageBuffers.push_back(std::move(sb));
+    std::sort(req.storageBuffers.begin(), req.storageBuffers.end(),
+              [](const auto& a, const auto& b) { return a.binding < b.binding; });
     rt::RunResult res = harness_->run(req);
     rep.timings.setupMs += res.timings.setupMs;
     rep.timings.uploadMs += res.timings.uploadMs;
@@ -387,6 +483,8 @@ ValidateReport Validator::run(const ValidationScene& scene) {
   report.validationLayers = harness_->validationEnabled();
   GenerateOptions gen = opts_.gen;
   gen.capture = true;
+  // The buffer forms must fit this mesh (+1: the harness draws an even count).
+  if (gen.maxVertices == 0) gen.maxVertices = static_cast<int64_t>(scene.mesh.vertexCount) + 1;
   LoadedInputs in = loadInputs(gen);
   auto t0 = Clock::now();
   GenerateResult chosen = generateFrom(in, gen);
