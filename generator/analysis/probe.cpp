@@ -40,6 +40,8 @@ ProbeRig makeDefault(const RuleSet& rules, const std::string& name, std::map<std
   pr.name = name;
   pr.params = std::move(params);
   pr.params.emplace("uniform_scale", 1);  // probe the rules that need it too
+  // Sparse morph rules size their loops by it (docs/buffers.md): a list as long as the targets.
+  pr.params.emplace("max_active_targets", pr.params.count("morph_targets") ? pr.params.at("morph_targets") : 0);
   pr.isDefault = true;
   evalFamilies(pr, rules, false);
   if (provideLeaves)
@@ -107,8 +109,19 @@ SnippetProbe buildSnippetProbe(const RuleSet& rules, int r, const ProbeRig& rig)
   s += fmt::format("// Probe of rule '{}' instantiated for {}.\n", rule.name, rig.name);
   std::map<std::string, Type> inputs;  // vertex inputs read (attribute streams)
   std::string members;                  // uniform block members
+  std::string buffers;                  // storage buffers and their accessors, as the emitter reads them
+  int binding = 1;
   for (const auto& fact : inst.needs) {
     const SemanticDecl* d = rules.findSemantic(splitIndexed(fact).first);
+    if (!d->bufferOf.empty()) {
+      const std::string n = "p_" + mangle(fact), t(glslName(d->type));
+      buffers += fmt::format(
+          "layout(set = 0, binding = {}, std430) readonly buffer ProbeBuffer{} {{\n  {} {}_data[];\n}};\n"
+          "{} {}(int i) {{ return {}_data[uint(gl_VertexIndex) + uint(i)]; }}\n",
+          binding, binding, t, n, t, n, n);
+      ++binding;
+      continue;
+    }
     if (auto st = rig.streams.find(fact); st != rig.streams.end()) {
       inputs.emplace(st->second.input, st->second.type);
       continue;
@@ -123,6 +136,7 @@ SnippetProbe buildSnippetProbe(const RuleSet& rules, int r, const ProbeRig& rig)
     location += isMatrix(type) ? 4 : 1;
   }
   if (!members.empty()) s += "layout(set = 0, binding = 0, std140) uniform ProbeInputs {\n" + members + "};\n";
+  s += buffers;
   s += fmt::format("layout(location = 0) {}out {} sg_probe_out;\n", isIntegerType(product->type) ? "flat " : "",
                    glslName(product->type));
   s += "void main() {\n";

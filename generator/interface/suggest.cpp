@@ -93,7 +93,8 @@ std::vector<std::string> closestSemantics(const RuleSet& rules, const std::strin
   using Key = std::tuple<int, int, int, int, std::string>;  // sort ascending
   std::vector<Key> ranked;
   for (const auto& d : rules.semantics) {
-    if (isMatrix(d.type) || d.arraySize || !d.arrayParam.empty() || !d.count.empty()) continue;  // not a varying
+    if (isMatrix(d.type) || d.arraySize || !d.arrayParam.empty() || !d.count.empty() || !d.bufferOf.empty())
+      continue;  // not a varying
     if (d.name == "clip.position") continue;  // gl_Position, never a fragment input
     if (scalarKind(d.type) != scalarKind(type)) continue;
     std::vector<std::string> sem = nameWords(d.name, true);

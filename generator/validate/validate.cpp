@@ -519,6 +519,11 @@ ValidateReport Validator::run(const ValidationScene& scene) {
           continue;  // the alternative needs something this rig cannot provide
         }
         double ms = msSince(tg);
+        // Banning the other producers may make the plan avoid the value altogether (another
+        // route to what needs it); that plan checks nothing about this rule.
+        bool uses = false;
+        for (int b : r.plan.actions) uses = uses || r.in.problem.actions[b].name == alt;
+        if (!uses) continue;
         RunReport rr = runQuantized(r, mesh, scene, report.poses, fmt::format("forced {} for {}", alt, p.facts[fact].name));
         rr.generateMs = ms;
         if (!seenPlans.insert(rr.rules).second) continue;

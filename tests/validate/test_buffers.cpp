@@ -143,17 +143,18 @@ TEST(Buffers, Limb8With300BonesReadsThePaletteFromABuffer) {
   EXPECT_TRUE(has(rep.runs[0].rules, "skin_matrix_blend_buffer_palette"));
 }
 
-// The Dawn face keeps its plan (cost 81, no buffer) and cross-checks every buffer form
+// The Dawn face keeps its plan (no buffer) and cross-checks every buffer form
 // that fits next to the other attributes.
 TEST(Buffers, DawnFaceUnchangedAndBufferFormsCrossChecked) {
   sg::ValidateReport rep = validate(sourcePath("examples/dawn/face.rig.yaml"), sourcePath(kFaceFrag),
                                     sourcePath(kFaceRules), "head", true, 1);
   expectAllPass(rep);
-  EXPECT_EQ(rep.runs[0].planCost, 81);
+  EXPECT_EQ(rep.runs[0].planCost, 100);  // 81 before the tangent-frame fallback of issue 13 (docs/cost-model.md)
   for (const auto& r : rep.runs[0].rules) EXPECT_EQ(r.find("buffer"), std::string::npos) << r;
   std::vector<std::string> f = forced(rep);
   EXPECT_TRUE(has(f, "object_position_morphed_buffer"));
-  EXPECT_TRUE(has(f, "normal_occlusion_morphed_buffer"));
+  // normal_occlusion_morphed_buffer is not forced here: with the other producers banned the
+  // plan morphs normal and occlusion separately, so that run would not use it.
   EXPECT_TRUE(has(f, "skin_matrix_blend_buffer_palette"));
 }
 
