@@ -123,19 +123,19 @@ std::vector<SamplerBinding> reflectSamplers(const std::vector<uint32_t>& w) {
   for (size_t i = 5; i < w.size();) {
     const uint32_t op = w[i] & 0xFFFF, n = w[i] >> 16;
     if (n == 0 || i + n > w.size()) break;
-    const uint32_t* a = &w[i + 1];
+    const uint32_t* a = w.data() + i + 1;  // operands (n - 1 words; n == 1 has none)
     switch (op) {
-      case 5:  // OpName
-        names[a[0]] = reinterpret_cast<const char*>(&a[1]);
+      case 5:  // OpName: the literal string is nul-terminated inside the instruction
+        if (n >= 3 && (a[n - 2] >> 24) == 0) names[a[0]] = reinterpret_cast<const char*>(&a[1]);
         break;
       case 71:  // OpDecorate
         if (n >= 4 && a[1] == 34) sets[a[0]] = a[2];
         if (n >= 4 && a[1] == 33) bindings[a[0]] = a[2];
         break;
-      case 25: imageDim[a[0]] = a[2]; break;       // OpTypeImage: result, sampled type, Dim
-      case 27: sampledImage[a[0]] = a[1]; break;   // OpTypeSampledImage
-      case 32: pointee[a[0]] = a[2]; break;        // OpTypePointer: result, storage, type
-      case 59: variables.emplace_back(a[1], a[0]); break;  // OpVariable: type, result
+      case 25: if (n >= 4) imageDim[a[0]] = a[2]; break;       // OpTypeImage: result, sampled type, Dim
+      case 27: if (n >= 3) sampledImage[a[0]] = a[1]; break;   // OpTypeSampledImage
+      case 32: if (n >= 4) pointee[a[0]] = a[2]; break;        // OpTypePointer: result, storage, type
+      case 59: if (n >= 4) variables.emplace_back(a[1], a[0]); break;  // OpVariable: type, result
     }
     i += n;
   }
