@@ -41,6 +41,19 @@ int defTypeComponents(DefType t) {
   }
 }
 
+DefType declType(Type t) {
+  switch (t) {
+    case Type::Float: return DefType::Float;
+    case Type::Vec2: return DefType::Vec2;
+    case Type::Vec3: return DefType::Vec3;
+    case Type::Vec4: case Type::IVec4: case Type::UVec4: return DefType::Vec4;
+    case Type::Int: case Type::UInt: return DefType::Int;
+    case Type::Mat3: return DefType::Mat3;
+    case Type::Mat4: return DefType::Mat4;
+  }
+  return DefType::Float;
+}
+
 namespace {
 
 bool isVec(DefType t) { return t == DefType::Vec2 || t == DefType::Vec3 || t == DefType::Vec4; }
@@ -275,19 +288,6 @@ class Parser {
   size_t pos_ = 0;
   int nesting_ = 0;
 };
-
-DefType declType(Type t) {
-  switch (t) {
-    case Type::Float: return DefType::Float;
-    case Type::Vec2: return DefType::Vec2;
-    case Type::Vec3: return DefType::Vec3;
-    case Type::Vec4: case Type::IVec4: case Type::UVec4: return DefType::Vec4;
-    case Type::Int: case Type::UInt: return DefType::Int;
-    case Type::Mat3: return DefType::Mat3;
-    case Type::Mat4: return DefType::Mat4;
-  }
-  return DefType::Float;
-}
 
 bool swizzleLetters(const std::string& s) {
   if (s.empty() || s.size() > 4) return false;

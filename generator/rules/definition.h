@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "common/diagnostics.h"
+#include "common/types.h"
 
 namespace sg {
 
@@ -28,6 +29,8 @@ constexpr int kMaxDefinitionDepth = 64;
 enum class DefType { Bool, Int, Float, Vec2, Vec3, Vec4, Mat3, Mat4 };
 const char* defTypeName(DefType t);
 int defTypeComponents(DefType t);  // 1, 2, 3, 4, 9, 16
+// How a declared semantic type is evaluated (integer vectors as Vec4, uint as Int).
+DefType declType(Type t);
 
 struct DefNode {
   enum Kind { Num, Name, Call, Unary, Binary, Ternary, Index, Swizzle, Sum, Let } kind = Num;

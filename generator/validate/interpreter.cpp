@@ -87,19 +87,6 @@ Val unflatten(DefType t, const double* in) {
   return v;
 }
 
-DefType declType(Type t) {
-  switch (t) {
-    case Type::Float: return DefType::Float;
-    case Type::Vec2: return DefType::Vec2;
-    case Type::Vec3: return DefType::Vec3;
-    case Type::Vec4: case Type::IVec4: case Type::UVec4: return DefType::Vec4;
-    case Type::Int: case Type::UInt: return DefType::Int;
-    case Type::Mat3: return DefType::Mat3;
-    case Type::Mat4: return DefType::Mat4;
-  }
-  return DefType::Float;
-}
-
 std::string showVal(const Val& v) {
   double f[16];
   flatten(v, f);
