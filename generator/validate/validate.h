@@ -10,6 +10,7 @@
 #include "pipeline/generate.h"
 #include "runtime/mesh.h"
 #include "runtime/vk_harness.h"
+#include "validate/program_inputs.h"
 
 namespace sg {
 
@@ -70,20 +71,6 @@ ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_
 // For rigs with an active-target list (morph.active_targets, docs/buffers.md): keeps, per
 // pose, a seeded choice of as many non-zero morph weights as the list holds.
 void limitActiveTargets(const Rig& rig, std::vector<rt::Pose>& poses, uint32_t seed);
-
-// The storage buffers a generated shader reads, filled from the mesh (per-vertex buffers,
-// `perVertex`) or from the pose (palettes, !perVertex), in the layout of docs/buffers.md.
-std::vector<rt::StorageBufferData> buildStorageBuffers(const Problem& p, const EmittedGlsl& glsl, const rt::Mesh& mesh,
-                                                       const rt::Pose& pose, bool perVertex);
-
-// The data a run feeds the GPU, for other users of the device (render, GPU timing):
-// the mesh with every integer/normalized stream rounded as its attribute format stores it,
-// one input's vertex stream, and the uniform block for a pose (uniforms with a definition,
-// such as a normal matrix, computed from the pose's).
-rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh);
-rt::VertexStream vertexStream(const Rig& rig, const EmittedInput& in, const rt::Mesh& mesh);
-std::vector<uint8_t> uniformBlock(const Rig& rig, const RuleSet& rules, const EmittedGlsl& glsl, const SpirvModule& spv,
-                                  const rt::Mesh& mesh, const rt::Pose& pose);
 
 struct ValidateOptions {
   GenerateOptions gen;
