@@ -117,8 +117,6 @@ void putElement(std::vector<uint8_t>& out, size_t at, Type element, const float*
   }
 }
 
-}  // namespace
-
 // The sparse-morph protocol (docs/buffers.md): the targets with a non-zero weight, in
 // increasing order, and their count, for rigs that read them.
 void addActiveTargets(const Rig& rig, const rt::Pose& pose, UniformValues& values) {
@@ -234,19 +232,49 @@ UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape
   return uniforms;
 }
 
+}  // namespace
+
 rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh) { return quantizedMesh(rig, mesh); }
 
-rt::VertexStream vertexStream(const Rig& rig, const EmittedInput& in, const rt::Mesh& mesh) {
-  return buildStream(rig, in, mesh);
+
+
+std::vector<rt::DescriptorBinding> declaredDescriptors(const std::vector<ShaderDescriptor>& reflected) {
+  std::vector<rt::DescriptorBinding> out;
+  for (const auto& d : reflected)
+    out.push_back({d.set, d.binding,
+                   d.kind == ShaderDescriptor::Kind::UniformBlock   ? rt::DescriptorKind::UniformBuffer
+                   : d.kind == ShaderDescriptor::Kind::StorageBlock ? rt::DescriptorKind::StorageBuffer
+                                                                    : rt::DescriptorKind::CombinedImageSampler,
+                   d.name});
+  return out;
 }
 
-std::vector<uint8_t> uniformBlock(const Rig& rig, const RuleSet& rules, const EmittedGlsl& glsl, const SpirvModule& spv,
-                                  const rt::Mesh& mesh, const rt::Pose& pose) {
+UniformValues feedPose(const GenerateResult& r, const rt::Mesh& mesh, const rt::Pose& pose, rt::ProgramInputs& inputs) {
+  const Rig& rig = r.in.rig;
   std::vector<rt::Pose> poses{pose};
-  drawDeclaredUniforms(poses, rig, rules);
-  UniformValues values = uniformValues(rig, rules, shapeOfRig(rig, rules), mesh, poses[0]);
+  drawDeclaredUniforms(poses, rig, r.in.rules);  // a no-op for poses whose uniforms are drawn already
+  UniformValues values = uniformValues(rig, r.in.rules, shapeOfRig(rig, r.in.rules), mesh, poses[0]);
   addActiveTargets(rig, poses[0], values);
-  return buildUniforms(rig, glsl, spv, values);
+  inputs.uniformData = buildUniforms(rig, r.glsl, r.spirv, values);
+  // Palettes follow the pose; per-vertex buffers stay.
+  std::vector<rt::StorageBufferData> palettes = buildStorageBuffers(r.in.problem, r.glsl, mesh, poses[0], false);
+  auto& buffers = inputs.storageBuffers;
+  for (const auto& p : palettes)
+    buffers.erase(std::remove_if(buffers.begin(), buffers.end(), [&](const auto& b) { return b.binding == p.binding; }),
+                  buffers.end());
+  for (auto& p : palettes) buffers.push_back(std::move(p));
+  std::sort(buffers.begin(), buffers.end(), [](const auto& a, const auto& b) { return a.binding < b.binding; });
+  return values;
+}
+
+rt::ProgramInputs programInputs(const GenerateResult& r, const rt::Mesh& mesh, const rt::Pose& pose) {
+  rt::ProgramInputs in;
+  in.vertexCount = static_cast<uint32_t>(mesh.vertexCount);
+  for (const auto& i : r.glsl.inputs) in.streams.push_back(buildStream(r.in.rig, i, mesh));
+  in.storageBuffers = buildStorageBuffers(r.in.problem, r.glsl, mesh, rt::Pose{}, true);
+  in.declared = declaredDescriptors(r.spirv.descriptors);
+  feedPose(r, mesh, pose, in);
+  return in;
 }
 
 }  // namespace sg

@@ -114,11 +114,9 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
 
   rt::RunRequest req;
   req.spirv = r.spirv.words;
-  req.vertexCount = static_cast<uint32_t>(mesh.vertexCount);
   req.capture.strideBytes = r.glsl.captureStride;
-  for (const auto& in : r.glsl.inputs) req.streams.push_back(vertexStream(rig, in, mesh));
-  const std::vector<rt::StorageBufferData> perVertexBuffers =
-      buildStorageBuffers(r.in.problem, r.glsl, mesh, rt::Pose{}, true);
+  if (poses.empty()) throw std::logic_error("validation needs a pose");
+  static_cast<rt::ProgramInputs&>(req) = programInputs(r, mesh, poses.front());
 
   for (const auto& o : r.glsl.outputs) {
     OutputReport out;
@@ -131,15 +129,9 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
   const RigShape shape = shapeOfRig(rig, r.in.rules);
   const RuleSet& rules = r.in.rules;
   for (const rt::Pose& pose : poses) {
-    // Uniforms: the pose's values, then those defined by a formula over them (a normal
-    // matrix), rounded to float as the GPU gets them.
-    UniformValues uniforms = uniformValues(rig, rules, shape, mesh, pose);
-    addActiveTargets(rig, pose, uniforms);
-    req.uniformData = buildUniforms(rig, r.glsl, r.spirv, uniforms);
-    req.storageBuffers = perVertexBuffers;
-    for (auto& sb : buildStorageBuffers(r.in.problem, r.glsl, mesh, pose, false)) req.storageBuffers.push_back(std::move(sb));
-    std::sort(req.storageBuffers.begin(), req.storageBuffers.end(),
-              [](const auto& a, const auto& b) { return a.binding < b.binding; });
+    // The pose's uniforms (and those defined over them, as floats) and palettes; the
+    // reference evaluates with the same values.
+    const UniformValues uniforms = feedPose(r, mesh, pose, req);
     rt::RunResult res = harness_->run(req);
     rep.timings.setupMs += res.timings.setupMs;
     rep.timings.uploadMs += res.timings.uploadMs;

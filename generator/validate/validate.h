@@ -90,6 +90,8 @@ class Validator {
   ValidateReport run(const ValidationScene& scene);
   // One generation result on the scene (no cross-check); exposed for tests and benchmarks.
   RunReport runOne(const GenerateResult& r, const ValidationScene& scene, const std::string& label);
+  // The device it runs on (render and bench draw on the same one).
+  const rt::Harness& harness() const { return *harness_; }
 
  private:
   // runOne on a mesh already quantized to the rig's attribute formats.
