@@ -147,7 +147,7 @@ std::vector<rt::Texture> texturesFor(const FragmentProgram& fragment, const Dawn
     if (s.kind != ShaderDescriptor::Kind::Sampler) continue;
     if (s.set != 1)
       throw InputError(where(s.name), fmt::format("sampler '{}' is in set {}; render binds textures in set 1 "
-                                                  "(set 0 is the vertex shader's uniform block)", s.name, s.set));
+                                                  "(set 0 is the vertex shader's uniform block and storage buffers)", s.name, s.set));
     rt::Texture t;
     if (!dawnTexture(s.name, s.cube, lighting, t)) {
       std::string known;
