@@ -9,38 +9,21 @@
 #include <string>
 #include <vector>
 
+#include "runtime/vk_program.h"
+
 namespace sg::rt {
-
-// One vertex buffer binding per stream, per-vertex rate, attribute at offset 0.
-struct VertexStream {
-  uint32_t location = 0;
-  VkFormat format = VK_FORMAT_UNDEFINED;
-  uint32_t stride = 0;
-  std::vector<uint8_t> data;  // at least vertexCount * stride bytes
-};
-
-// A read-only storage buffer at set 0, `binding` (std430 data as the shader declares it).
-// Per-vertex buffers must cover the drawn vertices: vertexCount rounded up to even.
-struct StorageBufferData {
-  uint32_t binding = 1;
-  std::vector<uint8_t> data;  // non-empty
-};
 
 // The shader's xfb_stride (a single capture buffer, xfb_buffer 0).
 struct CaptureLayout {
   uint32_t strideBytes = 0;
 };
 
-struct RunRequest {
+// The program's inputs (vk_program.h; textures are ignored: nothing is rasterized) and
+// the shader that reads them.
+struct RunRequest : ProgramInputs {
   // Vertex shader with xfb_buffer/xfb_offset/xfb_stride on every captured output
   // (gl_Position through a redeclared gl_PerVertex).
   std::vector<uint32_t> spirv;
-  std::vector<VertexStream> streams;
-  // Contents of the uniform block at set 0, binding 0; empty = no descriptor set.
-  std::vector<uint8_t> uniformData;
-  // Storage buffers at set 0 (bindings distinct from 0, the uniform block's).
-  std::vector<StorageBufferData> storageBuffers;
-  uint32_t vertexCount = 0;
   CaptureLayout capture;
 };
 

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -14,23 +15,12 @@
 
 namespace sg::rt {
 
-// A sampled texture at set 1, `binding` (combined image sampler, linear filtering).
-struct Texture {
-  uint32_t binding = 0;
-  bool cube = false;  // 6 faces in Vulkan order +X, -X, +Y, -Y, +Z, -Z
-  uint32_t size = 0;  // width = height
-  VkFormat format = VK_FORMAT_R8G8B8A8_UNORM;  // or VK_FORMAT_R16G16B16A16_SFLOAT (HDR)
-  std::vector<uint8_t> data;  // faces x size x size texels, rows top to bottom
-};
-
-struct DrawRequest {
+// A program's inputs (vk_program.h: streams, uniform block, storage buffers, textures,
+// declared descriptors) and the shaders and triangles that draw them.
+struct DrawRequest : ProgramInputs {
   std::vector<uint32_t> vertexSpirv;
   std::vector<uint32_t> fragmentSpirv;  // writes location 0 (vec4)
-  std::vector<VertexStream> streams;
-  uint32_t vertexCount = 0;
-  std::vector<uint32_t> indices;     // triangle list
-  std::vector<uint8_t> uniformData;  // set 0, binding 0 (vertex stage); empty = none
-  std::vector<Texture> textures;     // set 1 (fragment stage)
+  std::vector<uint32_t> indices;        // triangle list
   uint32_t width = 256, height = 256;
   std::array<float, 4> clearColor{0, 0, 0, 1};
 };
@@ -77,7 +67,7 @@ class Renderer {
 
  private:
   struct Impl;
-  Impl* impl_;
+  std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace sg::rt

@@ -97,7 +97,13 @@ struct BenchCommand {
     bo.floor = !noFloor;
     GpuBenchReport rep = runGpuBench(bo);
     std::cout << formatGpuBench(rep);
-    return 0;
+    int failed = 0;
+    for (const auto& row : rep.rows)
+      if (row.validation.rfind("FAIL", 0) == 0) {
+        std::cerr << "shadergen: error: " << row.label << " fails on " << rep.device << " (not timed): " << row.validation << "\n";
+        ++failed;
+      }
+    return failed ? 1 : 0;
   }
 };
 
@@ -131,7 +137,8 @@ void registerRender(CLI::App& app, CliState& state) {
   auto bench = std::make_shared<BenchCommand>();
   bench->bo.render.mesh = "dawn";
   CLI::App* b = app.add_subcommand("bench", "Time the generated vertex program, its forced alternatives, a hand-written "
-                                            "port and a pass-through floor on the GPU (timestamp queries)");
+                                            "port and a pass-through floor on the GPU (timestamp queries), each validated on that "
+                                            "device first (one that fails is not timed; exit status 1)");
   bench->args.add(*b);
   b->add_option("--hand-port", bench->bo.handPortPath, "A hand-written vertex shader with the same interface "
                                                        "(a_<attribute>, u_<uniform>), e.g. examples/dawn/listing-3-3.vert");

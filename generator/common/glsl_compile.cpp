@@ -244,6 +244,31 @@ std::vector<UniformMember> GlslShader::uniformMembers() const {
   return out;
 }
 
+std::vector<ShaderDescriptor> GlslShader::descriptors() const {
+  std::vector<ShaderDescriptor> out;
+  if (!impl_->ok) return out;
+  PoolScope scope(impl_->scratch);
+  glslang::TProgram& p = impl_->reflection();
+  auto add = [&](const glslang::TObjectReflection& r, ShaderDescriptor::Kind kind) {
+    const glslang::TType* t = r.getType();
+    ShaderDescriptor d;
+    d.name = r.name;
+    // glslang lists buffer blocks with the uniform blocks unless asked to separate them.
+    d.kind = t && t->getQualifier().storage == glslang::EvqBuffer ? ShaderDescriptor::Kind::StorageBlock : kind;
+    if (t && t->getQualifier().hasSet()) d.set = t->getQualifier().layoutSet;
+    if (t && t->getQualifier().hasBinding()) d.binding = t->getQualifier().layoutBinding;
+    d.cube = t && t->getBasicType() == glslang::EbtSampler && t->getSampler().dim == glslang::EsdCube;
+    out.push_back(std::move(d));
+  };
+  for (int i = 0; i < p.getNumUniformBlocks(); ++i) add(p.getUniformBlock(i), ShaderDescriptor::Kind::UniformBlock);
+  for (int i = 0; i < p.getNumBufferBlocks(); ++i) add(p.getBufferBlock(i), ShaderDescriptor::Kind::StorageBlock);
+  for (int i = 0; i < p.getNumUniformVariables(); ++i) {
+    const glslang::TObjectReflection& u = p.getUniform(i);
+    if (u.getType() && u.getType()->getBasicType() == glslang::EbtSampler) add(u, ShaderDescriptor::Kind::Sampler);
+  }
+  return out;
+}
+
 std::string GlslShader::linkWith(const GlslShader& next) const {
   if (!impl_->ok || !next.impl_->ok) return "a stage failed to compile";
   PoolScope scope(impl_->scratch);

@@ -56,6 +56,16 @@ struct UniformBlock {
   uint32_t size = 0;
 };
 
+// A descriptor the stage uses (statically, so a pipeline must bind it): a uniform block, a
+// storage block or a sampler, at its set and binding.
+struct ShaderDescriptor {
+  enum class Kind { UniformBlock, StorageBlock, Sampler };
+  std::string name;  // block or sampler name
+  Kind kind = Kind::UniformBlock;
+  uint32_t set = 0, binding = 0;
+  bool cube = false;  // a samplerCube
+};
+
 // One stage parsed (and linked alone) once. Movable, not copyable; not shared
 // between threads (each thread parses its own).
 class GlslShader {
@@ -75,6 +85,7 @@ class GlslShader {
   std::vector<StageVariable> outputs() const;
   std::vector<UniformBlock> uniformBlocks() const;
   std::vector<UniformMember> uniformMembers() const;
+  std::vector<ShaderDescriptor> descriptors() const;  // in glslang's reflection order
 
   // glslang's cross-stage link of this stage with `next` (both ok()). Returns "" when
   // they link, else glslang's log.

@@ -17,6 +17,7 @@ CompiledVertexShader compileVertex(const EmittedGlsl& glsl, const std::string& g
     if (b.name == "ShadergenUniforms") m.uniformBlockSize = b.size;
   for (const auto& u : parsed.uniformMembers())
     m.uniforms.push_back(UniformLayout{u.name, u.offset, u.arrayStride, u.matrixStride, u.size});
+  m.descriptors = parsed.descriptors();
   return CompiledVertexShader{std::move(m), std::move(parsed)};
 }
 

@@ -22,6 +22,7 @@ struct SpirvModule {
   std::vector<uint32_t> words;
   uint32_t uniformBlockSize = 0;
   std::vector<UniformLayout> uniforms;  // glslang's reflection of the compiled shader
+  std::vector<ShaderDescriptor> descriptors;  // what a run must bind (glslang's reflection)
 };
 
 // The vertex shader as parsed once: its SPIR-V and layout, and the parse itself (for the

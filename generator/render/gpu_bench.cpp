@@ -10,18 +10,17 @@
 #include <set>
 
 #include "common/input_file.h"
+#include "runtime/procedural.h"
 #include "runtime/vk_render.h"
 
 namespace sg {
 namespace {
 
-// One program to time: its SPIR-V for both modes and what feeds it.
+// One program to time: its render and capture builds (fed by programInputs).
 struct Program {
   GpuBenchRow row;
-  std::vector<uint32_t> renderSpirv, captureSpirv;
-  uint32_t captureStride = 0;
-  std::vector<rt::VertexStream> streams;
-  std::vector<uint8_t> uniforms;
+  GenerateResult render, capture;
+  bool validate = true;  // the floors write constants on purpose
 };
 
 double median(std::vector<double> v) {
@@ -47,40 +46,6 @@ GlslShader parseVertex(const std::string& text, const std::string& path, TargetE
   GlslShader s(GlslUnit{Stage::Vertex, text, path, {}}, env);
   if (!s.ok()) throwDiagnostics(s.diagnostics(), path, "the vertex shader does not compile");
   return s;
-}
-
-// Streams and uniforms of a hand-written shader that follows the emitter's naming
-// (a_<attribute>[<target>], u_<uniform>), from its own reflection.
-void feedHandWritten(const GlslShader& s, const std::string& path, const Rig& rig, const RuleSet& rules, const rt::Mesh& mesh,
-                     const rt::Pose& pose, std::vector<rt::VertexStream>& streams, std::vector<uint8_t>& uniforms) {
-  for (const auto& in : s.inputs()) {
-    EmittedInput e;
-    e.name = in.name;
-    e.location = in.location;
-    for (size_t a = 0; a < rig.attributes.size() && e.attribute < 0; ++a) {
-      const RigAttribute& ra = rig.attributes[a];
-      const std::string base = "a_" + ra.name;
-      if (!ra.perMorphTarget && in.name == base) e.attribute = static_cast<int>(a);
-      if (ra.perMorphTarget && in.name.size() > base.size() && in.name.compare(0, base.size(), base) == 0 &&
-          in.name.find_first_not_of("0123456789", base.size()) == std::string::npos) {
-        e.attribute = static_cast<int>(a);
-        e.target = std::stoi(in.name.substr(base.size()));
-      }
-    }
-    if (e.attribute < 0 || in.location < 0)
-      throw InputError(SourceLoc{path, 0, 0}, fmt::format("input '{}' names no attribute of rig '{}' (a_<attribute>[target] "
-                                                          "with a location)", in.name, rig.name));
-    streams.push_back(vertexStream(rig, e, mesh));
-  }
-  EmittedGlsl glsl;
-  SpirvModule spv;
-  for (const auto& b : s.uniformBlocks()) spv.uniformBlockSize = std::max(spv.uniformBlockSize, b.size);
-  for (const auto& m : s.uniformMembers()) {
-    spv.uniforms.push_back(UniformLayout{m.name, m.offset, m.arrayStride, m.matrixStride, m.size});
-    for (size_t u = 0; u < rig.uniforms.size(); ++u)
-      if (m.name == "u_" + rig.uniforms[u].name) glsl.uniforms.push_back(EmittedUniform{m.name, static_cast<int>(u)});
-  }
-  if (spv.uniformBlockSize) uniforms = uniformBlock(rig, rules, glsl, spv, mesh, pose);
 }
 
 // The floor: reads the position, writes it as gl_Position and a constant to every other
@@ -156,15 +121,44 @@ std::string addCaptureQualifiers(const std::string& glsl, const std::string& pat
   return result;
 }
 
-HandWrittenRun prepareHandWritten(const std::string& path, const Rig& rig, const RuleSet& rules, const rt::Mesh& mesh,
-                                  const rt::Pose& pose, const EmittedGlsl& capture, TargetEnv env) {
-  std::string text = readInputFile(path);
+GenerateResult handWrittenProgram(const std::string& text, const std::string& path, const GenerateResult& like,
+                                  TargetEnv env) {
   GlslShader s = parseVertex(text, path, env);
-  HandWrittenRun h;
-  h.renderSpirv = s.spirv();
-  h.captureSpirv = parseVertex(addCaptureQualifiers(text, path, capture), path, env).spirv();
-  feedHandWritten(s, path, rig, rules, mesh, pose, h.streams, h.uniforms);
-  return h;
+  const Rig& rig = like.in.rig;
+  GenerateResult r = like;
+  r.glsl.text = text;
+  r.glsl.inputs.clear();
+  r.glsl.uniforms.clear();
+  r.glsl.buffers.clear();
+  for (const auto& in : s.inputs()) {
+    EmittedInput e;
+    e.name = in.name;
+    e.location = in.location;
+    for (size_t a = 0; a < rig.attributes.size() && e.attribute < 0; ++a) {
+      const RigAttribute& ra = rig.attributes[a];
+      const std::string base = "a_" + ra.name;
+      if (!ra.perMorphTarget && in.name == base) e.attribute = static_cast<int>(a);
+      if (ra.perMorphTarget && in.name.size() > base.size() && in.name.compare(0, base.size(), base) == 0 &&
+          in.name.find_first_not_of("0123456789", base.size()) == std::string::npos) {
+        e.attribute = static_cast<int>(a);
+        e.target = std::stoi(in.name.substr(base.size()));
+      }
+    }
+    if (e.attribute < 0 || in.location < 0)
+      throw InputError(SourceLoc{path, 0, 0}, fmt::format("input '{}' names no attribute of rig '{}' (a_<attribute>[target] "
+                                                          "with a location)", in.name, rig.name));
+    r.glsl.inputs.push_back(e);
+  }
+  r.spirv = SpirvModule{};
+  r.spirv.words = s.spirv();
+  for (const auto& b : s.uniformBlocks()) r.spirv.uniformBlockSize = std::max(r.spirv.uniformBlockSize, b.size);
+  for (const auto& m : s.uniformMembers()) {
+    r.spirv.uniforms.push_back(UniformLayout{m.name, m.offset, m.arrayStride, m.matrixStride, m.size});
+    for (size_t u = 0; u < rig.uniforms.size(); ++u)
+      if (m.name == "u_" + rig.uniforms[u].name) r.glsl.uniforms.push_back(EmittedUniform{m.name, static_cast<int>(u)});
+  }
+  r.spirv.descriptors = s.descriptors();
+  return r;
 }
 
 double pearson(const std::vector<double>& x, const std::vector<double>& y) {
@@ -191,8 +185,8 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   LoadedInputs in = loadInputs(gen);
   const Rig& rig = in.rig;
   RenderScene scene = renderScene(rig, opts.render);
-  std::vector<uint32_t> frag = compileFragmentFile(gen.fragmentPath, env);
-  std::vector<rt::Texture> textures = texturesFor(frag, gen.fragmentPath, opts.render.lighting);
+  FragmentProgram frag = compileFragmentFile(gen.fragmentPath, env);
+  std::vector<rt::Texture> textures = texturesFor(frag, opts.render.lighting);
 
   // The programs: generated, its forced alternatives, the hand port, the floor.
   std::vector<Program> programs;
@@ -200,28 +194,21 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     GenerateOptions render = g, capture = g;
     render.capture = false;
     capture.capture = true;
-    GenerateResult r = generateFrom(in, render), c = generateFrom(in, capture);
     Program p;
+    p.render = generateFrom(in, render);
     p.row.label = label;
-    for (int a : r.plan.actions) p.row.rules.push_back(r.in.problem.actions[a].name);
+    for (int a : p.render.plan.actions) p.row.rules.push_back(p.render.in.problem.actions[a].name);
     for (const auto& q : programs)
       if (q.row.hasCost && q.row.rules == p.row.rules) return false;  // the same plan again
+    p.capture = generateFrom(in, capture);
     p.row.hasCost = true;
-    p.row.planCost = r.plan.cost;
-    p.row.spirvInstructions = countInstructions(r.spirv.words);
-    p.renderSpirv = r.spirv.words;
-    p.captureSpirv = c.spirv.words;
-    p.captureStride = c.glsl.captureStride;
-    for (const auto& i : r.glsl.inputs) p.streams.push_back(vertexStream(rig, i, scene.mesh));
-    p.uniforms = uniformBlock(rig, r.in.rules, r.glsl, r.spirv, scene.mesh, scene.pose);
+    p.row.planCost = p.render.plan.cost;
+    p.row.spirvInstructions = countInstructions(p.render.spirv.words);
     programs.push_back(std::move(p));
     return true;
   };
   addGenerated(gen, "generated");
-  GenerateResult chosen = generateFrom(in, gen);
-  GenerateOptions captureGen = gen;
-  captureGen.capture = true;
-  GenerateResult chosenCapture = generateFrom(in, captureGen);
+  const GenerateResult chosen = programs.front().render, chosenCapture = programs.front().capture;  // programs grows
   if (opts.alternatives) {
     const Problem& p = chosen.in.problem;
     for (int a : chosen.plan.actions) {
@@ -242,34 +229,47 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     }
   }
   if (!opts.handPortPath.empty()) {
-    HandWrittenRun h = prepareHandWritten(opts.handPortPath, rig, in.rules, scene.mesh, scene.pose, chosenCapture.glsl, env);
+    const std::string text = readInputFile(opts.handPortPath);
     Program p;
     p.row.label = "hand port (" + std::filesystem::path(opts.handPortPath).filename().string() + ")";
-    p.renderSpirv = std::move(h.renderSpirv);
-    p.row.spirvInstructions = countInstructions(p.renderSpirv);
-    p.captureSpirv = std::move(h.captureSpirv);
-    p.captureStride = chosenCapture.glsl.captureStride;
-    p.streams = std::move(h.streams);
-    p.uniforms = std::move(h.uniforms);
+    p.render = handWrittenProgram(text, opts.handPortPath, chosen, env);
+    p.capture = handWrittenProgram(addCaptureQualifiers(text, opts.handPortPath, chosenCapture.glsl), opts.handPortPath,
+                                   chosenCapture, env);
+    p.row.spirvInstructions = countInstructions(p.render.spirv.words);
     programs.push_back(std::move(p));
   }
   for (bool allInputs : {false, true}) {
     if (!opts.floor) break;
     Program p;
     p.row.label = allInputs ? "floor + every input fetched" : "floor (pass-through)";
-    GlslShader s = parseVertex(floorShader(chosen, false, allInputs), "floor.vert", env);
-    p.renderSpirv = s.spirv();
-    p.row.spirvInstructions = countInstructions(p.renderSpirv);
-    p.captureSpirv = parseVertex(floorShader(chosenCapture, true, allInputs), "floor.vert", env).spirv();
-    p.captureStride = chosenCapture.glsl.captureStride;
-    feedHandWritten(s, "floor.vert", rig, in.rules, scene.mesh, scene.pose, p.streams, p.uniforms);
+    p.render = handWrittenProgram(floorShader(chosen, false, allInputs), "floor.vert", chosen, env);
+    p.capture = handWrittenProgram(floorShader(chosenCapture, true, allInputs), "floor.vert", chosenCapture, env);
+    p.row.spirvInstructions = countInstructions(p.render.spirv.words);
+    p.validate = false;
     programs.push_back(std::move(p));
   }
 
-  RenderSession session(opts.render.device, opts.render.validationLayers);
-  rt::Renderer renderer(session.harness());
+  // Validated on the device that times them, fed exactly as timed: the timed pose and a
+  // hostile random one (a rest pose hides a wrong bone index).
+  ValidateOptions vo;
+  vo.device = opts.render.device;
+  vo.validationLayers = opts.render.validationLayers;
+  Validator validator(vo);
+  ValidationScene vscene{scene.mesh, {scene.pose}, scene.shape};
+  vscene.poses.push_back(rt::makeRandomPose(scene.shape, 1, rt::hostilePoseOptions(scene.shape.uniformScale)));
+  limitActiveTargets(rig, vscene.poses, 1);
+  for (Program& p : programs) {
+    if (!p.validate) continue;
+    RunReport v = validator.runOne(p.capture, vscene, p.row.label);
+    p.row.validation = v.pass ? "pass" : "FAIL";
+    for (const auto& o : v.outputs)
+      if (!o.pass) p.row.validation += fmt::format(": {} (max rel {:.2e})", o.name, o.maxRelError);
+    if (!v.validationMessages.empty()) p.row.validation += ": validation layer: " + v.validationMessages.front();
+  }
+
+  rt::Renderer renderer(validator.harness());
   GpuBenchReport rep;
-  rep.device = session.deviceName();
+  rep.device = validator.harness().deviceName();
   rep.driver = renderer.driver();
   rep.vertices = scene.mesh.vertexCount;
   rep.triangles = scene.indices.size() / 3;
@@ -280,21 +280,13 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   rep.height = opts.render.height;
   // Rounds over all programs, the order rotated each round; a program's number is its best
   // round's median frame, so another process stealing a round (lavapipe shares the CPU)
-  // does not pick the winner.
+  // does not pick the winner. A program that failed validation is not timed.
   auto best = [](double& slot, double v) { slot = slot < 0 ? v : std::min(slot, v); };
   const size_t n = programs.size();
   for (uint32_t round = 0; round < std::max<uint32_t>(1, opts.rounds); ++round)
     for (size_t k = 0; k < n; ++k) {
       Program& p = programs[(k + round) % n];
-      rt::DrawRequest req;
-      req.fragmentSpirv = frag;
-      req.streams = p.streams;
-      req.vertexCount = static_cast<uint32_t>(scene.mesh.vertexCount);
-      req.indices = scene.indices;
-      req.uniformData = p.uniforms;
-      req.textures = textures;
-      req.width = opts.render.width;
-      req.height = opts.render.height;
+      if (p.validate && p.row.validation != "pass") continue;
       rt::TimingRequest t;
       t.drawsPerFrame = opts.drawsPerFrame;
       t.frames = opts.frames + 1;
@@ -303,16 +295,18 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
         return median(frames) / (double(opts.drawsPerFrame) * double(vertices));
       };
       if (opts.rasterOn) {
-        req.vertexSpirv = p.renderSpirv;
+        rt::DrawRequest req = drawRequest(p.render, frag, textures, scene);
+        req.width = opts.render.width;
+        req.height = opts.render.height;
         t.rasterize = true;
         rt::Timing tm = renderer.time(req, t);
         best(p.row.rasterOnNsPerVertex, perVertex(tm.frameNs, tm.verticesPerDraw));
         best(p.row.rasterOnWallNsPerVertex, perVertex(tm.wallNs, tm.verticesPerDraw));
       }
       if (opts.rasterOff) {
-        req.vertexSpirv = p.captureSpirv;
+        rt::DrawRequest req = drawRequest(p.capture, frag, textures, scene);
         t.rasterize = false;
-        t.captureStride = p.captureStride;
+        t.captureStride = p.capture.glsl.captureStride;
         rt::Timing tm = renderer.time(req, t);
         best(p.row.rasterOffNsPerVertex, perVertex(tm.frameNs, tm.verticesPerDraw));
         best(p.row.rasterOffWallNsPerVertex, perVertex(tm.wallNs, tm.verticesPerDraw));
@@ -321,7 +315,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   for (const auto& p : programs) rep.rows.push_back(p.row);
   std::vector<double> cost, on, off, offWall;
   for (const auto& r : rep.rows)
-    if (r.hasCost) {
+    if (r.hasCost && r.validation == "pass") {
       cost.push_back(double(r.planCost));
       on.push_back(r.rasterOnNsPerVertex);
       off.push_back(r.rasterOffNsPerVertex);
@@ -333,7 +327,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   rep.spearmanOn = spearman(cost, on);
   rep.pearsonOff = pearson(cost, off);
   rep.spearmanOff = spearman(cost, off);
-  const auto& msgs = session.harness().validationMessages();
+  const auto& msgs = validator.harness().validationMessages();
   if (!msgs.empty()) throw std::runtime_error("validation layer: " + msgs.front());
   return rep;
 }
@@ -351,17 +345,17 @@ std::string formatGpuBench(const GpuBenchReport& r) {
   };
   s += "ns per vertex (x: relative to the generated program); timestamps = GPU timestamp queries, "
        "host = submit-to-fence wall time\n\n";
-  s += "| program | plan cost | SPIR-V instr. | raster on, timestamps | raster off (xfb), timestamps | raster on, host | raster off, host |\n";
-  s += "|---|---:|---:|---:|---:|---:|---:|\n";
+  s += "| program | on device | plan cost | SPIR-V instr. | raster on, timestamps | raster off (xfb), timestamps | raster on, host | raster off, host |\n";
+  s += "|---|---|---:|---:|---:|---:|---:|---:|\n";
   for (const auto& row : r.rows)
-    s += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", row.label, row.hasCost ? std::to_string(row.planCost) : "—",
-                     row.spirvInstructions, cell(row.rasterOnNsPerVertex, gen ? gen->rasterOnNsPerVertex : -1),
+    s += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", row.label, row.validation.empty() ? "—" : row.validation,
+                     row.hasCost ? std::to_string(row.planCost) : "—", row.spirvInstructions, cell(row.rasterOnNsPerVertex, gen ? gen->rasterOnNsPerVertex : -1),
                      cell(row.rasterOffNsPerVertex, gen ? gen->rasterOffNsPerVertex : -1),
                      cell(row.rasterOnWallNsPerVertex, gen ? gen->rasterOnWallNsPerVertex : -1),
                      cell(row.rasterOffWallNsPerVertex, gen ? gen->rasterOffWallNsPerVertex : -1));
-  s += fmt::format("\nplan cost vs time over the {} generated programs: raster on (timestamps) Pearson {:.2f}, Spearman {:.2f}; "
+  s += fmt::format("\nplan cost vs time over the {} generated programs that passed: raster on (timestamps) Pearson {:.2f}, Spearman {:.2f}; "
                    "raster off (timestamps) Pearson {:.2f}, Spearman {:.2f}; raster off (host) Pearson {:.2f}, Spearman {:.2f}\n",
-                   std::count_if(r.rows.begin(), r.rows.end(), [](const GpuBenchRow& x) { return x.hasCost; }), r.pearsonOn,
+                   std::count_if(r.rows.begin(), r.rows.end(), [](const GpuBenchRow& x) { return x.hasCost && x.validation == "pass"; }), r.pearsonOn,
                    r.spearmanOn, r.pearsonOff, r.spearmanOff, r.pearsonOffWall, r.spearmanOffWall);
   return s;
 }

@@ -3,7 +3,10 @@
 // and a pass-through floor, each drawn over the same mesh many times per frame with
 // Vulkan timestamp queries, with rasterization on (indexed triangles + the fragment
 // shader) and off (rasterizer discard + transform feedback, so nothing is optimised
-// away). docs/performance.md has the tables and what they say about the cost model.
+// away). Every program but the floors is first validated on the same device in the same
+// run (Validator::runOne: its captured outputs against the reference, fed by the same
+// programInputs); a program that fails is reported and not timed.
+// docs/performance.md has the tables and what they say about the cost model.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -30,6 +33,11 @@ struct GpuBenchRow {
   bool hasCost = false;
   int64_t planCost = 0;
   size_t spirvInstructions = 0;    // of the render build
+  // Validation on the device before timing: "pass", "FAIL: <output ...>" (then not timed),
+  // or "" for the floors, which write constants on purpose.
+  std::string validation;
+  // The cost model's predicted time per vertex (a device profile, issue 21); -1 = none.
+  double predictedNsPerVertex = -1;
   double rasterOnNsPerVertex = -1;   // median frame / (draws x vertices); -1 = not measured
   double rasterOffNsPerVertex = -1;
   double rasterOnWallNsPerVertex = -1;   // host submit-to-fence time (see rt::Timing::wallNs)
@@ -62,15 +70,12 @@ double spearman(const std::vector<double>& x, const std::vector<double>& y);
 // capture layout lacks.
 std::string addCaptureQualifiers(const std::string& glsl, const std::string& path, const EmittedGlsl& capture);
 
-// A hand-written vertex shader (emitter naming: a_<attribute>[target], u_<uniform>) fed
-// the way the generated one is: its capture build (xfb at the offsets of `capture`), its
-// vertex streams from `mesh` and its uniform block for `pose`.
-struct HandWrittenRun {
-  std::vector<uint32_t> renderSpirv, captureSpirv;
-  std::vector<rt::VertexStream> streams;
-  std::vector<uint8_t> uniforms;
-};
-HandWrittenRun prepareHandWritten(const std::string& path, const Rig& rig, const RuleSet& rules, const rt::Mesh& mesh,
-                                  const rt::Pose& pose, const EmittedGlsl& capture, TargetEnv env);
+// A hand-written vertex shader as a program that stands in for `like` (a generated one):
+// its own SPIR-V and interface from its reflection (emitter naming: a_<attribute>[target],
+// u_<uniform>; no storage buffers), `like`'s outputs and capture layout. Fed by
+// programInputs and validated by Validator::runOne like a generated program; a capture
+// build needs the text through addCaptureQualifiers first.
+GenerateResult handWrittenProgram(const std::string& text, const std::string& path, const GenerateResult& like,
+                                  TargetEnv env);
 
 }  // namespace sg

@@ -116,53 +116,14 @@ RenderScene renderScene(const Rig& rig, const RenderOptions& opts) {
   return s;
 }
 
-std::vector<SamplerBinding> reflectSamplers(const std::vector<uint32_t>& w) {
-  std::map<uint32_t, std::string> names;
-  std::map<uint32_t, uint32_t> sets, bindings, pointee, sampledImage, imageDim;
-  std::vector<std::pair<uint32_t, uint32_t>> variables;  // (id, pointer type)
-  for (size_t i = 5; i < w.size();) {
-    const uint32_t op = w[i] & 0xFFFF, n = w[i] >> 16;
-    if (n == 0 || i + n > w.size()) break;
-    const uint32_t* a = w.data() + i + 1;  // operands (n - 1 words; n == 1 has none)
-    switch (op) {
-      case 5:  // OpName: the literal string is nul-terminated inside the instruction
-        if (n >= 3 && (a[n - 2] >> 24) == 0) names[a[0]] = reinterpret_cast<const char*>(&a[1]);
-        break;
-      case 71:  // OpDecorate
-        if (n >= 4 && a[1] == 34) sets[a[0]] = a[2];
-        if (n >= 4 && a[1] == 33) bindings[a[0]] = a[2];
-        break;
-      case 25: if (n >= 4) imageDim[a[0]] = a[2]; break;       // OpTypeImage: result, sampled type, Dim
-      case 27: if (n >= 3) sampledImage[a[0]] = a[1]; break;   // OpTypeSampledImage
-      case 32: if (n >= 4) pointee[a[0]] = a[2]; break;        // OpTypePointer: result, storage, type
-      case 59: if (n >= 4) variables.emplace_back(a[1], a[0]); break;  // OpVariable: type, result
-    }
-    i += n;
-  }
-  std::vector<SamplerBinding> out;
-  for (auto [id, ptr] : variables) {
-    auto t = pointee.find(ptr);
-    if (t == pointee.end()) continue;
-    auto si = sampledImage.find(t->second);
-    if (si == sampledImage.end()) continue;
-    SamplerBinding b;
-    b.name = names.count(id) ? names[id] : fmt::format("%{}", id);
-    b.set = sets.count(id) ? sets[id] : 0;
-    b.binding = bindings.count(id) ? bindings[id] : 0;
-    b.cube = imageDim[si->second] == 3;  // Dim Cube
-    out.push_back(b);
-  }
-  return out;
+FragmentProgram compileFragmentFile(const std::string& path, TargetEnv env) {
+  GlslShader s(GlslUnit{Stage::Fragment, readInputFile(path), path, {}}, env);
+  if (!s.ok()) throwDiagnostics(s.diagnostics(), path, "the fragment shader does not compile");
+  return FragmentProgram{path, s.spirv(), s.descriptors()};
 }
 
-std::vector<uint32_t> compileFragmentFile(const std::string& path, TargetEnv env) {
-  GlslUnit unit{Stage::Fragment, readInputFile(path), path, {}};
-  CompileResult r = compileGlsl(unit, env);
-  if (!r.ok) throwDiagnostics(r.diagnostics, path, "the fragment shader does not compile");
-  return r.spirv;
-}
-
-std::vector<rt::Texture> texturesFor(const std::vector<uint32_t>& spirv, const std::string& path, const DawnLighting& lighting) {
+std::vector<rt::Texture> texturesFor(const FragmentProgram& fragment, const DawnLighting& lighting) {
+  const std::string& path = fragment.path;
   // Diagnostics point at the line that declares the sampler.
   auto where = [&](const std::string& name) {
     std::string text;
@@ -182,10 +143,11 @@ std::vector<rt::Texture> texturesFor(const std::vector<uint32_t>& spirv, const s
     return SourceLoc{path, 0, 0};
   };
   std::vector<rt::Texture> out;
-  for (const auto& s : reflectSamplers(spirv)) {
+  for (const auto& s : fragment.descriptors) {
+    if (s.kind != ShaderDescriptor::Kind::Sampler) continue;
     if (s.set != 1)
       throw InputError(where(s.name), fmt::format("sampler '{}' is in set {}; render binds textures in set 1 "
-                                                  "(set 0 is the vertex shader's uniform block)", s.name, s.set));
+                                                  "(set 0 is the vertex shader's uniform block and storage buffers)", s.name, s.set));
     rt::Texture t;
     if (!dawnTexture(s.name, s.cube, lighting, t)) {
       std::string known;
@@ -211,18 +173,23 @@ RenderSession::~RenderSession() = default;
 
 std::string RenderSession::deviceName() const { return harness_->deviceName(); }
 
-RenderResult RenderSession::render(const GenerateResult& gen, const std::vector<uint32_t>& fragmentSpirv,
+rt::DrawRequest drawRequest(const GenerateResult& gen, const FragmentProgram& fragment,
+                            const std::vector<rt::Texture>& textures, const RenderScene& scene) {
+  rt::DrawRequest req;
+  static_cast<rt::ProgramInputs&>(req) = programInputs(gen, scene.mesh, scene.pose);
+  req.textures = textures;
+  for (auto& d : declaredDescriptors(fragment.descriptors)) req.declared.push_back(std::move(d));
+  req.vertexSpirv = gen.spirv.words;
+  req.fragmentSpirv = fragment.spirv;
+  req.indices = scene.indices;
+  return req;
+}
+
+RenderResult RenderSession::render(const GenerateResult& gen, const FragmentProgram& fragment,
                                    const std::vector<rt::Texture>& textures, const RenderScene& scene,
                                    const RenderOptions& opts) {
   const size_t before = harness_->validationMessages().size();
-  rt::DrawRequest req;
-  req.vertexSpirv = gen.spirv.words;
-  req.fragmentSpirv = fragmentSpirv;
-  req.vertexCount = static_cast<uint32_t>(scene.mesh.vertexCount);
-  req.indices = scene.indices;
-  for (const auto& in : gen.glsl.inputs) req.streams.push_back(vertexStream(gen.in.rig, in, scene.mesh));
-  req.uniformData = uniformBlock(gen.in.rig, gen.in.rules, gen.glsl, gen.spirv, scene.mesh, scene.pose);
-  req.textures = textures;
+  rt::DrawRequest req = drawRequest(gen, fragment, textures, scene);
   req.width = opts.width;
   req.height = opts.height;
   req.clearColor = opts.background;
@@ -240,8 +207,8 @@ RenderResult RenderSession::render(const RenderOptions& opts) {
   GenerateOptions g = opts.gen;
   g.capture = false;
   GenerateResult gen = generate(g);
-  std::vector<uint32_t> frag = compileFragmentFile(g.fragmentPath, g.targetEnv);
-  std::vector<rt::Texture> textures = texturesFor(frag, g.fragmentPath, opts.lighting);
+  FragmentProgram frag = compileFragmentFile(g.fragmentPath, g.targetEnv);
+  std::vector<rt::Texture> textures = texturesFor(frag, opts.lighting);
   RenderScene scene = renderScene(gen.in.rig, opts);
   return render(gen, frag, textures, scene, opts);
 }

@@ -63,13 +63,12 @@ std::vector<uint32_t> triangleList(const std::vector<uint32_t>& indices, int mod
 // positions) fills the image.
 void frameCamera(const rt::Mesh& mesh, const rt::RigShape& shape, const RenderCamera& cam, float aspect, rt::Pose& pose);
 
-// A combined image sampler of a SPIR-V module (OpName + DescriptorSet/Binding decorations).
-struct SamplerBinding {
-  std::string name;
-  uint32_t set = 0, binding = 0;
-  bool cube = false;
+// A fragment shader compiled from a file, with the descriptors it uses (glslang's reflection).
+struct FragmentProgram {
+  std::string path;
+  std::vector<uint32_t> spirv;
+  std::vector<ShaderDescriptor> descriptors;
 };
-std::vector<SamplerBinding> reflectSamplers(const std::vector<uint32_t>& spirv);
 
 struct RenderResult {
   rt::Image image;
@@ -91,8 +90,8 @@ class RenderSession {
   // Throws InputError for bad inputs (a sampler no texture serves: at its declaration).
   RenderResult render(const RenderOptions& opts);
   // Draws an already generated program over a scene.
-  RenderResult render(const GenerateResult& gen, const std::vector<uint32_t>& fragmentSpirv,
-                      const std::vector<rt::Texture>& textures, const RenderScene& scene, const RenderOptions& opts);
+  RenderResult render(const GenerateResult& gen, const FragmentProgram& fragment, const std::vector<rt::Texture>& textures,
+                      const RenderScene& scene, const RenderOptions& opts);
 
  private:
   std::unique_ptr<rt::Harness> harness_;
@@ -100,11 +99,15 @@ class RenderSession {
 };
 
 // Compiles a fragment shader file (errors as InputErrors at their file:line).
-std::vector<uint32_t> compileFragmentFile(const std::string& path, TargetEnv env);
-// The textures for every sampler of `fragmentSpirv` (set 1 only); throws InputError at the
-// sampler's declaration in `fragmentPath` for one that is not in set 1 or has no texture.
-std::vector<rt::Texture> texturesFor(const std::vector<uint32_t>& fragmentSpirv, const std::string& fragmentPath,
-                                     const DawnLighting& lighting);
+FragmentProgram compileFragmentFile(const std::string& path, TargetEnv env);
+// The textures for every sampler of the fragment shader (set 1 only); throws InputError at
+// the sampler's declaration for one that is not in set 1 or has no texture.
+std::vector<rt::Texture> texturesFor(const FragmentProgram& fragment, const DawnLighting& lighting);
+
+// What a draw of program `gen` with `fragment` reads: programInputs over the scene plus the
+// textures and the fragment shader's declared samplers.
+rt::DrawRequest drawRequest(const GenerateResult& gen, const FragmentProgram& fragment,
+                            const std::vector<rt::Texture>& textures, const RenderScene& scene);
 
 // 8-bit RGB PNG bytes (alpha dropped: listing 3-4 writes "haze" there, not coverage). Fixed
 // settings and no time chunk, so the bytes depend only on the pixels.

@@ -10,6 +10,7 @@
 #include "pipeline/generate.h"
 #include "runtime/mesh.h"
 #include "runtime/vk_harness.h"
+#include "validate/program_inputs.h"
 
 namespace sg {
 
@@ -71,20 +72,6 @@ ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_
 // pose, a seeded choice of as many non-zero morph weights as the list holds.
 void limitActiveTargets(const Rig& rig, std::vector<rt::Pose>& poses, uint32_t seed);
 
-// The storage buffers a generated shader reads, filled from the mesh (per-vertex buffers,
-// `perVertex`) or from the pose (palettes, !perVertex), in the layout of docs/buffers.md.
-std::vector<rt::StorageBufferData> buildStorageBuffers(const Problem& p, const EmittedGlsl& glsl, const rt::Mesh& mesh,
-                                                       const rt::Pose& pose, bool perVertex);
-
-// The data a run feeds the GPU, for other users of the device (render, GPU timing):
-// the mesh with every integer/normalized stream rounded as its attribute format stores it,
-// one input's vertex stream, and the uniform block for a pose (uniforms with a definition,
-// such as a normal matrix, computed from the pose's).
-rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh);
-rt::VertexStream vertexStream(const Rig& rig, const EmittedInput& in, const rt::Mesh& mesh);
-std::vector<uint8_t> uniformBlock(const Rig& rig, const RuleSet& rules, const EmittedGlsl& glsl, const SpirvModule& spv,
-                                  const rt::Mesh& mesh, const rt::Pose& pose);
-
 struct ValidateOptions {
   GenerateOptions gen;
   bool crossCheck = false;  // also force each alternative derivation and check it
@@ -103,6 +90,8 @@ class Validator {
   ValidateReport run(const ValidationScene& scene);
   // One generation result on the scene (no cross-check); exposed for tests and benchmarks.
   RunReport runOne(const GenerateResult& r, const ValidationScene& scene, const std::string& label);
+  // The device it runs on (render and bench draw on the same one).
+  const rt::Harness& harness() const { return *harness_; }
 
  private:
   // runOne on a mesh already quantized to the rig's attribute formats.

@@ -3,10 +3,12 @@
 // must equal the generated shader's (otherwise the hand port row times something else).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
 #include "render/gpu_bench.h"
+#include "common/input_file.h"
 #include "runtime/procedural.h"
 #include "test_util.h"
 
@@ -50,6 +52,54 @@ TEST(GpuBench, CaptureQualifiersGoOnEveryOutputAndUnknownOutputsAreErrors) {
   }
 }
 
+sg::GpuBenchOptions quickBench(const std::string& rules) {
+  sg::GpuBenchOptions b;
+  b.render.gen.rigPath = sourcePath("examples/dawn/face.rig.yaml");
+  b.render.gen.fragmentPath = sourcePath("examples/dawn/face.frag");
+  b.render.gen.rulesPaths = {rules};
+  b.render.mesh = "head";
+  b.render.width = b.render.height = 32;
+  b.drawsPerFrame = 1;
+  b.frames = 1;
+  b.rounds = 1;
+  b.floor = false;
+  return b;
+}
+
+TEST(GpuBench, BufferFedAlternativesAreValidatedAndTimed) {
+  sg::GpuBenchOptions b = quickBench(sourcePath("examples/dawn/rules.yaml"));
+  b.render.gen.maxAttributes = 8;
+  sg::GpuBenchReport rep = sg::runGpuBench(b);
+  size_t bufferRows = 0;
+  for (const auto& row : rep.rows) {
+    bool buffers = std::any_of(row.rules.begin(), row.rules.end(), [](const std::string& n) { return n.find("buffer") != std::string::npos; });
+    bufferRows += buffers;
+    EXPECT_EQ(row.validation, "pass") << row.label;
+    EXPECT_GT(row.rasterOnNsPerVertex, 0) << row.label;
+    EXPECT_GT(row.rasterOffNsPerVertex, 0) << row.label;
+  }
+  EXPECT_GE(bufferRows, 3u);
+}
+
+TEST(GpuBench, AProgramThatFailsOnTheDeviceIsReportedAndNotTimed) {
+  // Eye direction reversed: the plan compiles and runs but computes the wrong outputs.
+  RulesCopy rules("bench_eye");
+  ASSERT_TRUE(rules.edit("view.yaml", "normalize(${world.position} - ${camera.position})",
+                         "normalize(${camera.position} - ${world.position})"));
+  sg::GpuBenchOptions b = quickBench(rules.dawnRules().string());
+  b.alternatives = false;
+  b.floor = true;
+  sg::GpuBenchReport rep = sg::runGpuBench(b);
+  ASSERT_EQ(rep.rows.size(), 3u);
+  const sg::GpuBenchRow& gen = rep.rows[0];
+  EXPECT_EQ(gen.validation.rfind("FAIL", 0), 0u) << gen.validation;
+  EXPECT_EQ(gen.rasterOnNsPerVertex, -1);
+  EXPECT_EQ(gen.rasterOffNsPerVertex, -1);
+  EXPECT_EQ(rep.rows[1].validation, "");  // the floors are timed without a reference
+  EXPECT_GT(rep.rows[1].rasterOnNsPerVertex, 0);
+  EXPECT_NE(sg::formatGpuBench(rep).find("| generated | FAIL"), std::string::npos);
+}
+
 TEST(GpuBench, HandPortOfListing33ComputesWhatTheGeneratedShaderComputes) {
   sg::GenerateOptions g;
   g.rigPath = sourcePath("examples/dawn/face.rig.yaml");
@@ -60,21 +110,19 @@ TEST(GpuBench, HandPortOfListing33ComputesWhatTheGeneratedShaderComputes) {
   sg::ValidationScene scene = sg::proceduralScene(gen.in.rig, "head", 3, 1);
   sg::rt::Mesh mesh = sg::quantizeForRig(gen.in.rig, scene.mesh);
   const sg::rt::Pose& pose = scene.poses.front();
-  sg::HandWrittenRun hand =
-      sg::prepareHandWritten(sourcePath("examples/dawn/listing-3-3.vert"), gen.in.rig, gen.in.rules, mesh, pose, gen.glsl,
-                             g.targetEnv);
+  const std::string path = sourcePath("examples/dawn/listing-3-3.vert");
+  sg::GenerateResult hand = sg::handWrittenProgram(
+      sg::addCaptureQualifiers(sg::readInputFile(path), path, gen.glsl), path, gen, g.targetEnv);
+  EXPECT_NE(hand.spirv.words, gen.spirv.words);
 
   sg::rt::Harness harness;
-  sg::rt::RunRequest a;
+  sg::rt::RunRequest a, b;
+  static_cast<sg::rt::ProgramInputs&>(a) = sg::programInputs(gen, mesh, pose);
   a.spirv = gen.spirv.words;
-  a.vertexCount = static_cast<uint32_t>(mesh.vertexCount);
   a.capture.strideBytes = gen.glsl.captureStride;
-  for (const auto& in : gen.glsl.inputs) a.streams.push_back(sg::vertexStream(gen.in.rig, in, mesh));
-  a.uniformData = sg::uniformBlock(gen.in.rig, gen.in.rules, gen.glsl, gen.spirv, mesh, pose);
-  sg::rt::RunRequest b = a;
-  b.spirv = hand.captureSpirv;
-  b.streams = hand.streams;
-  b.uniformData = hand.uniforms;
+  static_cast<sg::rt::ProgramInputs&>(b) = sg::programInputs(hand, mesh, pose);
+  b.spirv = hand.spirv.words;
+  b.capture.strideBytes = gen.glsl.captureStride;
   std::vector<uint8_t> ga = harness.run(a).captured, gb = harness.run(b).captured;
   ASSERT_EQ(ga.size(), gb.size());
   EXPECT_TRUE(harness.validationMessages().empty()) << harness.validationMessages().front();

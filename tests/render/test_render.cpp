@@ -2,7 +2,9 @@
 // generated shader or broken textures would get wrong.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <cstdlib>
 
 #include "render/render.h"
@@ -202,6 +204,39 @@ TEST(Render, HilightFollowsTheRimLightCubeMap) {
   o.lighting.rimDirection = {0, 0, -1};
   double without = meanLuma(renderChecked(o).image, 0, kSize);
   EXPECT_NE(with, without);
+}
+
+TEST(Render, BufferFedPlanCoversExactlyThePixelsOfTheAttributeFedPlan) {
+  // --max-attributes 8 moves morph deltas and skin influences into storage buffers
+  // (docs/buffers.md): the same rig, pose and camera must draw the same silhouette. A
+  // random pose, so bones and morph weights matter.
+  sg::RenderOptions o = dawnOptions();
+  o.poseSeed = 3;
+  o.camera.yawDegrees = 25;
+  sg::RenderResult attributes = renderChecked(o);
+  o.gen.maxAttributes = 8;
+  sg::RenderResult buffers = renderChecked(o);
+  auto readsBuffers = [](const sg::RenderResult& r) {
+    return std::any_of(r.rules.begin(), r.rules.end(), [](const std::string& n) { return n.find("buffer") != std::string::npos; });
+  };
+  EXPECT_FALSE(readsBuffers(attributes));
+  EXPECT_TRUE(readsBuffers(buffers));
+  std::vector<bool> a = covered(attributes.image), b = covered(buffers.image);
+  EXPECT_GT(std::count(a.begin(), a.end(), true), long(kSize) * kSize / 8);
+  EXPECT_EQ(a, b);
+}
+
+TEST(Render, FragmentSamplersAreTheOnesTheShaderDeclares) {
+  // examples/dawn/face.frag declares its six samplers at set 1, bindings 0-5, the last three cubes.
+  sg::FragmentProgram f = sg::compileFragmentFile(sourcePath("examples/dawn/face.frag"), sg::TargetEnv::Vulkan1_0);
+  std::vector<std::tuple<std::string, uint32_t, uint32_t, bool>> got;
+  for (const auto& d : f.descriptors)
+    if (d.kind == sg::ShaderDescriptor::Kind::Sampler) got.emplace_back(d.name, d.set, d.binding, d.cube);
+  std::sort(got.begin(), got.end(), [](const auto& x, const auto& y) { return std::get<2>(x) < std::get<2>(y); });
+  const std::vector<std::tuple<std::string, uint32_t, uint32_t, bool>> want = {
+      {"SkinColorFrontSpecMap", 1, 0, false}, {"SkinNormSideSpecMap", 1, 1, false}, {"SpecularColorShiftMap", 1, 2, false},
+      {"DiffuseCubeMap", 1, 3, true},         {"SpecularCubeMap", 1, 4, true},      {"HilightCubeMap", 1, 5, true}};
+  EXPECT_EQ(got, want);
 }
 
 TEST(Render, BrokenEyeDirectionChangesTheShadingNotTheSilhouette) {

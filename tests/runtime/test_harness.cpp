@@ -268,6 +268,61 @@ void main() {
   EXPECT_EQ(c.mismatches, 0u) << c.report.str();
 }
 
+TEST_F(HarnessTest, RefusesADeclaredDescriptorThatNothingFeedsAndReadsItOnceFed) {
+  const char* src = R"(#version 450
+layout(location = 0) in vec4 inValue;
+layout(set = 0, binding = 2, std430) readonly buffer Deltas { vec4 deltas[]; };
+out gl_PerVertex { layout(xfb_buffer = 0, xfb_offset = 0, xfb_stride = 16) vec4 gl_Position; };
+void main() { gl_Position = inValue + deltas[gl_VertexIndex]; }
+)";
+  // glslang's reflection names what the program uses: a storage block at set 0, binding 2.
+  sg::GlslShader parsed(sg::GlslUnit{sg::Stage::Vertex, src, "deltas.vert", {}}, sg::TargetEnv::Vulkan1_0);
+  ASSERT_TRUE(parsed.ok());
+  std::vector<sg::ShaderDescriptor> reflected = parsed.descriptors();
+  ASSERT_EQ(reflected.size(), 1u);
+  EXPECT_EQ(reflected[0].kind, sg::ShaderDescriptor::Kind::StorageBlock);
+  EXPECT_EQ(reflected[0].set, 0u);
+  EXPECT_EQ(reflected[0].binding, 2u);
+
+  const uint32_t n = 7;  // odd: the capture pass pads to 8, so the buffer holds 8 elements
+  std::vector<float> values(size_t(n) * 4), deltas(size_t(n + 1) * 4);
+  for (size_t i = 0; i < values.size(); ++i) values[i] = float(i) * 0.5f;
+  for (size_t i = 0; i < deltas.size(); ++i) deltas[i] = 100.0f + float(i);
+  RunRequest req;
+  req.spirv = parsed.spirv();
+  req.vertexCount = n;
+  req.capture.strideBytes = 16;
+  VertexStream s{0, VK_FORMAT_R32G32B32A32_SFLOAT, 16, std::vector<uint8_t>(values.size() * 4)};
+  std::memcpy(s.data.data(), values.data(), s.data.size());
+  req.streams = {s};
+  req.declared = {{0, 2, sg::rt::DescriptorKind::StorageBuffer, "Deltas"}};
+  auto refusal = [&](const RunRequest& r) -> std::string {
+    try {
+      harness_->run(r);
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const std::string unfed = "reads storage buffer 'Deltas' at set 0, binding 2, which nothing feeds";
+  EXPECT_NE(refusal(req).find(unfed), std::string::npos) << refusal(req);
+  sg::rt::StorageBufferData buffer{3, std::vector<uint8_t>(deltas.size() * 4)};
+  std::memcpy(buffer.data.data(), deltas.data(), buffer.data.size());
+  req.storageBuffers = {buffer};  // at the wrong binding
+  EXPECT_NE(refusal(req).find(unfed), std::string::npos) << refusal(req);
+  req.storageBuffers[0].binding = 2;
+  RunResult res = harness_->run(req);
+  ASSERT_EQ(res.captured.size(), size_t(n) * 16);
+  Checker c;
+  for (uint32_t v = 0; v < n; ++v)
+    for (int i = 0; i < 4; ++i) {
+      float got;
+      std::memcpy(&got, &res.captured[(size_t(v) * 4 + size_t(i)) * 4], 4);
+      c.expect("gl_Position", v, i, got, double(values[v * 4 + i]) + double(deltas[v * 4 + i]));
+    }
+  EXPECT_EQ(c.mismatches, 0u) << c.report.str();
+}
+
 TEST_F(HarnessTest, RejectsMalformedRequests) {
   SkinInput in = makeInput(16, 6);
   RunRequest good = makeRequest(in, skinSpirv_);

@@ -1,0 +1,32 @@
+// The data a generated program reads on a device, built from the plan (its emitted
+// interface and reflection), the mesh and the pose in one place: vertex streams, the
+// uniform block (with the sparse active-target list), storage buffers (per-vertex and
+// palettes) and the descriptors the shader declares (rt::ProgramInputs). validate, render
+// and bench feed programs only through programInputs/feedPose.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "pipeline/generate.h"
+#include "runtime/mesh.h"
+#include "runtime/vk_program.h"
+#include "validate/interpreter.h"
+
+namespace sg {
+
+// Everything program `r` reads over `mesh` (already quantizeForRig'd) in `pose`: its vertex
+// streams, storage buffers, uniform block and declared descriptors. Throws InputError when
+// the mesh or pose lacks what the program reads.
+rt::ProgramInputs programInputs(const GenerateResult& r, const rt::Mesh& mesh, const rt::Pose& pose);
+// Feeds `inputs` (built by programInputs for this mesh) for another pose: the uniform
+// block and the palettes. Returns the uniform values it fed (the reference uses the same).
+UniformValues feedPose(const GenerateResult& r, const rt::Mesh& mesh, const rt::Pose& pose, rt::ProgramInputs& inputs);
+
+// The descriptors of a shader's reflection, as the runtime checks them.
+std::vector<rt::DescriptorBinding> declaredDescriptors(const std::vector<ShaderDescriptor>& reflected);
+
+// The mesh with every integer/normalized stream rounded as its attribute format stores it
+// (what the GPU reads back), so the reference sees exactly the GPU's values.
+rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh);
+
+}  // namespace sg
