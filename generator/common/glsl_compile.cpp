@@ -340,13 +340,17 @@ std::string validateSpirv(const std::vector<uint32_t>& words, TargetEnv env) {
   return messages.empty() ? "spirv-val: invalid module" : messages;
 }
 
-std::vector<uint32_t> optimizeSpirv(const std::vector<uint32_t>& words, TargetEnv env) {
+std::vector<uint32_t> optimizeSpirv(const std::vector<uint32_t>& words, TargetEnv env, bool unrollLoops) {
   spvtools::Optimizer opt(versionsOf(env).tools);
   std::string messages;
   opt.SetMessageConsumer([&](spv_message_level_t level, const char*, const spv_position_t&, const char* msg) {
     if (level <= SPV_MSG_ERROR) messages += std::string(msg) + "\n";
   });
   opt.RegisterPerformancePasses();
+  if (unrollLoops) {
+    opt.RegisterPass(spvtools::CreateLoopUnrollPass(true));
+    opt.RegisterPerformancePasses();
+  }
   std::vector<uint32_t> out;
   if (!opt.Run(words.data(), words.size(), &out)) throw std::runtime_error("spirv-opt failed: " + messages);
   return out;

@@ -13,7 +13,7 @@
 namespace sg {
 
 // Validates a plan: each action applicable in order from init, goals reached, cost is
-// the sum of the actions' costs, no action repeated, and every action's product is new
+// the sum of the actions' costs (and the costs of the inputs read, once each), no action repeated, and every action's product is new
 // and needed (a goal or a precondition of a later action) — the tidy-plan contract.
 inline ::testing::AssertionResult planIsValid(const Problem& p, const Plan& plan) {
   std::vector<bool> have(p.facts.size(), false);
@@ -45,8 +45,18 @@ inline ::testing::AssertionResult planIsValid(const Problem& p, const Plan& plan
   }
   for (int g : p.goals)
     if (!have[g]) return ::testing::AssertionFailure() << "goal " << p.facts[g].name << " not reached";
+  // Under a device profile each rig input read (by a rule or as a pass-through goal) is
+  // paid once, plus the fixed terms; both are zero without one.
+  std::set<int> items;
+  for (int ai : plan.actions)
+    for (int f : p.actions[ai].pre)
+      if (p.facts[f].resource >= 0) items.insert(p.facts[f].resource);
+  for (int g : p.goals)
+    if (p.facts[g].resource >= 0) items.insert(p.facts[g].resource);
+  for (int r : items) sum += p.resources[r].cost;
+  sum += p.fixedCost;
   if (sum != plan.cost)
-    return ::testing::AssertionFailure() << "plan.cost " << plan.cost << " != sum of action costs " << sum;
+    return ::testing::AssertionFailure() << "plan.cost " << plan.cost << " != sum of action and input costs " << sum;
   return ::testing::AssertionSuccess();
 }
 
