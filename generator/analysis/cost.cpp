@@ -409,7 +409,9 @@ SpirvAccesses measureAccesses(const std::vector<uint32_t>& words) {
   struct Chain {
     uint32_t base;
     bool dynamic;
+    std::vector<uint32_t> indices;
   };
+  std::set<std::vector<uint32_t>> loaded;
   std::map<uint32_t, Chain> chains;  // access chain result -> its base and whether an index is computed
   for (size_t i = 5; i < words.size();) {
     const uint32_t len = words[i] >> 16;
@@ -437,19 +439,33 @@ SpirvAccesses measureAccesses(const std::vector<uint32_t>& words) {
         if (len >= 4) {
           bool dynamic = false;
           for (uint32_t k = 4; k < len; ++k) dynamic = dynamic || !constants.count(w[k]);
-          chains[w[2]] = Chain{w[3], dynamic};
+          chains[w[2]] = Chain{w[3], dynamic, std::vector<uint32_t>(w + 4, w + len)};
         }
         break;
       case spv::OpLoad: {
         if (len < 4) break;
         uint32_t ptr = w[3];
         bool dynamic = false;
+        std::vector<uint32_t> path;  // the indices from the variable down, innermost chain last
         for (auto c = chains.find(ptr); c != chains.end(); c = chains.find(ptr)) {
           dynamic = dynamic || c->second.dynamic;
+          path.insert(path.begin(), c->second.indices.begin(), c->second.indices.end());
           ptr = c->second.base;
         }
         auto var = variableType.find(ptr);
         if (var == variableType.end()) break;
+        // One fetch per element: loads of the same element (same variable and index values up
+        // to the last computed index; constant indices after it pick parts of the element,
+        // such as a component of a vec4 or a column of a palette matrix) count once.
+        size_t keep = path.size();
+        for (size_t k = path.size(); k-- > 0;)
+          if (!constants.count(path[k])) {
+            keep = k + 1;
+            break;
+          }
+        path.resize(keep);
+        path.insert(path.begin(), ptr);
+        if (!loaded.insert(path).second) break;
         const uint32_t cls = pointerClass[var->second];
         const bool buffer = cls == spv::StorageClassStorageBuffer ||
                             (cls == spv::StorageClassUniform && bufferBlocks.count(pointee[var->second]));

@@ -44,8 +44,9 @@ struct AutoCost {
 AutoCost measureRuleCost(const RuleSet& rules, int rule, const ProbeRig& rig);
 
 // Memory accesses per vertex of a program (the cost model's per-rule terms,
-// docs/device-profiles.md): OpLoads through a storage buffer, per binding; OpLoads from a
-// uniform block through an access chain with a computed index (palette[joint]).
+// docs/device-profiles.md), as elements fetched (loads of one element, whatever parts of it,
+// count once): through a storage buffer, per binding; from the uniform block through an
+// access chain with a computed index (palette[joint]).
 struct SpirvAccesses {
   std::map<uint32_t, int64_t> bufferLoads;  // binding -> loads
   int64_t indexedUniformLoads = 0;
