@@ -1,7 +1,10 @@
 // Benchmarks of the search engines (issue 12). Not part of ctest except a smoke run:
 // bench/search_table.sh runs them and prints the table of docs/search.md.
 //
-// BM_Dawn/<solver>: one search on the Dawn face problem (examples/dawn), search alone.
+// BM_Dawn/<solver>: one search on the Dawn face problem (examples/dawn), search alone;
+//   BM_DawnProfiled: the same under devices/example.yaml (issue 21).
+// BM_LibraryProfiled/<rules>/<solver>: the libraries below under a random device profile
+//   (tests/support addRandomProfile), against the IP on the same priced instances.
 // BM_Library/<rules>/<solver>: the seeded synthetic libraries of tests/support
 //   (random_library.h), 10 seeds (1..10) per size, each solved once per iteration with a
 //   per-search time limit. Counters: median and worst time (ms), the median time as a
@@ -72,26 +75,31 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2;
 }
 
-const std::vector<sg::Problem>& library(int rules) {
-  static std::map<int, std::vector<sg::Problem>> cache;
-  auto& v = cache[rules];
+// profiled: the same libraries under a random device profile (sgtest::addRandomProfile:
+// inputs priced once per plan, so the items read join the regression state).
+const std::vector<sg::Problem>& library(int rules, bool profiled = false) {
+  static std::map<std::pair<int, bool>, std::vector<sg::Problem>> cache;
+  auto& v = cache[{rules, profiled}];
   if (v.empty())
-    for (int seed = 1; seed <= kSeeds; ++seed) v.push_back(sgtest::randomLibrary(sgtest::LibraryShape{rules, static_cast<uint64_t>(seed)}));
+    for (int seed = 1; seed <= kSeeds; ++seed) {
+      v.push_back(sgtest::randomLibrary(sgtest::LibraryShape{rules, static_cast<uint64_t>(seed)}));
+      if (profiled) sgtest::addRandomProfile(v.back(), static_cast<uint64_t>(seed));
+    }
   return v;
 }
 
 // The integer program's outcomes per size: the cost oracle and the time baseline.
-const std::vector<Outcome>& oracle(int rules) {
-  static std::map<int, std::vector<Outcome>> cache;
-  auto& v = cache[rules];
+const std::vector<Outcome>& oracle(int rules, bool profiled = false) {
+  static std::map<std::pair<int, bool>, std::vector<Outcome>> cache;
+  auto& v = cache[{rules, profiled}];
   if (v.empty())
-    for (const auto& p : library(rules)) v.push_back(solve(p, kSolvers[7]));
+    for (const auto& p : library(rules, profiled)) v.push_back(solve(p, kSolvers[7]));
   return v;
 }
 
-void BM_Library(benchmark::State& state, int rules, Solver solver) {
-  const auto& problems = library(rules);
-  const auto& ip = oracle(rules);
+void BM_Library(benchmark::State& state, int rules, Solver solver, bool profiled) {
+  const auto& problems = library(rules, profiled);
+  const auto& ip = oracle(rules, profiled);
   std::vector<Outcome> out;
   for (auto _ : state) {
     out.clear();
@@ -122,16 +130,20 @@ void BM_Library(benchmark::State& state, int rules, Solver solver) {
   state.counters["limit_s"] = solver.limitSeconds;
 }
 
-void BM_Dawn(benchmark::State& state, Solver solver) {
-  static const sg::LoadedInputs in = [] {
+// profiled: under devices/example.yaml (input locations dear, arithmetic nearly free).
+void BM_Dawn(benchmark::State& state, Solver solver, bool profiled) {
+  auto load = [](bool withProfile) {
     sg::GenerateOptions g;
     const std::string dir = std::string(SG_SOURCE_DIR) + "/examples/dawn/";
     g.rigPath = dir + "face.rig.yaml";
     g.fragmentPath = dir + "face.frag";
     g.rulesPaths = {dir + "rules.yaml"};
+    if (withProfile) g.deviceProfilePath = std::string(SG_SOURCE_DIR) + "/devices/example.yaml";
     return sg::loadInputs(g);
-  }();
-  static const int64_t optimum = solve(in.problem, kSolvers[7]).cost;
+  };
+  static const sg::LoadedInputs plain = load(false), priced = load(true);
+  const sg::LoadedInputs& in = profiled ? priced : plain;
+  const int64_t optimum = solve(in.problem, kSolvers[7]).cost;
   Outcome o;
   for (auto _ : state) o = solve(in.problem, solver);
   if (o.cost != optimum) state.SkipWithError("plan cost differs from the integer program's optimum");
@@ -187,15 +199,27 @@ int writeLibrary(const std::string& dir, int rules, uint64_t seed) {
 int main(int argc, char** argv) {
   if (argc == 5 && std::string(argv[1]) == "--write-library")
     return writeLibrary(argv[2], std::atoi(argv[3]), std::strtoull(argv[4], nullptr, 10));
-  for (const Solver& s : kSolvers)
-    benchmark::RegisterBenchmark((std::string("BM_Dawn/") + s.name).c_str(), BM_Dawn, s)
-        ->Unit(benchmark::kMicrosecond)
-        ->UseRealTime();
+  for (bool profiled : {false, true})
+    for (const Solver& s : kSolvers)
+      benchmark::RegisterBenchmark((std::string(profiled ? "BM_DawnProfiled/" : "BM_Dawn/") + s.name).c_str(), BM_Dawn,
+                                   s, profiled)
+          ->Unit(benchmark::kMicrosecond)
+          ->UseRealTime();
   for (int rules : {100, 300, 1000, 3000})
     for (const Solver& s : kSolvers)
       if (runs(rules, s.name))
         benchmark::RegisterBenchmark((std::string("BM_Library/") + std::to_string(rules) + "/" + s.name).c_str(),
-                                     BM_Library, rules, s)
+                                     BM_Library, rules, s, false)
+            ->Iterations(1)
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+  // Under a random device profile: the exact engines only (forward hands priced problems to the IP).
+  for (int rules : {100, 300, 1000, 3000})
+    for (const Solver& s : kSolvers)
+      if (std::string(s.name) == "regression/lmcut" || std::string(s.name) == "ip")
+        benchmark::RegisterBenchmark(
+            (std::string("BM_LibraryProfiled/") + std::to_string(rules) + "/" + s.name).c_str(), BM_Library, rules, s,
+            true)
             ->Iterations(1)
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();

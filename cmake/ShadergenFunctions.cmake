@@ -11,6 +11,7 @@
 #     [CAPTURE]                 # transform-feedback build (to read outputs back with sg::rt::Harness)
 #     [MAP <Name=sem[,sem...]>...]  # --map overrides of fragment inputs
 #     [TEMPLATES <dir>]         # --templates (default: the ones shipped with shadergen)
+#     [DEVICE_PROFILE <file>]   # --device-profile: the plan cheapest on that device (docs/device-profiles.md)
 #     [DEPENDS <file>...])      # extra dependencies of the generator run
 #
 # Runs `shadergen generate` in a custom command whose DEPFILE lists every file the
@@ -51,7 +52,7 @@ endfunction()
 
 function(shadergen_add_vertex_shader target)
   set(options OPTIMIZE EMBED CAPTURE)
-  set(one RIG FRAGMENT OUTPUT_NAME TARGET_ENV TEMPLATES)
+  set(one RIG FRAGMENT OUTPUT_NAME TARGET_ENV TEMPLATES DEVICE_PROFILE)
   set(multi RULES MAP DEPENDS)
   cmake_parse_arguments(PARSE_ARGV 1 SG "${options}" "${one}" "${multi}")
 
@@ -125,6 +126,13 @@ function(shadergen_add_vertex_shader target)
     list(APPEND _args --templates "${_tpl}")
   endif()
 
+  if(SG_DEVICE_PROFILE)
+    # A dependency as well (the depfile names it too once the generator has run).
+    get_filename_component(_profile "${SG_DEVICE_PROFILE}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+    list(APPEND _args --device-profile "${_profile}")
+    list(APPEND _extra "${_profile}")
+  endif()
+
   add_custom_command(
     OUTPUT ${_outputs}
     COMMAND ${_sg_exe} ${_args}
@@ -156,6 +164,7 @@ endfunction()
 #     [OUTPUT_DIR <dir>]         # default: ${CMAKE_CURRENT_BINARY_DIR}/shadergen/<target>/<manifest name>
 #     [RULES <file>...]          # rules files read before the manifest's (e.g. ${SHADERGEN_RULES_DIR}/standard.yaml)
 #     [JOBS <n>]                 # worker threads (default: every hardware thread)
+#     [DEVICE_PROFILE <file>]    # --device-profile for every variant, in place of the manifest's
 #     [DEPENDS <file>...])       # extra dependencies
 #
 # The custom command's output is <dir>/index.json (every variant with its plan cost and
@@ -166,7 +175,7 @@ endfunction()
 # definition SHADERGEN_<NAME>_INDEX="<dir>/index.json" (NAME: the manifest's file name up
 # to the first '.', upper-cased, non-alphanumerics as '_'), also set in the caller's scope.
 function(shadergen_add_shader_variants target)
-  cmake_parse_arguments(PARSE_ARGV 1 SG "" "MANIFEST;OUTPUT_DIR;JOBS" "RULES;DEPENDS")
+  cmake_parse_arguments(PARSE_ARGV 1 SG "" "MANIFEST;OUTPUT_DIR;JOBS;DEVICE_PROFILE" "RULES;DEPENDS")
   if(SG_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "shadergen_add_shader_variants(${target}): unknown arguments: ${SG_UNPARSED_ARGUMENTS}")
   endif()
@@ -199,6 +208,11 @@ function(shadergen_add_shader_variants target)
   endforeach()
   if(SG_JOBS)
     list(APPEND _args -j "${SG_JOBS}")
+  endif()
+  if(SG_DEVICE_PROFILE)
+    get_filename_component(_profile "${SG_DEVICE_PROFILE}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+    list(APPEND _args --device-profile "${_profile}")
+    list(APPEND _extra "${_profile}")
   endif()
   add_custom_command(
     OUTPUT "${_dir}/index.json"

@@ -8,6 +8,7 @@
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -351,15 +352,18 @@ CostBreakdown measureSpirv(const std::vector<uint32_t>& words) {
   return b;
 }
 
-AutoCost measureRuleCost(const RuleSet& rules, int r, const ProbeRig& rig) {
-  AutoCost res;
+namespace {
+
+// The rule's probe compiled and optimised (loops with a constant trip count unrolled when
+// `unroll`); nullopt with the reasons in `diags` (located in the rules file).
+std::optional<std::vector<uint32_t>> optimisedProbe(const RuleSet& rules, int r, const ProbeRig& rig, bool unroll,
+                                                    SnippetProbe& probe, std::vector<Diagnostic>& diags) {
   const Rule& rule = rules.rules[static_cast<size_t>(r)];
-  SnippetProbe probe;
   try {
     probe = buildSnippetProbe(rules, r, rig);
   } catch (const InputError& e) {
-    res.diagnostics.push_back(e.diagnostic());
-    return res;
+    diags.push_back(e.diagnostic());
+    return std::nullopt;
   }
   CompileResult c = compileSnippetProbe(probe, rule);
   if (!c.ok) {
@@ -369,24 +373,156 @@ AutoCost measureRuleCost(const RuleSet& rules, int r, const ProbeRig& rig) {
     for (const auto& d : c.diagnostics)
       if (d.severity == Severity::Error && d.message.find("compilation terminated") == std::string::npos &&
           (d.loc.line == 0 || lines.insert({d.loc.file, d.loc.line}).second))
-        res.diagnostics.push_back(d);
-    if (res.diagnostics.empty())
-      res.diagnostics.push_back(Diagnostic{Severity::Error, rule.loc,
-                                           fmt::format("the snippet of rule '{}' does not compile", rule.name)});
-    return res;
+        diags.push_back(d);
+    if (diags.empty())
+      diags.push_back(Diagnostic{Severity::Error, rule.loc,
+                                 fmt::format("the snippet of rule '{}' does not compile", rule.name)});
+    return std::nullopt;
   }
-  std::vector<uint32_t> opt;
   try {
-    opt = optimizeSpirv(c.spirv, TargetEnv::Vulkan1_0);
+    return optimizeSpirv(c.spirv, TargetEnv::Vulkan1_0, unroll);
   } catch (const std::exception& e) {
-    res.diagnostics.push_back(Diagnostic{Severity::Error, rule.loc,
-                                         fmt::format("rule '{}': cannot optimise its snippet: {}", rule.name, e.what())});
-    return res;
+    diags.push_back(Diagnostic{Severity::Error, rule.loc,
+                               fmt::format("rule '{}': cannot optimise its snippet: {}", rule.name, e.what())});
+    return std::nullopt;
   }
-  res.breakdown = measureSpirv(opt);
+}
+
+}  // namespace
+
+AutoCost measureRuleCost(const RuleSet& rules, int r, const ProbeRig& rig) {
+  AutoCost res;
+  SnippetProbe probe;
+  std::optional<std::vector<uint32_t>> opt = optimisedProbe(rules, r, rig, false, probe, res.diagnostics);
+  if (!opt) return res;
+  res.breakdown = measureSpirv(*opt);
   res.cost = res.breakdown.total;
   res.ok = true;
   return res;
+}
+
+SpirvAccesses measureAccesses(const std::vector<uint32_t>& words) {
+  SpirvAccesses out;
+  std::set<uint32_t> constants, bufferBlocks;
+  std::map<uint32_t, uint32_t> binding, pointerClass, pointee;  // id -> Binding; pointer type -> class, pointee
+  std::map<uint32_t, uint32_t> variableType;                    // variable -> its pointer type
+  struct Chain {
+    uint32_t base;
+    bool dynamic;
+    std::vector<uint32_t> indices;
+  };
+  std::set<std::vector<uint32_t>> loaded;
+  std::map<uint32_t, Chain> chains;  // access chain result -> its base and whether an index is computed
+  for (size_t i = 5; i < words.size();) {
+    const uint32_t len = words[i] >> 16;
+    if (len == 0 || i + len > words.size()) break;
+    const auto op = static_cast<spv::Op>(words[i] & 0xffffu);
+    const uint32_t* w = &words[i];
+    switch (op) {
+      case spv::OpConstant: case spv::OpConstantComposite: case spv::OpConstantNull: case spv::OpSpecConstant:
+        if (len >= 3) constants.insert(w[2]);
+        break;
+      case spv::OpDecorate:
+        if (len >= 4 && w[2] == spv::DecorationBinding) binding[w[1]] = w[3];
+        if (len >= 3 && w[2] == spv::DecorationBufferBlock) bufferBlocks.insert(w[1]);
+        break;
+      case spv::OpTypePointer:
+        if (len >= 4) {
+          pointerClass[w[1]] = w[2];
+          pointee[w[1]] = w[3];
+        }
+        break;
+      case spv::OpVariable:
+        if (len >= 4) variableType[w[2]] = w[1];
+        break;
+      case spv::OpAccessChain: case spv::OpInBoundsAccessChain:
+        if (len >= 4) {
+          bool dynamic = false;
+          for (uint32_t k = 4; k < len; ++k) dynamic = dynamic || !constants.count(w[k]);
+          chains[w[2]] = Chain{w[3], dynamic, std::vector<uint32_t>(w + 4, w + len)};
+        }
+        break;
+      case spv::OpLoad: {
+        if (len < 4) break;
+        uint32_t ptr = w[3];
+        bool dynamic = false;
+        std::vector<uint32_t> path;  // the indices from the variable down, innermost chain last
+        for (auto c = chains.find(ptr); c != chains.end(); c = chains.find(ptr)) {
+          dynamic = dynamic || c->second.dynamic;
+          path.insert(path.begin(), c->second.indices.begin(), c->second.indices.end());
+          ptr = c->second.base;
+        }
+        auto var = variableType.find(ptr);
+        if (var == variableType.end()) break;
+        // One fetch per element: loads of the same element (same variable and index values up
+        // to the last computed index; constant indices after it pick parts of the element,
+        // such as a component of a vec4 or a column of a palette matrix) count once.
+        size_t keep = path.size();
+        for (size_t k = path.size(); k-- > 0;)
+          if (!constants.count(path[k])) {
+            keep = k + 1;
+            break;
+          }
+        path.resize(keep);
+        path.insert(path.begin(), ptr);
+        if (!loaded.insert(path).second) break;
+        const uint32_t cls = pointerClass[var->second];
+        const bool buffer = cls == spv::StorageClassStorageBuffer ||
+                            (cls == spv::StorageClassUniform && bufferBlocks.count(pointee[var->second]));
+        if (buffer) ++out.bufferLoads[binding.count(ptr) ? binding[ptr] : 0];
+        else if (cls == spv::StorageClassUniform && dynamic) ++out.indexedUniformLoads;
+        break;
+      }
+      default: break;
+    }
+    i += len;
+  }
+  return out;
+}
+
+RuleAccesses measureRuleAccesses(const RuleSet& rules, int r, const ProbeRig& rig) {
+  RuleAccesses res;
+  SnippetProbe probe;
+  std::optional<std::vector<uint32_t>> opt = optimisedProbe(rules, r, rig, true, probe, res.diagnostics);
+  if (!opt) return res;
+  SpirvAccesses a = measureAccesses(*opt);
+  for (const auto& [b, loads] : a.bufferLoads)
+    if (b >= 1 && b <= probe.buffers.size()) res.bufferLoads[probe.buffers[b - 1]] += loads;
+  res.indexedUniformLoads = a.indexedUniformLoads;
+  res.ok = true;
+  return res;
+}
+
+void measureAccessTerms(Problem& p, const RuleSet& rules, const Rig& rig) {
+  std::optional<ProbeRig> pr;
+  std::map<int, RuleAccesses> measured;  // per rule
+  for (auto& act : p.actions) {
+    // Only a rule that reads a storage buffer or a uniform array can load either.
+    bool reads = false;
+    for (int q : act.pre) {
+      const Fact& f = p.facts[static_cast<size_t>(q)];
+      reads = reads || f.source == Fact::Source::Buffer || (f.source == Fact::Source::Uniform && f.arraySize > 0);
+    }
+    if (!reads) continue;
+    if (!pr) pr = probeRigFromRig(rig, rules);
+    auto it = measured.find(act.rule);
+    if (it == measured.end()) it = measured.emplace(act.rule, measureRuleAccesses(rules, act.rule, *pr)).first;
+    const RuleAccesses& a = it->second;
+    if (!a.ok) {
+      InputError e(a.diagnostics.front());
+      e.related.assign(a.diagnostics.begin() + 1, a.diagnostics.end());
+      throw e;
+    }
+    act.terms[kTermBufferLoads] = act.terms[kTermBufferBytes] = 0;
+    for (const auto& [fact, loads] : a.bufferLoads) {
+      const int f = p.findFact(fact);
+      if (f < 0 || p.facts[static_cast<size_t>(f)].source != Fact::Source::Buffer) continue;
+      act.terms[kTermBufferLoads] += loads;
+      act.terms[kTermBufferBytes] += loads * p.buffers[static_cast<size_t>(p.facts[static_cast<size_t>(f)].rigIndex)].strideBytes;
+    }
+    act.terms[kTermIndexedUniformLoads] = a.indexedUniformLoads;
+  }
+  priceProblem(p, p.weights);
 }
 
 void resolveAutoCosts(RuleSet& rules, const Rig& rig) {

@@ -4,6 +4,7 @@
 // instruction slots (the unit of the hand-written costs).
 #pragma once
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 #include "analysis/probe.h"
 #include "common/diagnostics.h"
 #include "rules/rules.h"
+#include "search/problem.h"
 
 namespace sg {
 
@@ -40,6 +42,31 @@ struct AutoCost {
 // Measures rules.rules[rule] instantiated for `rig` (template errors and compile errors
 // are returned as diagnostics, not thrown).
 AutoCost measureRuleCost(const RuleSet& rules, int rule, const ProbeRig& rig);
+
+// Memory accesses per vertex of a program (the cost model's per-rule terms,
+// docs/device-profiles.md), as elements fetched (loads of one element, whatever parts of it,
+// count once): through a storage buffer, per binding; from the uniform block through an
+// access chain with a computed index (palette[joint]).
+struct SpirvAccesses {
+  std::map<uint32_t, int64_t> bufferLoads;  // binding -> loads
+  int64_t indexedUniformLoads = 0;
+};
+SpirvAccesses measureAccesses(const std::vector<uint32_t>& words);
+
+struct RuleAccesses {
+  bool ok = false;
+  std::map<std::string, int64_t> bufferLoads;  // per buffer semantic read: element loads
+  int64_t indexedUniformLoads = 0;
+  std::vector<Diagnostic> diagnostics;
+};
+// Counted on the rule's probe (analysis/probe.h) optimised with loops of constant trip
+// count unrolled, so a loop over the targets counts one load per target.
+RuleAccesses measureRuleAccesses(const RuleSet& rules, int rule, const ProbeRig& rig);
+
+// Sets the buffer-load, buffer-byte (loads x the buffer's element stride) and indexed
+// uniform load terms of every action that reads a storage buffer or a uniform array, then
+// reprices the problem. Throws InputError when a snippet cannot be measured.
+void measureAccessTerms(Problem& p, const RuleSet& rules, const Rig& rig);
 
 // Replaces every `cost: auto` by the measured cost for `rig` (rules whose `when` is false
 // for the rig are left alone: they are not instantiated). Throws InputError when a snippet

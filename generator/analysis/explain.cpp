@@ -165,7 +165,14 @@ std::string formatExplanation(const LoadedInputs& in, const Explanation& e) {
     }
     out += fmt::format("  {:<40} {:<24} {:>5} {:>5}  {}\n", a.name, p.facts[a.add].name, a.cost, s.uses, without);
   }
+  if (in.profile) {
+    // Under a device profile the inputs (each paid once) and the fixed terms cost too.
+    out += fmt::format("rules {} + rig inputs read and fixed terms {} (fs per vertex, device profile)\n", sum,
+                       e.plan.cost - sum);
+    sum = e.plan.cost;
+  }
   out += fmt::format("total cost {} ({} rules, each paid once; {} A*)\n", sum, e.steps.size(), e.heuristic);
+  if (in.profile) out += "\n" + describePlanCost(e.plan, p, *in.profile);
   if (!in.rules.changes.empty()) out += "\n" + formatRuleChanges(in.rules);
   return out;
 }

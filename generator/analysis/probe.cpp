@@ -119,6 +119,7 @@ SnippetProbe buildSnippetProbe(const RuleSet& rules, int r, const ProbeRig& rig)
           "layout(set = 0, binding = {}, std430) readonly buffer ProbeBuffer{} {{\n  {} {}_data[];\n}};\n"
           "{} {}(int i) {{ return {}_data[uint(gl_VertexIndex) + uint(i)]; }}\n",
           binding, binding, t, n, t, n, n);
+      probe.buffers.push_back(fact);
       ++binding;
       continue;
     }

@@ -51,6 +51,7 @@ struct SnippetProbe {
   std::vector<SourceLoc> snippetLines;  // where each emitted snippet line sits in the rules file
   std::string productType;  // GLSL type of the product
   SourceLoc end;  // just past the last snippet line's text (where a missing ';' is reported)
+  std::vector<std::string> buffers;  // the storage buffers read: binding i + 1 holds buffers[i] (a fact name)
 };
 
 // Builds the probe shader for rules.rules[rule]. Throws InputError (located in the rules

@@ -42,12 +42,21 @@ Result generate(const Options& options) {
                                                         options.targetEnv));
     o.optimize = options.optimize;
     o.templateDir = options.templates;
+    o.deviceProfilePath = options.deviceProfile;
     sg::GenerateResult g = sg::generate(o);
     r.glsl = g.glsl.text;
     r.spirv = g.spirv.words;
-    r.reflection = sg::reflectionJson(g.in.rig, g.glsl, g.spirv);
+    r.reflection = sg::reflectionOf(g);
     r.cost = g.plan.cost;
     for (int a : g.plan.actions) r.rules.push_back(g.in.problem.actions[a].name);
+    if (g.in.profile) {
+      const sg::PlanCostPrediction c = sg::predictPlanCost(g.plan, g.in.problem, *g.in.profile);
+      for (int t = 0; t < sg::kTermCount; ++t) {
+        r.termAmounts[sg::termName(t)] = c.amounts[static_cast<size_t>(t)];
+        r.termNanoseconds[sg::termName(t)] = c.nanoseconds[static_cast<size_t>(t)];
+      }
+      r.predictedNanoseconds = c.totalNanoseconds;
+    }
     r.ok = true;
   } catch (const sg::InputError& e) {
     r.diagnostics.push_back(convert(e.diagnostic()));

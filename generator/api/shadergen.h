@@ -25,6 +25,7 @@ struct Options {
   std::string targetEnv = "vulkan1.0";  // .. "vulkan1.3"
   bool optimize = false;             // spirv-opt -O
   std::string templates;             // "" = the templates installed with shadergen
+  std::string deviceProfile;         // device profile YAML (docs/device-profiles.md); "" = instruction slots
 };
 
 struct Diagnostic {
@@ -40,7 +41,12 @@ struct Result {
   std::string glsl;                   // the vertex shader (Vulkan GLSL 450)
   std::vector<uint32_t> spirv;        // validated SPIR-V
   std::string reflection;             // JSON: vertex inputs, uniform layout, outputs
-  int64_t cost = 0;                   // plan cost (vertex-program instruction slots)
+  int64_t cost = 0;                   // plan cost: instruction slots, or femtoseconds per vertex with a profile
+  // With a device profile: the plan's amount and predicted nanoseconds per vertex of each
+  // cost term ("arithmetic", "locations", ...), and their sum.
+  std::map<std::string, int64_t> termAmounts;
+  std::map<std::string, double> termNanoseconds;
+  double predictedNanoseconds = 0;
   std::vector<std::string> rules;     // the plan's rules, in order
   std::vector<Diagnostic> diagnostics;  // why it failed (when !ok)
 };

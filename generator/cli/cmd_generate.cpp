@@ -45,6 +45,10 @@ void GenerateArgs::add(CLI::App& cmd) {
                  "The most vertices one draw has: per-vertex storage buffers that would exceed "
                  "maxStorageBufferRange (2^27 bytes) at that count are not used (default: unknown, all allowed)")
       ->check(CLI::Range(int64_t{0}, int64_t{1} << 32));
+  cmd.add_option("--device-profile", opts.deviceProfilePath,
+                 "Device profile (YAML, docs/device-profiles.md): weights in ns per vertex of arithmetic, vertex "
+                 "input locations, bytes fetched, buffer and indexed uniform loads, outputs. The plan becomes the "
+                 "cheapest in predicted time on that device (default: instruction slots)");
   cmd.add_option("--target-env", targetEnv, "vulkan1.0 (default), vulkan1.1, vulkan1.2, vulkan1.3")
       ->check(CLI::IsMember({"vulkan", "vulkan1.0", "vulkan1.1", "vulkan1.2", "vulkan1.3"}));
   cmd.add_option("--templates", opts.templateDir, "Directory with vertex.glsl templates");
@@ -151,7 +155,7 @@ struct GenerateCommand {
       if (sym.empty() || std::isdigit(static_cast<unsigned char>(sym[0]))) sym = "sg_" + sym;
       files.push_back({pathFor("header"), spirvHeader(r.spirv.words, sym + "_spv") + buffersHeader(r.glsl, sym)});
     }
-    if (kinds.count("reflection")) files.push_back({pathFor("reflection"), reflectionJson(r.in.rig, r.glsl, r.spirv)});
+    if (kinds.count("reflection")) files.push_back({pathFor("reflection"), reflectionOf(r)});
     if (depfile || !depfilePath.empty()) {
       // Every output is a target of the depfile (first = the first output, as Ninja wants).
       std::vector<std::string> targets;
@@ -168,6 +172,7 @@ struct GenerateCommand {
       std::cout << fmt::format("plan for rig '{}' ({} rules, {} expanded, {} heuristic):\n", r.in.rig.name,
                                r.plan.actions.size(), r.stats.expanded, o.heuristic);
       std::cout << describePlan(r.in.problem, r.plan);
+      if (r.in.profile) std::cout << describePlanCost(r.plan, r.in.problem, *r.in.profile);
       for (const auto& f : files) std::cout << "wrote " << f.path << "\n";
     }
     return 0;

@@ -365,15 +365,28 @@ std::string validateSpirv(const std::vector<uint32_t>& words, TargetEnv env) {
   return messages.empty() ? "spirv-val: invalid module" : messages;
 }
 
-std::vector<uint32_t> optimizeSpirv(const std::vector<uint32_t>& words, TargetEnv env) {
+std::vector<uint32_t> optimizeSpirv(const std::vector<uint32_t>& words, TargetEnv env, bool unrollLoops) {
   spvtools::Optimizer opt(versionsOf(env).tools);
   std::string messages;
   opt.SetMessageConsumer([&](spv_message_level_t level, const char*, const spv_position_t&, const char* msg) {
     if (level <= SPV_MSG_ERROR) messages += std::string(msg) + "\n";
   });
   opt.RegisterPerformancePasses();
+  std::vector<uint32_t> in = words;
+  if (unrollLoops) {
+    // The unroller only takes loops marked Unroll: mark every loop (OpLoopMerge's control).
+    constexpr uint32_t kOpLoopMerge = 246, kUnroll = 0x1, kDontUnroll = 0x2;
+    for (size_t i = 5; i < in.size();) {
+      const uint32_t len = in[i] >> 16;
+      if (len == 0 || i + len > in.size()) break;
+      if ((in[i] & 0xffffu) == kOpLoopMerge && len >= 4) in[i + 3] = (in[i + 3] & ~kDontUnroll) | kUnroll;
+      i += len;
+    }
+    opt.RegisterPass(spvtools::CreateLoopUnrollPass(true));
+    opt.RegisterPerformancePasses();
+  }
   std::vector<uint32_t> out;
-  if (!opt.Run(words.data(), words.size(), &out)) throw std::runtime_error("spirv-opt failed: " + messages);
+  if (!opt.Run(in.data(), in.size(), &out)) throw std::runtime_error("spirv-opt failed: " + messages);
   return out;
 }
 

@@ -116,7 +116,9 @@ std::vector<Diagnostic> parseGlslangLog(const std::string& log, const GlslUnit& 
 std::string validateSpirv(const std::vector<uint32_t>& words, TargetEnv env);
 
 // spirv-opt -O (performance passes). Throws std::runtime_error on optimiser failure.
-std::vector<uint32_t> optimizeSpirv(const std::vector<uint32_t>& words, TargetEnv env);
+// unrollLoops: also unroll every loop with a constant trip count, then -O again (how the
+// cost model counts the loads a rule's loop makes, analysis/cost.h).
+std::vector<uint32_t> optimizeSpirv(const std::vector<uint32_t>& words, TargetEnv env, bool unrollLoops = false);
 
 // Number of instructions in a module (header excluded).
 size_t countInstructions(const std::vector<uint32_t>& words);

@@ -62,7 +62,8 @@ std::string buffersHeader(const EmittedGlsl& glsl, const std::string& symbol) {
   return h;
 }
 
-std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spirv) {
+std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spirv,
+                           const DeviceProfile* profile, const PlanCostPrediction* predicted) {
   std::string j = "{\n  \"rig\": " + quote(rig.name) + ",\n  \"inputs\": [";
   for (size_t i = 0; i < glsl.inputs.size(); ++i) {
     const auto& in = glsl.inputs[i];
@@ -95,6 +96,14 @@ std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvM
   }
   j += "\n  ]},\n";
   j += buffersJson(glsl);
+  if (profile && predicted) {
+    j += fmt::format("  \"predicted_cost\": {{\"device\": {}, \"ns_per_vertex\": {:.6f}, \"terms\": {{",
+                     quote(profile->device), predicted->totalNanoseconds);
+    for (size_t t = 0; t < kTermCount; ++t)
+      j += fmt::format("{}\n    {}: {{\"amount\": {}, \"ns\": {:.6f}}}", t ? "," : "", quote(termName(static_cast<int>(t))),
+                       predicted->amounts[t], predicted->nanoseconds[t]);
+    j += "\n  }},\n";
+  }
   j += "  \"outputs\": [";
   for (size_t i = 0; i < glsl.outputs.size(); ++i) {
     const auto& o = glsl.outputs[i];

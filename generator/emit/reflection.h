@@ -6,10 +6,13 @@
 #include "emit/glsl_emitter.h"
 #include "emit/spirv.h"
 #include "rig/rig.h"
+#include "search/device_profile.h"
 
 namespace sg {
 
-std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spirv);
+// With a device profile, also the plan's predicted cost per term ("predicted_cost").
+std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spirv,
+                           const DeviceProfile* profile = nullptr, const PlanCostPrediction* predicted = nullptr);
 
 // A C/C++ header defining `static const uint32_t <symbol>[]` with the SPIR-V words.
 std::string spirvHeader(const std::vector<uint32_t>& words, const std::string& symbol);

@@ -9,6 +9,7 @@
 #include "analysis/cost.h"
 #include "analysis/explain.h"
 #include "analysis/probe.h"
+#include "emit/reflection.h"
 #include "rig/gltf_import.h"
 #include "rig/rig_lod.h"
 
@@ -78,6 +79,14 @@ LoadedInputs instantiateStage(Rig rig, RuleSet rules, FragmentInterface fragment
     throwAll(std::move(all));
   }
   return in;
+}
+
+DeviceProfile loadDeviceProfileStage(const std::string& path) { return loadDeviceProfile(path); }
+
+void priceStage(LoadedInputs& in, const DeviceProfile& profile) {
+  measureAccessTerms(in.problem, in.rules, in.rig);
+  applyDeviceProfile(in.problem, profile);
+  in.profile = profile;
 }
 
 Plan searchStage(const LoadedInputs& in, const SearchOptions& opts, SearchStats* stats) {
@@ -208,6 +217,7 @@ std::vector<std::string> inputsRead(const LoadedInputs& in, const TemplateSet& t
   files.push_back(in.fragment.file);
   files.insert(files.end(), in.rules.files.begin(), in.rules.files.end());
   files.push_back(templates.file());
+  if (in.profile && !in.profile->file.empty()) files.push_back(in.profile->file);
   return files;
 }
 
@@ -219,10 +229,17 @@ LoadedInputs loadInputs(const GenerateOptions& opts) {
   LoadedInputs in = instantiateStage(std::move(rig), loadRulesStage(opts.rulesPaths),
                                      loadFragmentStage(opts.fragmentPath, opts.targetEnv), opts.overrides,
                                      opts.conventions);
+  if (!opts.deviceProfilePath.empty()) priceStage(in, loadDeviceProfileStage(opts.deviceProfilePath));
   for (const auto& b : opts.bannedRules)  // a misspelt --ban would otherwise change nothing silently
     if (std::none_of(in.rules.rules.begin(), in.rules.rules.end(), [&](const Rule& r) { return r.name == b; }))
       throw InputError(SourceLoc{}, fmt::format("--ban {}: no rule of that name in the rules files", b));
   return in;
+}
+
+std::string reflectionOf(const GenerateResult& r) {
+  if (!r.in.profile) return reflectionJson(r.in.rig, r.glsl, r.spirv);
+  const PlanCostPrediction c = predictPlanCost(r.plan, r.in.problem, *r.in.profile);
+  return reflectionJson(r.in.rig, r.glsl, r.spirv, &*r.in.profile, &c);
 }
 
 std::string explainUnreachable(const Problem& p, const RuleSet& rules) {

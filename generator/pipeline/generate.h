@@ -51,6 +51,9 @@ struct GenerateOptions {
   // maxStorageBufferBytes for that many vertices are not used (docs/buffers.md).
   int64_t maxVertices = 0;
   int64_t maxStorageBufferBytes = int64_t{1} << 27;  // maxStorageBufferRange every device has
+  // A device profile (docs/device-profiles.md): the plan is the cheapest in predicted time
+  // on that device. "" = the instruction-slot model.
+  std::string deviceProfilePath;
 };
 
 struct GenerateResult {
@@ -72,6 +75,10 @@ GenerateResult generate(const GenerateOptions& opts);
 GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts);
 // Same, with templates already loaded (batch builds load them once).
 GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const GenerateOptions& opts);
+
+// The reflection JSON of a generated shader (emit/reflection.h), with the plan's predicted
+// cost per term when the inputs were priced with a device profile.
+std::string reflectionOf(const GenerateResult& r);
 
 // For an unsolvable problem: why each unreachable goal cannot be produced.
 std::string explainUnreachable(const Problem& p, const RuleSet& rules);

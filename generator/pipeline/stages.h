@@ -43,6 +43,13 @@ LoadedInputs instantiateStage(Rig rig, RuleSet rules, FragmentInterface fragment
                               const std::vector<VaryingOverride>& overrides,
                               const std::vector<std::string>& conventions = {});
 
+// ---- price (with a device profile only) ------------------------------------------------
+// Measures the buffer and indexed uniform loads of each rule that can make them and prices
+// the problem's terms with the profile's weights (docs/device-profiles.md). Without it the
+// costs are the rules' instruction slots, as they always were.
+DeviceProfile loadDeviceProfileStage(const std::string& path);
+void priceStage(LoadedInputs& in, const DeviceProfile& profile);
+
 // ---- search -----------------------------------------------------------------------------
 // The optimal plan (to force alternatives, remove rules first: withoutRules). Throws
 // InputError at every fragment input whose request cannot be met, explaining why;

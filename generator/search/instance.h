@@ -2,11 +2,13 @@
 // them. Built once by the load and instantiate stages (pipeline/stages.h) and read by
 // every later one (search, emit, explain, graph, validate), so nothing re-reads a file.
 #pragma once
+#include <optional>
 #include <vector>
 
 #include "interface/fragment_interface.h"
 #include "rig/rig.h"
 #include "rules/rules.h"
+#include "search/device_profile.h"
 #include "search/problem.h"
 
 namespace sg {
@@ -17,6 +19,8 @@ struct LoadedInputs {
   FragmentInterface fragment;
   std::vector<Varying> varyings;
   Problem problem;
+  // The device profile the problem is priced with (priceStage); none: instruction slots.
+  std::optional<DeviceProfile> profile;
 };
 
 }  // namespace sg

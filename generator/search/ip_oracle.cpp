@@ -92,7 +92,7 @@ std::optional<Plan> integerProgramSearch(const Problem& p, SearchStats* stats, c
     }
   }
   if (cols == 0)  // every goal provided (GLPK rejects empty programs)
-    return finish(exceededLimit(p, resourceUsage(p, {})) < 0 ? std::optional<Plan>(Plan{}) : std::nullopt);  // every goal provided (GLPK rejects empty programs)
+    return finish(exceededLimit(p, resourceUsage(p, {})) < 0 ? std::optional<Plan>(tidyPlan(p, {})) : std::nullopt);
   std::vector<int> comp = components(nf, succ);
   std::vector<int> compSize(nf + 1, 0);
   for (int f = 0; f < nf; ++f) ++compSize[comp[f]];
@@ -166,7 +166,9 @@ std::optional<Plan> integerProgramSearch(const Problem& p, SearchStats* stats, c
   }
   // Device limits: z_i = 1 if the plan reads resource item i (z_i >= x_a for every action
   // reading it; 1 for items of pass-through goals); per limit, sum amount_i z_i <= max.
-  // Only when reading every item could break a limit (as in the regression engine).
+  // Only when reading every item could break a limit (as in the regression engine), or when
+  // items have costs (a device profile): then cost_i z_i joins the objective, so each input
+  // is paid once however many chosen rules read it.
   std::vector<int> zCol(p.resources.size(), 0);
   std::vector<std::vector<int>> readers(p.resources.size());
   std::vector<bool> goalItem(p.resources.size(), false);
@@ -179,12 +181,13 @@ std::optional<Plan> integerProgramSearch(const Problem& p, SearchStats* stats, c
   for (size_t r = 0; r < p.resources.size(); ++r)
     if ((!readers[r].empty() || goalItem[r]) && static_cast<size_t>(p.resources[r].limit) < all.size())
       all[p.resources[r].limit] += p.resources[r].amount;
-  if (exceededLimit(p, all) >= 0) {
+  if (exceededLimit(p, all) >= 0 || hasItemCosts(p)) {
     for (size_t r = 0; r < p.resources.size(); ++r) {
       if (readers[r].empty() && !goalItem[r]) continue;
       zCol[r] = ++cols;
       glp_add_cols(P, 1);
       glp_set_col_kind(P, cols, GLP_BV);
+      glp_set_obj_coef(P, cols, static_cast<double>(p.resources[r].cost));
       if (goalItem[r]) glp_set_col_bnds(P, cols, GLP_FX, 1, 1);
       for (int x : readers[r]) row(0, {{zCol[r], 1}, {x, -1}});
     }

@@ -35,6 +35,9 @@ Plan tidyPlan(const Problem& p, const std::vector<int>& actions) {
       plan.actions.push_back(a);
       plan.cost += p.actions[a].cost;
     }
+  // Inputs are paid once per plan however many rules read them (zero without a profile).
+  for (int r : itemsRead(p, plan.actions)) plan.cost += p.resources[r].cost;
+  plan.cost += p.fixedCost;
   return plan;
 }
 
@@ -44,7 +47,9 @@ std::string describePlan(const Problem& p, const Plan& plan) {
     const Action& a = p.actions[plan.actions[i]];
     out += fmt::format("  {:2}. {:<28} -> {:<24} cost {}\n", i + 1, a.name, p.facts[a.add].name, a.cost);
   }
-  out += fmt::format("  total cost {}\n", plan.cost);
+  // Under a device profile costs are femtoseconds per vertex (search/device_profile.h).
+  out += p.weights == kSlotWeights ? fmt::format("  total cost {}\n", plan.cost)
+                                   : fmt::format("  total cost {} (fs per vertex, device profile)\n", plan.cost);
   return out;
 }
 

@@ -10,7 +10,7 @@ struct Problem;
 
 struct Plan {
   std::vector<int> actions;  // indices into Problem::actions, in application order
-  int64_t cost = 0;
+  int64_t cost = 0;  // its actions' costs, the items they read (once each) and Problem::fixedCost
 };
 
 // Drops actions whose product no goal needs (zero-cost detours) and orders the rest

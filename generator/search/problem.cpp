@@ -28,6 +28,26 @@ std::pair<std::string, int64_t> splitIndexed(const std::string& s) {
   }
 }
 
+const char* termName(int term) {
+  static const char* const names[kTermCount] = {"arithmetic",   "locations",  "attribute_bytes",
+                                                "buffer_bytes", "buffer_loads", "indexed_uniform_loads",
+                                                "outputs",      "vertices"};
+  return term >= 0 && term < kTermCount ? names[term] : "?";
+}
+
+int64_t weighTerms(const TermWeights& w, const TermAmounts& a) {
+  // Saturates far below INT64_MAX so that sums of a plan's costs cannot overflow either.
+  constexpr int64_t kCap = INT64_MAX / 1024;
+  int64_t sum = 0;
+  for (int t = 0; t < kTermCount; ++t) {
+    int64_t x = 0;
+    if (__builtin_mul_overflow(w[t], a[t], &x) || __builtin_add_overflow(sum, x, &sum) || sum > kCap) return kCap;
+  }
+  return sum;
+}
+
+int vertexInputLocations(Type t) { return t == Type::Mat4 ? 4 : t == Type::Mat3 ? 3 : 1; }
+
 int Problem::findFact(const std::string& name) const {
   for (size_t i = 0; i < facts.size(); ++i)
     if (facts[i].name == name) return static_cast<int>(i);
@@ -55,6 +75,9 @@ class Builder {
     std::sort(p_.goals.begin(), p_.goals.end());
     p_.goals.erase(std::unique(p_.goals.begin(), p_.goals.end()), p_.goals.end());
     std::sort(p_.init.begin(), p_.init.end());
+    p_.fixedTerms[kTermVertices] = 1;
+    for (const auto& v : varyings) p_.fixedTerms[kTermOutputs] += int64_t{componentCount(v.type)} * std::max(1, v.arraySize);
+    priceProblem(p_, kSlotWeights);
     setDeviceLimits(p_, kVulkanMinVertexAttributes, kVulkanMinUniformBytes, kVulkanMinStorageBuffers);
     return std::move(p_);
   }
@@ -123,9 +146,12 @@ class Builder {
           int f = factOrFail(name, attr.loc, fmt::format("attribute '{}' provides", attr.name).c_str());
           provide(f, Fact::Source::Attribute, static_cast<int>(a), attr.perMorphTarget ? t : -1, part.swizzle, *have,
                   attr.loc);
-          p_.facts[f].resource = resourceFor(attr.perMorphTarget ? fmt::format("attribute a_{}{}", attr.name, t)
-                                                                 : "attribute a_" + attr.name,
-                                             kLimitAttributes, 1);
+          const int item = resourceFor(attr.perMorphTarget ? fmt::format("attribute a_{}{}", attr.name, t)
+                                                           : "attribute a_" + attr.name,
+                                       kLimitAttributes, 1);
+          p_.facts[f].resource = item;
+          p_.resources[item].terms[kTermLocations] = vertexInputLocations(attr.shaderType);
+          p_.resources[item].terms[kTermAttributeBytes] = formatBytes(attr.format);
         }
     }
     for (size_t u = 0; u < rig_.uniforms.size(); ++u) {
@@ -243,6 +269,7 @@ class Builder {
     std::sort(act.pre.begin(), act.pre.end());
     // `cost: auto` is measured before instantiation (analysis/cost.h resolveAutoCosts).
     act.cost = ruleCost(rule, shape_);
+    act.terms[kTermArithmetic] = act.cost;
     for (auto& l : inst.code) act.code.push_back(CodeLine{std::move(l.text), l.loc});
     if (p_.facts[act.add].source != Fact::Source::Computed) {
       p_.skippedRules.emplace_back(r, fmt::format("'{}' is provided by the rig", rule.produces));
@@ -285,19 +312,36 @@ void dropOversizedBuffers(Problem& p, int64_t maxVertices, int64_t maxBytes) {
   }
 }
 
-std::vector<int64_t> resourceUsage(const Problem& p, const std::vector<int>& actions) {
+std::vector<int> itemsRead(const Problem& p, const std::vector<int>& actions) {
   std::vector<bool> seen(p.resources.size(), false);
-  std::vector<int64_t> usage(p.limits.size(), 0);
   auto read = [&](int f) {
-    int r = p.facts[f].resource;
-    if (r < 0 || seen[r]) return;
-    seen[r] = true;
-    if (static_cast<size_t>(p.resources[r].limit) < usage.size()) usage[p.resources[r].limit] += p.resources[r].amount;
+    if (int r = p.facts[f].resource; r >= 0) seen[r] = true;
   };
   for (int a : actions)
     for (int q : p.actions[a].pre) read(q);
   for (int g : p.goals) read(g);
+  std::vector<int> items;
+  for (size_t r = 0; r < seen.size(); ++r)
+    if (seen[r]) items.push_back(static_cast<int>(r));
+  return items;
+}
+
+std::vector<int64_t> resourceUsage(const Problem& p, const std::vector<int>& actions) {
+  std::vector<int64_t> usage(p.limits.size(), 0);
+  for (int r : itemsRead(p, actions))
+    if (static_cast<size_t>(p.resources[r].limit) < usage.size()) usage[p.resources[r].limit] += p.resources[r].amount;
   return usage;
+}
+
+void priceProblem(Problem& p, const TermWeights& w) {
+  p.weights = w;
+  for (auto& a : p.actions) a.cost = weighTerms(w, a.terms);
+  for (auto& r : p.resources) r.cost = weighTerms(w, r.terms);
+  p.fixedCost = weighTerms(w, p.fixedTerms);
+}
+
+bool hasItemCosts(const Problem& p) {
+  return std::any_of(p.resources.begin(), p.resources.end(), [](const ResourceItem& r) { return r.cost > 0; });
 }
 
 int exceededLimit(const Problem& p, const std::vector<int64_t>& usage) {

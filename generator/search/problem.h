@@ -2,6 +2,7 @@
 // instances; actions are rule instances (one product, a set of preconditions, a
 // cost, and their unrolled snippet). Delete-free: applying an action only adds.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -34,6 +35,31 @@ struct Fact {
 // sum over the distinct items its rules' needs and its pass-through goals read.
 constexpr int64_t kVulkanMinVertexAttributes = 16;  // maxVertexInputAttributes every device has
 constexpr int64_t kVulkanMinUniformBytes = 16384;   // maxUniformBufferRange every device has
+// The terms of the cost model (docs/device-profiles.md): what a vertex program pays for,
+// each counted per vertex. A plan's cost is the weighted sum of its amounts; the weights
+// are a device profile (search/device_profile.h) or, without one, the instruction-slot
+// model: arithmetic 1, every other term 0 (docs/cost-model.md).
+enum CostTerm {
+  kTermArithmetic = 0,      // instruction slots (the rules' costs, stated or `cost: auto`)
+  kTermLocations,           // vertex input locations read (an input charged once per plan)
+  kTermAttributeBytes,      // bytes fetched from vertex attributes (their formats)
+  kTermBufferBytes,         // bytes fetched from storage buffers (element strides)
+  kTermBufferLoads,         // storage-buffer elements loaded
+  kTermIndexedUniformLoads, // uniform loads at an index computed per vertex (palette[joint])
+  kTermOutputs,             // output components written (the varyings and gl_Position)
+  kTermVertices,            // 1: the fixed cost of running the program for one vertex
+  kTermCount
+};
+using TermAmounts = std::array<int64_t, kTermCount>;
+// "arithmetic", "locations", ...: the keys of a device profile's `weights:`.
+const char* termName(int term);
+// Search cost units per unit of each term (int64: A* stays exact). Without a profile the
+// unit is the instruction slot; a profile's unit is the femtosecond (docs/device-profiles.md).
+using TermWeights = std::array<int64_t, kTermCount>;
+constexpr TermWeights kSlotWeights = {1, 0, 0, 0, 0, 0, 0, 0};
+// sum of weight x amount (checked: a hostile profile cannot overflow it silently).
+int64_t weighTerms(const TermWeights& w, const TermAmounts& a);
+
 struct ResourceLimit {
   std::string what;    // "vertex input attributes"
   std::string option;  // how the user raises it: "--max-attributes"
@@ -43,6 +69,10 @@ struct ResourceItem {
   std::string name;  // "attribute a_coord_morph3", "uniform u_bone_xf"
   int limit = 0;     // index in Problem::limits
   int64_t amount = 0;
+  // What reading it costs, paid once per plan however many rules read it: the amounts per
+  // term (an attribute's locations and bytes) and their weighted sum (priceProblem).
+  TermAmounts terms{};
+  int64_t cost = 0;
 };
 enum ResourceLimitIndex { kLimitAttributes = 0, kLimitUniformBytes = 1, kLimitStorageBuffers = 2 };
 constexpr int64_t kVulkanMinStorageBuffers = 4;  // maxPerStageDescriptorStorageBuffers every device has
@@ -89,8 +119,11 @@ struct Action {
   int rule = -1;     // index in RuleSet::rules
   std::vector<int> pre;  // sorted, unique
   int add = -1;
-  int64_t cost = 0;
+  int64_t cost = 0;  // weighTerms(Problem::weights, terms); the rule's cost without a profile
   std::vector<CodeLine> code;
+  // Per instance of the rule: terms[kTermArithmetic] is the rule's cost in slots; buffer and
+  // indexed uniform loads are measured from its snippet (analysis/cost.h measureRuleAccesses).
+  TermAmounts terms{};
 };
 
 struct Problem {
@@ -103,6 +136,11 @@ struct Problem {
   std::vector<ResourceLimit> limits;  // empty: unconstrained (random libraries, tests)
   std::vector<ResourceItem> resources;
   std::vector<BufferSource> buffers;
+  // The cost model's weights, and what every plan pays regardless of its rules (outputs,
+  // the vertex itself): fixedTerms, and fixedCost = their weighted sum, part of every plan's cost.
+  TermWeights weights = kSlotWeights;
+  TermAmounts fixedTerms{};
+  int64_t fixedCost = 0;
 
   int findFact(const std::string& name) const;  // -1 if absent
 };
@@ -122,8 +160,18 @@ void setDeviceLimits(Problem& p, int64_t maxAttributes, int64_t maxUniformBytes,
 // provided, so the search uses other forms. maxVertices <= 0: vertex count unknown, keep all.
 void dropOversizedBuffers(Problem& p, int64_t maxVertices, int64_t maxBytes);
 
+// The distinct resource items a set of actions (and the goals the rig provides) read, ascending.
+std::vector<int> itemsRead(const Problem& p, const std::vector<int>& actions);
 // Usage per limit of the rig inputs a set of actions (and the goals) read.
 std::vector<int64_t> resourceUsage(const Problem& p, const std::vector<int>& actions);
+// Prices actions, items and the fixed terms with `w` (costs = weighTerms of their terms).
+// With kSlotWeights every cost is what it was without a cost model: the rules' slots.
+void priceProblem(Problem& p, const TermWeights& w);
+// Whether some resource item has a cost (the search must then track the items a plan reads).
+bool hasItemCosts(const Problem& p);
+// Vertex input locations of a shader input type (Vulkan: a matrix takes one per column,
+// a 64-bit vector of 3 or 4 components two).
+int vertexInputLocations(Type t);
 // The first limit the usage exceeds, or -1.
 int exceededLimit(const Problem& p, const std::vector<int64_t>& usage);
 // "21 vertex input attributes, above the limit of 16 (--max-attributes)".

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -33,6 +34,7 @@ struct SharedInputs {
   std::map<std::string, Rig> rigs;                     // by manifest path
   std::map<std::string, FragmentInterface> fragments;  // by path
   std::map<std::string, std::string> digests;          // file -> SHA-256 of its bytes (cache keys)
+  std::optional<DeviceProfile> profile;                // the manifest's device_profile
 };
 
 SharedInputs loadShared(const Manifest& m, const std::vector<Variant>& variants) {
@@ -61,6 +63,10 @@ SharedInputs loadShared(const Manifest& m, const std::vector<Variant>& variants)
   for (const auto& [path, rig] : s.rigs)
     for (const auto& f : rig.sourceFiles) keep(f);
   for (const auto& [path, frag] : s.fragments) keep(frag.file);
+  if (!m.deviceProfile.empty()) {
+    s.profile = loadDeviceProfileStage(m.deviceProfile);
+    keep(m.deviceProfile);
+  }
   return s;
 }
 
@@ -69,6 +75,7 @@ std::vector<std::string> inputsOf(const SharedInputs& s, const Variant& v) {
   files.push_back(s.fragments.at(v.pass->fragment).file);
   files.insert(files.end(), s.rules.files.begin(), s.rules.files.end());
   files.push_back(s.templates.file());
+  if (s.profile) files.push_back(s.profile->file);  // an input, so part of the cache key and the depfile
   return files;
 }
 
@@ -168,6 +175,7 @@ void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v,
   Rig rig = v.params.empty() ? base : rigWithParameters(base, v.params, paramsAt);
   LoadedInputs in = instantiateStage(std::move(rig), s.rules, s.fragments.at(v.pass->fragment), v.pass->maps,
                                      v.pass->conventions);
+  if (s.profile) priceStage(in, *s.profile);
   GenerateOptions o;
   o.heuristic = m.heuristic;
   o.targetEnv = m.targetEnv;
@@ -178,7 +186,7 @@ void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v,
   for (int a : r.plan.actions) out.rules.push_back(r.in.problem.actions[a].name);
   out.glsl = r.glsl.text;
   out.spirv.assign(reinterpret_cast<const char*>(r.spirv.words.data()), r.spirv.words.size() * 4);
-  out.reflection = reflectionJson(r.in.rig, r.glsl, r.spirv);
+  out.reflection = reflectionOf(r);
 }
 
 void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts, BuiltVariant& out) {
@@ -236,6 +244,8 @@ std::string indexJson(const Manifest& m, const BuildReport& r) {
   out += fmt::format("  \"shadergen\": {},\n", jsonString(shadergenVersion()));
   out += fmt::format("  \"target_env\": {},\n", jsonString(targetEnvName(m.targetEnv)));
   out += fmt::format("  \"optimize\": {},\n", m.optimize ? "true" : "false");
+  if (!m.deviceProfile.empty())  // then "cost" is femtoseconds per vertex on that device
+    out += fmt::format("  \"device_profile\": {},\n", jsonString(m.deviceProfile));
   std::string rules;
   for (const auto& f : m.rules) rules += (rules.empty() ? "" : ", ") + jsonString(f);
   out += fmt::format("  \"rules\": [{}],\n", rules);

@@ -49,7 +49,7 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
   YAML::Node root = parseYaml(text, file);
   y.expectMap(root, "a manifest");
   y.checkKeys(root, {"output", "rules", "templates", "target_env", "optimize", "heuristic", "emit", "rigs", "passes",
-                     "axes", "exclude", "name"});
+                     "axes", "exclude", "name", "device_profile"});
   m.outputDir = resolvePath(file, root["output"] ? y.scalar(root["output"], "'output'") : "shaders");
   if (!root["rules"]) y.fail(root, "the manifest needs 'rules' (a rules file or a list of them)");
   for (const auto& r : scalarOrList(y, root["rules"], "'rules'")) m.rules.push_back(resolvePath(file, r));
@@ -59,6 +59,7 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
     if (!parseTargetEnv(env, m.targetEnv))
       y.fail(root["target_env"], fmt::format("unknown target_env '{}' (vulkan1.0, vulkan1.1, vulkan1.2, vulkan1.3)", env));
   }
+  if (root["device_profile"]) m.deviceProfile = resolvePath(file, y.scalar(root["device_profile"], "'device_profile'"));
   if (root["optimize"]) m.optimize = y.boolean(root["optimize"], "'optimize'");
   if (root["heuristic"]) {
     m.heuristic = y.scalar(root["heuristic"], "'heuristic'");

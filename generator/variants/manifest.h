@@ -54,6 +54,7 @@ struct Manifest {
   TargetEnv targetEnv = TargetEnv::Vulkan1_0;
   bool optimize = false;
   std::string heuristic = "lmcut";
+  std::string deviceProfile;  // `device_profile:` (docs/device-profiles.md); "" = instruction slots
 };
 
 // One shader to make.

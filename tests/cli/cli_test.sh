@@ -336,6 +336,26 @@ EOF
   [ ! -e bad-out/index.json ] && ok "no index after a failure" || fail "index written despite a failure"
   ;;
 
+device_profile)
+  # Without a profile: what generate always printed; with one: a dearer-per-location plan,
+  # its prediction per term, the profile in the depfile, the prediction in the reflection.
+  expect 0 "no profile" -- "$SG" generate "${DAWN[@]}" --emit glsl,reflection -o plain/face
+  grep -q "total cost 100$" last.out && ok "slot model total cost 100" || fail "no-profile plan: $(cat last.out)"
+  grep -q "predicted" last.out && fail "prediction printed without a profile" || ok "no prediction without a profile"
+  grep -q predicted_cost plain/face.json && fail "predicted_cost without a profile" || ok "reflection unchanged"
+  P=$SRC/devices/example.yaml
+  expect 0 "--device-profile" -- "$SG" generate "${DAWN[@]}" --emit glsl,reflection -o prof/face -MD --device-profile "$P"
+  grep -q "fs per vertex, device profile" last.out && ok "cost in femtoseconds" || fail "$(cat last.out)"
+  grep -qE "^    locations +[0-9]+ +0\.570000 " last.out && ok "locations priced at 0.57 ns" || fail "$(cat last.out)"
+  grep -qE "^    total +[0-9.]+$" last.out && ok "predicted total printed" || fail "$(cat last.out)"
+  grep -qF "$(realpath -ms "$P")" prof/face.vert.d && ok "depfile lists the profile" || fail "$(cat prof/face.vert.d)"
+  grep -q '"predicted_cost": {"device": ' prof/face.json && ok "reflection has the prediction" || fail "$(cat prof/face.json)"
+  cmp -s plain/face.vert prof/face.vert && fail "the profile did not change the plan" || ok "the profile changes the plan"
+  expect 0 "explain --device-profile" -- "$SG" explain "${DAWN[@]}" --device-profile "$P" --no-alternatives
+  grep -q "predicted per vertex on 'example" last.out && ok "explain shows the terms" || fail "$(cat last.out)"
+  grep -qE "^    buffer_loads +[1-9]" last.out && ok "explain: buffer loads counted" || fail "$(cat last.out)"
+  ;;
+
 *)
   echo "unknown case $case_name" >&2
   exit 2

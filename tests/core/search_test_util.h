@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <set>
+#include <stdexcept>
 #include <vector>
 
 #include "search/plan.h"
@@ -13,7 +14,7 @@
 namespace sg {
 
 // Validates a plan: each action applicable in order from init, goals reached, cost is
-// the sum of the actions' costs, no action repeated, and every action's product is new
+// the sum of the actions' costs (and the costs of the inputs read, once each), no action repeated, and every action's product is new
 // and needed (a goal or a precondition of a later action) — the tidy-plan contract.
 inline ::testing::AssertionResult planIsValid(const Problem& p, const Plan& plan) {
   std::vector<bool> have(p.facts.size(), false);
@@ -45,9 +46,66 @@ inline ::testing::AssertionResult planIsValid(const Problem& p, const Plan& plan
   }
   for (int g : p.goals)
     if (!have[g]) return ::testing::AssertionFailure() << "goal " << p.facts[g].name << " not reached";
+  // Under a device profile each rig input read (by a rule or as a pass-through goal) is
+  // paid once, plus the fixed terms; both are zero without one.
+  std::set<int> items;
+  for (int ai : plan.actions)
+    for (int f : p.actions[ai].pre)
+      if (p.facts[f].resource >= 0) items.insert(p.facts[f].resource);
+  for (int g : p.goals)
+    if (p.facts[g].resource >= 0) items.insert(p.facts[g].resource);
+  for (int r : items) sum += p.resources[r].cost;
+  sum += p.fixedCost;
   if (sum != plan.cost)
-    return ::testing::AssertionFailure() << "plan.cost " << plan.cost << " != sum of action costs " << sum;
+    return ::testing::AssertionFailure() << "plan.cost " << plan.cost << " != sum of action and input costs " << sum;
   return ::testing::AssertionSuccess();
+}
+
+constexpr int64_t kNone = -1;  // exhaustiveOptimum: no feasible plan
+
+// Exhaustive: every subset of actions, its delete-free closure from init; feasible if the
+// goals are covered and the resource items read by the actions that fire (and by the goals
+// the rig provides) fit every limit. Cost: the fired actions, each distinct item read (paid
+// once: a device profile's inputs), and the fixed cost. The cheapest feasible subset, or
+// kNone. Written from the definition, sharing nothing with the engines but the Problem.
+inline int64_t exhaustiveOptimum(const Problem& p) {
+  const size_t n = p.actions.size();
+  if (n > 20) throw std::logic_error("instance too large for the exhaustive solver");
+  int64_t best = kNone;
+  for (uint32_t s = 0; s < (1u << n); ++s) {
+    std::vector<bool> have(p.facts.size(), false), fired(n, false);
+    for (int f : p.init) have[f] = true;
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (size_t a = 0; a < n; ++a) {
+        const Action& act = p.actions[a];
+        if (!(s >> a & 1u) || fired[a]) continue;
+        if (!std::all_of(act.pre.begin(), act.pre.end(), [&](int q) { return have[q]; })) continue;
+        fired[a] = true;
+        have[act.add] = changed = true;
+      }
+    }
+    if (!std::all_of(p.goals.begin(), p.goals.end(), [&](int g) { return have[g]; })) continue;
+    int64_t cost = p.fixedCost;
+    std::set<int> items;
+    for (size_t a = 0; a < n; ++a) {
+      if (!fired[a]) continue;
+      cost += p.actions[a].cost;
+      for (int q : p.actions[a].pre)
+        if (p.facts[q].resource >= 0) items.insert(p.facts[q].resource);
+    }
+    for (int g : p.goals)
+      if (p.facts[g].resource >= 0) items.insert(p.facts[g].resource);
+    std::vector<int64_t> use(p.limits.size(), 0);
+    for (int i : items) {
+      cost += p.resources[i].cost;
+      if (static_cast<size_t>(p.resources[i].limit) < use.size()) use[p.resources[i].limit] += p.resources[i].amount;
+    }
+    bool fits = true;
+    for (size_t l = 0; l < use.size(); ++l) fits = fits && use[l] <= p.limits[l].max;
+    if (fits && (best == kNone || cost < best)) best = cost;
+  }
+  return best;
 }
 
 }  // namespace sg

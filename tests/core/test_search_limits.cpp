@@ -23,50 +23,6 @@
 namespace sg {
 namespace {
 
-constexpr int64_t kNone = -1;
-
-// Exhaustive: every subset of actions, its delete-free closure from init, feasible if the
-// goals are covered and the resource items read by the actions that fire (and by the
-// goals the rig provides) fit every limit; the cheapest such subset. Written from the
-// definition, sharing nothing with the engines but the Problem struct.
-int64_t exhaustiveOptimum(const Problem& p) {
-  const size_t n = p.actions.size();
-  if (n > 20) throw std::logic_error("instance too large for the exhaustive solver");
-  int64_t best = kNone;
-  for (uint32_t s = 0; s < (1u << n); ++s) {
-    int64_t cost = 0;
-    for (size_t a = 0; a < n; ++a)
-      if (s >> a & 1u) cost += p.actions[a].cost;
-    if (best != kNone && cost >= best) continue;
-    std::vector<bool> have(p.facts.size(), false), fired(n, false);
-    for (int f : p.init) have[f] = true;
-    for (bool changed = true; changed;) {
-      changed = false;
-      for (size_t a = 0; a < n; ++a) {
-        const Action& act = p.actions[a];
-        if (!(s >> a & 1u) || fired[a]) continue;
-        if (!std::all_of(act.pre.begin(), act.pre.end(), [&](int q) { return have[q]; })) continue;
-        fired[a] = true;
-        have[act.add] = changed = true;
-      }
-    }
-    if (!std::all_of(p.goals.begin(), p.goals.end(), [&](int g) { return have[g]; })) continue;
-    std::set<int> items;
-    for (size_t a = 0; a < n; ++a)
-      if (fired[a])
-        for (int q : p.actions[a].pre)
-          if (p.facts[q].resource >= 0 && std::count(p.init.begin(), p.init.end(), q)) items.insert(p.facts[q].resource);
-    for (int g : p.goals)
-      if (p.facts[g].resource >= 0 && std::count(p.init.begin(), p.init.end(), g)) items.insert(p.facts[g].resource);
-    std::vector<int64_t> use(p.limits.size(), 0);
-    for (int i : items) use[p.resources[i].limit] += p.resources[i].amount;
-    bool fits = true;
-    for (size_t l = 0; l < use.size(); ++l) fits = fits && use[l] <= p.limits[l].max;
-    if (fits) best = cost;
-  }
-  return best;
-}
-
 // Gives every rig input a resource item (amount 1-3, one of two limits) and sets each
 // limit just below what the unconstrained optimum reads, so that it binds.
 void addBindingLimits(Problem& p, std::mt19937& rng) {

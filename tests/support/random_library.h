@@ -100,4 +100,37 @@ inline sg::Problem randomLibrary(const LibraryShape& shape) {
   return p;
 }
 
+// A random device profile over a library (issue 21): the actions' costs become their
+// arithmetic term, some actions get buffer and indexed uniform loads, every rig input a
+// resource item with 1-2 locations and 4-16 bytes (read once per plan), the plan outputs
+// and the vertex fixed terms; random weights (inputs from free to far dearer than rules),
+// then priced. Used by tests/core/test_search_costs.cpp and bench/bench_search.cpp.
+inline void addRandomProfile(sg::Problem& p, uint64_t seed) {
+  std::mt19937_64 rng(seed * 7919 + 17);
+  auto pick = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+  for (auto& a : p.actions) {
+    a.terms = sg::TermAmounts{};
+    a.terms[sg::kTermArithmetic] = a.cost;
+    a.terms[sg::kTermBufferLoads] = pick(0, 3) == 0 ? pick(1, 4) : 0;
+    a.terms[sg::kTermBufferBytes] = 16 * a.terms[sg::kTermBufferLoads];
+    a.terms[sg::kTermIndexedUniformLoads] = pick(0, 4) == 0 ? pick(1, 4) : 0;
+  }
+  if (p.limits.empty()) p.limits = {sg::ResourceLimit{"vertex input attributes", "--max-attributes", INT64_MAX}};
+  p.resources.clear();
+  for (int f : p.init) {
+    p.facts[f].resource = static_cast<int>(p.resources.size());
+    sg::ResourceItem item{p.facts[f].name, 0, 1};
+    item.terms[sg::kTermLocations] = pick(1, 2);
+    item.terms[sg::kTermAttributeBytes] = 4 * pick(1, 4);
+    p.resources.push_back(item);
+  }
+  p.fixedTerms = sg::TermAmounts{};
+  p.fixedTerms[sg::kTermOutputs] = pick(4, 12);
+  p.fixedTerms[sg::kTermVertices] = 1;
+  sg::TermWeights w{};
+  for (auto& x : w) x = pick(0, 3) == 0 ? 0 : pick(1, 12);
+  w[sg::kTermLocations] = pick(0, 2) == 0 ? 0 : pick(1, 40);
+  sg::priceProblem(p, w);
+}
+
 }  // namespace sgtest

@@ -1,0 +1,102 @@
+// Device profiles on the Dawn face (issue 21, docs/device-profiles.md): without a profile
+// the plan, its cost and the reflection are the instruction-slot model's; the term amounts
+// of that plan are the rig's (16 input locations, 220 attribute bytes per vertex); under a
+// profile where input locations are dear the search moves to buffer-fed forms that read
+// fewer locations, and its plan is the cheapest under that profile by every engine.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "pipeline/generate.h"
+#include "search/device_profile.h"
+#include "search/ip_oracle.h"
+
+namespace sg {
+namespace {
+
+const std::string kDawn = std::string(SG_SOURCE_DIR) + "/examples/dawn/";
+
+GenerateOptions faceOptions(const std::string& profile = "") {
+  GenerateOptions o;
+  o.rigPath = kDawn + "face.rig.yaml";
+  o.fragmentPath = kDawn + "face.frag";
+  o.rulesPaths = {kDawn + "rules.yaml"};
+  o.templateDir = std::string(SG_SOURCE_DIR) + "/templates";
+  o.deviceProfilePath = profile;
+  return o;
+}
+
+std::string writeProfile(const std::string& name, const std::string& text) {
+  auto path = std::filesystem::temp_directory_path() / ("sg_" + name + ".device.yaml");
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+std::vector<std::string> ruleNames(const GenerateResult& r) {
+  std::vector<std::string> names;
+  for (int a : r.plan.actions) names.push_back(r.in.problem.actions[a].name);
+  return names;
+}
+
+TEST(DawnProfile, WithoutAProfileTheSlotModelIsUnchanged) {
+  GenerateResult r = generate(faceOptions());
+  EXPECT_FALSE(r.in.profile);
+  EXPECT_EQ(r.in.problem.weights, kSlotWeights);
+  EXPECT_EQ(r.plan.cost, 100);  // docs/design.md: the Dawn face plan with the tangent fallback
+  EXPECT_EQ(r.in.problem.fixedCost, 0);
+  for (const auto& item : r.in.problem.resources) EXPECT_EQ(item.cost, 0) << item.name;
+  EXPECT_EQ(reflectionOf(r).find("predicted_cost"), std::string::npos);
+  // The rig's streams: coord (12 B), normal, tangent (16), 5 x coord_morph (12), 5 x
+  // normal_morph (16), bone_weight (16), bone_index (uint8x4: 4), skin_uvst (16).
+  TermAmounts a = planTermAmounts(r.plan, r.in.problem);
+  EXPECT_EQ(a[kTermLocations], 16);
+  EXPECT_EQ(a[kTermAttributeBytes], 12 + 16 + 16 + 5 * 12 + 5 * 16 + 16 + 4 + 16);
+  EXPECT_EQ(a[kTermArithmetic], 100);
+  EXPECT_EQ(a[kTermVertices], 1);
+}
+
+// A profile that charges one femtosecond per slot and nothing else is the slot model in
+// other units: same plan, cost 100 fs.
+TEST(DawnProfile, ASlotsOnlyProfileKeepsThePlan) {
+  GenerateResult slots = generate(faceOptions());
+  GenerateResult r = generate(faceOptions(writeProfile("slots", "device: slots\nweights:\n  arithmetic: 0.000001\n")));
+  ASSERT_TRUE(r.in.profile);
+  EXPECT_EQ(ruleNames(r), ruleNames(slots));
+  EXPECT_EQ(r.plan.cost, 100);
+  EXPECT_EQ(r.glsl.text, slots.glsl.text);
+}
+
+TEST(DawnProfile, ExpensiveLocationsMoveThePlanToBuffers) {
+  GenerateResult slots = generate(faceOptions());
+  GenerateResult r = generate(faceOptions(std::string(SG_SOURCE_DIR) + "/devices/example.yaml"));
+  ASSERT_TRUE(r.in.profile);
+  const Problem& p = r.in.problem;
+  const PlanCostPrediction c = predictPlanCost(r.plan, p, *r.in.profile);
+  EXPECT_LT(c.amounts[kTermLocations], 16);
+  EXPECT_GT(c.amounts[kTermBufferLoads], 0);
+  EXPECT_NE(ruleNames(r), ruleNames(slots));
+  // The plan's cost is its prediction in femtoseconds, and the slot model's plan costs more
+  // under this profile (the actions are the same instances in both problems).
+  EXPECT_EQ(r.plan.cost, std::llround(c.totalNanoseconds * kFemtosecondsPerNanosecond));
+  const Plan slotPlanPriced = tidyPlan(p, slots.plan.actions);
+  EXPECT_GT(slotPlanPriced.cost, r.plan.cost);
+  const PlanCostPrediction old = predictPlanCost(slotPlanPriced, p, *r.in.profile);
+  EXPECT_EQ(old.amounts[kTermLocations], 16);
+  // Every engine agrees on the optimum.
+  for (const char* engine : {"regression", "ip", "forward"}) {
+    SearchOptions o;
+    o.engine = engine;
+    auto plan = findPlan(p, o);
+    ASSERT_TRUE(plan) << engine;
+    EXPECT_EQ(plan->cost, r.plan.cost) << engine;
+  }
+  std::string json = reflectionOf(r);
+  EXPECT_NE(json.find("\"predicted_cost\""), std::string::npos);
+  EXPECT_NE(json.find("\"locations\": {\"amount\": " + std::to_string(c.amounts[kTermLocations])), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sg
