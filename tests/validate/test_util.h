@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "rig/rig.h"
+#include "runtime/procedural.h"
 #include "validate/validate.h"
 
 namespace sgtest {
@@ -119,6 +121,32 @@ inline ErrorMax maxErrors(const sg::ValidateReport& rep) {
       if (o.maxRelError > m.rel) m.rel = o.maxRelError, m.relAt = o.name;
     }
   return m;
+}
+
+// A rig file for a procedural mesh built with `mo` (every stream it carries, every uniform).
+inline sg::Rig rigFor(const sg::rt::MeshOptions& mo, bool model, bool uniformScale) {
+  std::string y = "rig: oracle\ndeformers:\n";
+  y += "  bones: " + std::to_string(mo.influences ? mo.bones : 0) + "\n  influences: " + std::to_string(mo.influences) +
+       "\n  morph_targets: " + std::to_string(mo.morphTargets) + "\n  uniform_scale: " + (uniformScale ? "1" : "0") + "\n";
+  if (mo.morphTargets) y += std::string("  morphs: [position") + (mo.morphNormals ? ", normal" : "") + (mo.morphTangents ? ", tangent" : "") + "]\n";
+  y += "attributes:\n  p: { format: float32x3, provides: vertex.position }\n"
+       "  n: { format: float32x4, provides: { vertex.normal: xyz, vertex.occlusion: w } }\n"
+       "  t: { format: float32x4, provides: { vertex.tangent: xyz, vertex.handedness: w } }\n";
+  if (mo.morphTargets) {
+    y += "  dp: { format: float32x3, per_target: true, provides: morph.position }\n";
+    if (mo.morphNormals) y += "  dn: { format: float32x4, per_target: true, provides: { morph.normal: xyz, morph.occlusion: w } }\n";
+    if (mo.morphTangents) y += "  dt: { format: float32x3, per_target: true, provides: morph.tangent }\n";
+  }
+  for (int s = 0; s < (mo.influences + 3) / 4; ++s)
+    y += "  j" + std::to_string(s) + ": { format: float32x4, provides: \"skin.joints[" + std::to_string(s) + "]\" }\n" +
+         "  w" + std::to_string(s) + ": { format: float32x4, provides: \"skin.weights[" + std::to_string(s) + "]\" }\n";
+  y += "uniforms:\n";
+  if (mo.influences) y += "  bones: { type: mat4, array: bones, semantic: skin.bones }\n";
+  if (mo.morphTargets) y += "  mw: { type: float, array: morph_targets, semantic: morph.weights }\n";
+  if (model) y += "  model: { type: mat4, semantic: model.matrix }\n";
+  y += "  cam: { type: vec3, semantic: camera.position }\n  view: { type: mat4, semantic: camera.view }\n"
+       "  proj: { type: mat4, semantic: camera.projection }\n  dapple: { type: mat4, semantic: dapple.matrix }\n";
+  return sg::loadRigText(y, "oracle.rig.yaml");
 }
 
 }  // namespace sgtest
