@@ -30,6 +30,7 @@ enum class Op : uint8_t {
   Add, Sub, Mul, Div, Min, Max, Lt, Le, Gt, Ge, Eq, Ne, And, Or,
   // d = op a
   Neg, Abs, Sqrt, Sign, Not, Copy,
+  MulAdd,  // d = a * b + c (two roundings, as the Mul and Add it replaces)
   Select,  // d = a != 0 ? b : c
   Load,    // d = stream[vertex]
   Gather,  // d = element a of a uniform array or family (checked)
@@ -783,6 +784,7 @@ class Compiler {
         if (a->varying) f(a->base);
       if (in.guarded) f(in.guard.base);
     };
+    fuseMultiplyAdds(reads);
     std::vector<char> live(regs, 0);
     std::vector<char> keep(code.size(), 0);
     for (size_t i = code.size(); i-- > 0;) {
@@ -837,6 +839,40 @@ class Compiler {
     for (const Instr& in : code) p_.stats.checks += in.op == Op::Trap || in.op == Op::Gather || in.op == Op::Call;
   }
 
+  // x + a * b where the product is read only there: one pass over the lanes instead of two.
+  template <class Reads>
+  void fuseMultiplyAdds(Reads reads) {
+    auto& code = p_.code;
+    std::vector<int> readCount(regSize_.size(), 0), writer(regSize_.size(), -1);
+    for (size_t i = 0; i < code.size(); ++i) {
+      reads(code[i], [&](uint32_t r) { ++readCount[r]; });
+      const Instr& in = code[i];
+      if (in.op != Op::Output && in.op != Op::Trap) writer[in.dst] = in.op == Op::Mul && in.dstOff == 0 && writer[in.dst] == -1 ? static_cast<int>(i) : -2;
+    }
+    std::vector<char> fused(code.size(), 0);
+    for (Instr& in : code) {
+      if (in.op != Op::Add) continue;
+      for (Arg* side : {&in.b, &in.a}) {
+        if (!side->varying || readCount[side->base] != 1 || writer[side->base] < 0) continue;
+        const Instr& mul = code[static_cast<size_t>(writer[side->base])];
+        bool whole = mul.n == in.n;
+        for (int c = 0; c < in.n && whole; ++c) whole = side->map[c] == c;
+        if (!whole) continue;
+        const Arg other = side == &in.b ? in.a : in.b;
+        fused[static_cast<size_t>(writer[side->base])] = 1;
+        in.op = Op::MulAdd;
+        in.a = mul.a;
+        in.b = mul.b;
+        in.c = other;
+        break;
+      }
+    }
+    std::vector<Instr> kept;
+    for (size_t i = 0; i < code.size(); ++i)
+      if (!fused[i]) kept.push_back(code[i]);
+    code = std::move(kept);
+  }
+
   const RuleSet& rules_;
   const RigShape& shape_;
   const rt::Mesh& mesh_;
@@ -855,36 +891,56 @@ class Compiler {
 
 inline const double* at(const double* ws, const Arg& x, int c) { return ws + x.base + x.map[c] * (x.varying ? B : 1); }
 
+// One component over the lanes of a batch; restrict parameters let the loops vectorize.
+template <class F>
+void lanes(double* __restrict d, const double* __restrict x, const double* __restrict y, F f) {
+  for (size_t l = 0; l < B; ++l) d[l] = f(x[l], y[l]);
+}
+template <class F>
+void lanesX(double* __restrict d, const double* __restrict x, double y, F f) {
+  for (size_t l = 0; l < B; ++l) d[l] = f(x[l], y);
+}
+template <class F>
+void lanesY(double* __restrict d, double x, const double* __restrict y, F f) {
+  for (size_t l = 0; l < B; ++l) d[l] = f(x, y[l]);
+}
+
 template <class F>
 void binaryKernel(double* ws, const Instr& in, F f) {
   for (int c = 0; c < in.n; ++c) {
-    double* __restrict d = ws + in.dst + (in.dstOff + c) * B;
-    const double* __restrict x = at(ws, in.a, c);
-    const double* __restrict y = at(ws, in.b, c);
-    if (in.a.varying && in.b.varying) {
-      for (size_t l = 0; l < B; ++l) d[l] = f(x[l], y[l]);
-    } else if (in.a.varying) {
-      const double k = *y;
-      for (size_t l = 0; l < B; ++l) d[l] = f(x[l], k);
-    } else {
-      const double k = *x;
-      for (size_t l = 0; l < B; ++l) d[l] = f(k, y[l]);
-    }
+    double* d = ws + in.dst + (in.dstOff + c) * B;
+    const double* x = at(ws, in.a, c);
+    const double* y = at(ws, in.b, c);
+    if (in.a.varying && in.b.varying) lanes(d, x, y, f);
+    else if (in.a.varying) lanesX(d, x, *y, f);
+    else lanesY(d, *x, y, f);
   }
 }
 
 template <class F>
 void unaryKernel(double* ws, const Instr& in, F f) {
   for (int c = 0; c < in.n; ++c) {
-    double* __restrict d = ws + in.dst + (in.dstOff + c) * B;
-    const double* __restrict x = at(ws, in.a, c);
-    if (in.a.varying) {
-      for (size_t l = 0; l < B; ++l) d[l] = f(x[l]);
-    } else {
-      const double k = f(*x);
-      for (size_t l = 0; l < B; ++l) d[l] = k;
-    }
+    double* d = ws + in.dst + (in.dstOff + c) * B;
+    const double* x = at(ws, in.a, c);
+    if (in.a.varying) lanesX(d, x, 0.0, [f](double v, double) { return f(v); });
+    else lanesY(d, f(*x), x, [](double v, double) { return v; });
   }
+}
+
+template <size_t XS, size_t YS, size_t ZS>
+void mulAddLanes(double* __restrict d, const double* __restrict x, const double* __restrict y, const double* __restrict z) {
+  for (size_t l = 0; l < B; ++l) {
+    const double p = x[l * XS] * y[l * YS];
+    d[l] = p + z[l * ZS];
+  }
+}
+
+void mulAddKernel(double* ws, const Instr& in) {
+  using Fn = void (*)(double*, const double*, const double*, const double*);
+  static constexpr Fn kinds[8] = {mulAddLanes<0, 0, 0>, mulAddLanes<0, 0, 1>, mulAddLanes<0, 1, 0>, mulAddLanes<0, 1, 1>,
+                                  mulAddLanes<1, 0, 0>, mulAddLanes<1, 0, 1>, mulAddLanes<1, 1, 0>, mulAddLanes<1, 1, 1>};
+  const Fn f = kinds[(in.a.varying ? 4 : 0) + (in.b.varying ? 2 : 0) + (in.c.varying ? 1 : 0)];
+  for (int c = 0; c < in.n; ++c) f(ws + in.dst + (in.dstOff + c) * B, at(ws, in.a, c), at(ws, in.b, c), at(ws, in.c, c));
 }
 
 bool active(const double* ws, const Instr& in, size_t l) { return !in.guarded || at(ws, in.guard, 0)[l] != 0; }
@@ -909,6 +965,7 @@ bool DefinitionProgram::Impl::runBatch(double* ws, size_t batch, std::vector<std
       case Op::Abs: case Op::Sqrt: case Op::Sign: case Op::Not:
         unaryKernel(ws, in, [op = in.op](double x) { return apply(op, x); });
         break;
+      case Op::MulAdd: mulAddKernel(ws, in); break;
       case Op::Select: {
         const double* cond = at(ws, in.a, 0);
         const size_t cs = in.a.varying ? 1 : 0;
@@ -923,8 +980,17 @@ bool DefinitionProgram::Impl::runBatch(double* ws, size_t batch, std::vector<std
       case Op::Load: {
         const glm::vec4* src = streams[in.extra]->data() + first;
         double* d = ws + in.dst;
-        for (int c = 0; c < in.n; ++c)
-          for (size_t l = 0; l < m; ++l) d[static_cast<size_t>(c) * B + l] = c < in.k ? src[l][c] : 0.0;
+        for (int c = in.k; c < in.n; ++c) std::fill(d + static_cast<size_t>(c) * B, d + static_cast<size_t>(c) * B + m, 0.0);
+        // One pass over the stream (components beyond k are not the semantic's).
+        if (in.k == 1) {
+          for (size_t l = 0; l < m; ++l) d[l] = src[l].x;
+        } else if (in.k == 2) {
+          for (size_t l = 0; l < m; ++l) d[l] = src[l].x, d[B + l] = src[l].y;
+        } else if (in.k == 3) {
+          for (size_t l = 0; l < m; ++l) d[l] = src[l].x, d[B + l] = src[l].y, d[2 * B + l] = src[l].z;
+        } else {
+          for (size_t l = 0; l < m; ++l) d[l] = src[l].x, d[B + l] = src[l].y, d[2 * B + l] = src[l].z, d[3 * B + l] = src[l].w;
+        }
         break;
       }
       case Op::Gather: {

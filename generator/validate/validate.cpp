@@ -474,49 +474,62 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
       for (size_t k = 0; k < missing.size(); ++k) pr.values[missing[k]] = std::move(values[k]);
     }
     rep.referenceMs += msSince(t0);
+    // Compare vertex by vertex, every output of a captured record together (one pass over
+    // the capture). Matrices: columns in order; arrays: elements in order (both as their
+    // semantics list them).
+    struct Compared {
+      const EmittedOutput* o;
+      OutputReport* out;
+      std::vector<std::pair<const double*, size_t>> refs;  // values, components
+      size_t comps;
+    };
+    std::vector<Compared> compared;
+    size_t widest = 0;
     for (size_t oi = 0; oi < r.glsl.outputs.size(); ++oi) {
+      if (rep.outputs[oi].unchecked) continue;
       const EmittedOutput& o = r.glsl.outputs[oi];
-      OutputReport& out = rep.outputs[oi];
-      if (out.unchecked) continue;
-      std::vector<const std::vector<double>*> refs;
-      std::vector<int> widths;
-      for (const auto& sem : o.semantics) {
-        refs.push_back(&pr.values.at(sem));
-        widths.push_back(reference.components(sem));
-      }
-      // Matrices: columns in order; arrays: elements in order (both as their semantics list them).
-      int comps = componentCount(o.type) * std::max(1, o.arraySize);
-      bool isFloat = scalarKind(o.type) == ScalarKind::Float;
-      std::vector<double> ref(static_cast<size_t>(comps)), gpu(static_cast<size_t>(comps));
-      for (size_t v = 0; v < mesh.vertexCount; ++v) {
+      Compared c{&o, &rep.outputs[oi], {}, static_cast<size_t>(componentCount(o.type) * std::max(1, o.arraySize))};
+      for (const auto& sem : o.semantics)
+        c.refs.emplace_back(pr.values.at(sem).data(), static_cast<size_t>(reference.components(sem)));
+      widest = std::max(widest, c.comps);
+      compared.push_back(std::move(c));
+    }
+    std::vector<double> ref(widest), gpu(widest);
+    for (size_t v = 0; v < mesh.vertexCount; ++v) {
+      const uint8_t* record = res.captured.data() + v * r.glsl.captureStride;
+      for (Compared& cmp : compared) {
+        const EmittedOutput& o = *cmp.o;
+        OutputReport& out = *cmp.out;
+        const size_t comps = cmp.comps;
         size_t k = 0;
-        for (size_t si = 0; si < refs.size(); ++si)
-          for (int c = 0; c < widths[si] && k < ref.size(); ++c) ref[k++] = (*refs[si])[v * static_cast<size_t>(widths[si]) + static_cast<size_t>(c)];
-        const uint8_t* rec = res.captured.data() + v * r.glsl.captureStride + o.captureOffset;
+        for (const auto& [values, width] : cmp.refs)
+          for (size_t c = 0; c < width && k < comps; ++c) ref[k++] = values[v * width + c];
+        const uint8_t* rec = record + o.captureOffset;
+        const ScalarKind kind = scalarKind(o.type);
         double scale = 1.0;
-        for (int c = 0; c < comps; ++c) {
-          if (isFloat) {
+        for (size_t c = 0; c < comps; ++c) {
+          if (kind == ScalarKind::Float) {
             float f;
             std::memcpy(&f, rec + 4 * c, 4);
-            gpu[static_cast<size_t>(c)] = f;
+            gpu[c] = f;
           } else {
             uint32_t u;
             std::memcpy(&u, rec + 4 * c, 4);
-            gpu[static_cast<size_t>(c)] = scalarKind(o.type) == ScalarKind::Int ? static_cast<int32_t>(u) : u;
+            gpu[c] = kind == ScalarKind::Int ? static_cast<int32_t>(u) : u;
           }
-          if (std::isfinite(ref[static_cast<size_t>(c)])) scale = std::max(scale, std::abs(ref[static_cast<size_t>(c)]));
+          if (std::isfinite(ref[c])) scale = std::max(scale, std::abs(ref[c]));
         }
-        for (int c = 0; c < comps; ++c) {
-          const double g = gpu[static_cast<size_t>(c)], x = ref[static_cast<size_t>(c)];
+        for (size_t c = 0; c < comps; ++c) {
+          const double g = gpu[c], x = ref[c];
           double err = std::abs(g - x);
           if (!std::isfinite(g) || !std::isfinite(x)) {
             err = INFINITY;
-            if (out.nonFinite.empty()) out.nonFinite = nonFiniteReport(reference, o, v, c, g, x);
+            if (out.nonFinite.empty()) out.nonFinite = nonFiniteReport(reference, o, v, static_cast<int>(c), g, x);
           }
           double rel = err / scale;
           if (rel > out.maxRelError || (err > out.maxAbsError && out.maxRelError == 0)) {
             out.worstVertex = v;
-            out.worstComponent = c;
+            out.worstComponent = static_cast<int>(c);
           }
           out.maxAbsError = std::max(out.maxAbsError, err);
           out.maxRelError = std::max(out.maxRelError, rel);
