@@ -123,9 +123,10 @@ TEST(Program, AgreesWithTreeOnProceduralMeshes) {
 TEST(Program, AgreesWithTreeOnDawnSubset) {
   const sg::RuleSet rules = sg::loadRules({sourcePath("examples/dawn/rules.yaml")});
   sg::Rig rig = sg::loadRigFile(sourcePath("examples/dawn/face.rig.yaml"));
-  sg::ValidationScene scene = sg::proceduralScene(rig, "dawn", 1, 2);
-  ASSERT_EQ(scene.mesh.vertexCount, 180000u);
-  rt::Mesh mesh = everyNth(sg::quantizeForRig(rig, scene.mesh), 61);  // 2,951 vertices across the face
+  // Every 61st of the 180,000 vertices (2,951 across the face); the 2,009-vertex head of the
+  // same shape in the sanitizer build, where building the large mesh is the slow part.
+  sg::ValidationScene scene = sg::proceduralScene(rig, sgtest::kSanitized ? "head" : "dawn", 1, 2);
+  rt::Mesh mesh = sgtest::kSanitized ? sg::quantizeForRig(rig, scene.mesh) : everyNth(sg::quantizeForRig(rig, scene.mesh), 61);
   size_t compared = 0;
   for (const auto& pose : scene.poses) compared += compareAll(rules, rig, mesh, sg::poseUniforms(rig, pose)).compared;
   EXPECT_GT(compared, 200000u);
@@ -415,7 +416,8 @@ TEST(Program, AgreesWithTreeOnRandomDefinitions) {
                                sg::DefType::Mat3, sg::DefType::Mat4, sg::DefType::Int};
   const char* names[] = {"float", "vec2", "vec3", "vec4", "mat3", "mat4", "int"};
   size_t compared = 0, errors = 0, nonFinite = 0;
-  for (uint32_t seed = 0; seed < 400; ++seed) {
+  const uint32_t definitions = sgtest::kSanitized ? 100 : 400;  // the tree walker is slow under ASan
+  for (uint32_t seed = 0; seed < definitions; ++seed) {
     RandomDefinition gen(seed);
     const size_t k = seed % 7;
     const std::string text = gen.make(types[k]);
@@ -439,9 +441,9 @@ TEST(Program, AgreesWithTreeOnRandomDefinitions) {
     errors += !tree.error.empty();
   }
   // Most formulas evaluate; some meet an index past the palette or a NaN, as intended.
-  EXPECT_GT(compared, 200000u);
-  EXPECT_GT(errors, 5u);
-  EXPECT_GT(nonFinite, 100u);
+  EXPECT_GT(compared, definitions * 500u);
+  EXPECT_GT(errors, definitions / 80);
+  EXPECT_GT(nonFinite, definitions / 4);
 }
 
 }  // namespace

@@ -18,6 +18,20 @@ namespace sgtest {
 
 namespace fs = std::filesystem;
 
+// The ASan + UBSan build (cmake/Sanitizers.cmake, `cmake/dev.sh sanitize`), where code runs
+// several times slower: tests whose point is not the mesh size use a smaller one there.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+inline constexpr bool kSanitized = true;
+#else
+inline constexpr bool kSanitized = false;
+#endif
+#else
+inline constexpr bool kSanitized = false;
+#endif
+
 inline std::string sourcePath(const std::string& rel) { return std::string(SG_SOURCE_DIR) + "/" + rel; }
 inline std::string dataPath(const std::string& name) { return sourcePath("tests/validate/data/" + name); }
 
