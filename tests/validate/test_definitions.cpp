@@ -26,7 +26,6 @@ namespace {
 namespace fs = std::filesystem;
 namespace rt = sg::rt;
 using sgtest::RulesCopy;
-using sgtest::rigFor;
 using sgtest::sourcePath;
 using sgtest::writeText;
 
@@ -120,27 +119,12 @@ int compareOracle(const sg::Rig& rig, const rt::Mesh& mesh, const rt::Pose& pose
 
 TEST(Oracle, InterpreterAgreesWithReferenceOnProceduralMeshes) {
   int compared = 0;
-  for (int influences : {0, 1, 2, 4, 8})
-    for (int targets : {0, 3})
-      for (bool uniformScale : {false, true})
-        for (const char* which : {"head", "limb"}) {
-          rt::MeshOptions mo;
-          mo.influences = influences;
-          mo.morphTargets = targets;
-          mo.morphTangents = targets > 0 && influences % 2 == 0;
-          mo.bones = 6;
-          bool model = influences == 0 && !uniformScale;
-          rt::Mesh mesh = std::string(which) == "head" ? rt::makeHead(12, 16, mo) : rt::makeLimb(10, 12, mo);
-          sg::Rig rig = rigFor(mo, model, uniformScale);
-          rt::RigShape rs = rt::rigShapeFor(mo);
-          rs.hasModelMatrix = model;
-          rs.uniformScale = uniformScale;
-          for (uint32_t seed : {3u, 4u}) {
-            SCOPED_TRACE(::testing::Message() << which << " influences " << influences << " targets " << targets
-                                              << " uniform_scale " << uniformScale << " seed " << seed);
-            compared += compareOracle(rig, mesh, rt::makeRandomPose(rs, seed, rt::hostilePoseOptions(uniformScale)), rs);
-          }
-        }
+  sgtest::forEachProceduralCase([&](const sgtest::ProceduralCase& c) {
+    for (uint32_t seed : {3u, 4u}) {
+      SCOPED_TRACE(::testing::Message() << "seed " << seed);
+      compared += compareOracle(c.rig, c.mesh, rt::makeRandomPose(c.shape, seed, rt::hostilePoseOptions(c.uniformScale)), c.shape);
+    }
+  });
   EXPECT_GT(compared, 600);
 }
 

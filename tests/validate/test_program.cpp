@@ -98,25 +98,10 @@ rt::Mesh everyNth(const rt::Mesh& mesh, size_t n) {
 
 TEST(Program, AgreesWithTreeOnProceduralMeshes) {
   size_t compared = 0;
-  for (int influences : {0, 1, 2, 4, 8})
-    for (int targets : {0, 3})
-      for (bool uniformScale : {false, true})
-        for (const char* which : {"head", "limb"}) {
-          rt::MeshOptions mo;
-          mo.influences = influences;
-          mo.morphTargets = targets;
-          mo.morphTangents = targets > 0 && influences % 2 == 0;
-          mo.bones = 6;
-          const bool model = influences == 0 && !uniformScale;
-          rt::Mesh mesh = std::string(which) == "head" ? rt::makeHead(12, 16, mo) : rt::makeLimb(10, 12, mo);
-          sg::Rig rig = rigFor(mo, model, uniformScale);
-          rt::RigShape rs = rt::rigShapeFor(mo);
-          rs.hasModelMatrix = model;
-          SCOPED_TRACE(::testing::Message() << which << " influences " << influences << " targets " << targets
-                                            << " uniform_scale " << uniformScale);
-          rt::Pose pose = rt::makeRandomPose(rs, 5, rt::hostilePoseOptions(uniformScale));
-          compared += compareAll(standardRules(), rig, mesh, sg::poseUniforms(rig, pose)).compared;
-        }
+  sgtest::forEachProceduralCase([&](const sgtest::ProceduralCase& c) {
+    rt::Pose pose = rt::makeRandomPose(c.shape, 5, rt::hostilePoseOptions(c.uniformScale));
+    compared += compareAll(standardRules(), c.rig, c.mesh, sg::poseUniforms(c.rig, pose)).compared;
+  });
   EXPECT_GT(compared, 500000u);
 }
 

@@ -163,4 +163,42 @@ inline sg::Rig rigFor(const sg::rt::MeshOptions& mo, bool model, bool uniformSca
   return sg::loadRigText(y, "oracle.rig.yaml");
 }
 
+// One procedural case: the mesh, the rig file describing it, and the reference's shape.
+struct ProceduralCase {
+  std::string which;  // "head" or "limb"
+  sg::rt::MeshOptions mo;
+  bool uniformScale = false;
+  sg::rt::Mesh mesh;
+  sg::Rig rig;
+  sg::rt::RigShape shape;
+};
+
+// Every rig form on small procedural meshes: 0, 1, 2, 4 and 8 influences, with and without
+// 3 morph targets (tangents morphed for even influence counts), uniform scale or not (the
+// unskinned ones without it get a model matrix), head and limb.
+template <class F>
+void forEachProceduralCase(F f) {
+  for (int influences : {0, 1, 2, 4, 8})
+    for (int targets : {0, 3})
+      for (bool uniformScale : {false, true})
+        for (const char* which : {"head", "limb"}) {
+          ProceduralCase c;
+          c.which = which;
+          c.uniformScale = uniformScale;
+          c.mo.influences = influences;
+          c.mo.morphTargets = targets;
+          c.mo.morphTangents = targets > 0 && influences % 2 == 0;
+          c.mo.bones = 6;
+          const bool model = influences == 0 && !uniformScale;
+          c.mesh = c.which == "head" ? sg::rt::makeHead(12, 16, c.mo) : sg::rt::makeLimb(10, 12, c.mo);
+          c.rig = rigFor(c.mo, model, uniformScale);
+          c.shape = sg::rt::rigShapeFor(c.mo);
+          c.shape.hasModelMatrix = model;
+          c.shape.uniformScale = uniformScale;
+          SCOPED_TRACE(::testing::Message() << which << " influences " << influences << " targets " << targets
+                                            << " uniform_scale " << uniformScale);
+          f(c);
+        }
+}
+
 }  // namespace sgtest
