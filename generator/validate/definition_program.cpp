@@ -612,7 +612,7 @@ class Compiler {
   }
 
   // An element of a family or uniform array at an index that depends on the vertex.
-  Value indexed(const DefNode& n, int sem, const Value& index) {
+  Value indexed(int sem, const Value& index) {
     const SemanticDecl& d = rules_.semantics[static_cast<size_t>(sem)];
     Table table;
     table.t = declType(d.type);
@@ -636,7 +636,6 @@ class Compiler {
     in.a = arg(index, 1);
     in.extra = static_cast<uint32_t>(p_.tables.size());
     p_.tables.push_back(std::move(table));
-    (void)n;
     emit(in);
     ++checked_;
     return dst;
@@ -656,7 +655,7 @@ class Compiler {
     if (base.kind == DefNode::Name && base.ref == DefNode::Semantic) {
       const SemanticDecl& d = rules_.semantics[static_cast<size_t>(base.semantic)];
       if (!d.count.empty() || !d.arrayParam.empty()) {
-        if (!i.constant) return indexed(n, base.semantic, i);
+        if (!i.constant) return indexed(base.semantic, i);
         if (at < 0) return trap(n.type);
         if (std::optional<Value> v = provided(base.semantic, at)) return *v;
         return trap(n.type);  // not provided: the tree walker throws UndefinedSemantic

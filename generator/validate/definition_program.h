@@ -39,7 +39,7 @@ class DefinitionProgram {
     size_t instructions = 0;    // per batch of vertices
     size_t perVertexCalls = 0;  // operations evaluated vertex by vertex (inverse of a per-vertex matrix, ...)
     size_t checks = 0;          // instructions that can hand a batch back
-    size_t constants = 0;       // values computed while compiling
+    size_t constants = 0;       // doubles computed while compiling (uniform-only values, literals)
   };
   Stats stats() const;
 

@@ -151,9 +151,9 @@ Val call(const DefNode& n, Val* a, size_t count) {
   };
   // Over the vector's own components (GLM's order: x + y + z, (x + y) + (z + w)).
   auto dot = [](const Val& x, const Val& y) {
-    const int n = defTypeComponents(x.t);
-    return n == 2 ? glm::dot(glm::dvec2(x.m[0]), glm::dvec2(y.m[0]))
-           : n == 3 ? glm::dot(dvec3(x.m[0]), dvec3(y.m[0]))
+    const int size = defTypeComponents(x.t);
+    return size == 2 ? glm::dot(glm::dvec2(x.m[0]), glm::dvec2(y.m[0]))
+           : size == 3 ? glm::dot(dvec3(x.m[0]), dvec3(y.m[0]))
                     : glm::dot(x.m[0], y.m[0]);
   };
   if (f == "dot") return scalar(dot(a[0], a[1]));
