@@ -10,6 +10,12 @@
 //   pose), and a minimal shader (gl_Position from a position and one matrix) validated on a
 //   mesh of the same size.
 // BM_ValidateMinimal, BM_ReferenceDawn: those baselines on their own.
+// BM_Definitions/<threads>: the reference validation computes, the definitions of the Dawn
+//   face's outputs (Interpreter::evaluate: compiled, on `threads` threads, 0 = every core) on
+//   the 180,000-vertex mesh in one pose, as ratios to what it checks and replaced, measured
+//   in the same iterations: the device run of the same plan on the same mesh (lavapipe, draw
+//   + transform feedback: RunReport::timings.runMs), the hand-written GLM reference, and the
+//   tree walker (timed on every 60th vertex, scaled to the mesh).
 // BM_Search/<heuristic>: A* on the Dawn problem (blind, hmax, lmcut), with expansions and
 //   time as ratios against blind search (uniform cost), measured in the same iterations.
 #include <benchmark/benchmark.h>
@@ -19,7 +25,10 @@
 #include <memory>
 #include <string>
 
+#include "rules/instantiate.h"
 #include "runtime/reference.h"
+#include "validate/interpreter.h"
+#include "validate/poses.h"
 #include "validate/validate.h"
 
 namespace {
@@ -139,6 +148,49 @@ void BM_ReferenceDawn(benchmark::State& state) {
   state.counters["vertices"] = static_cast<double>(dawn.scene.mesh.vertexCount);
 }
 BENCHMARK(BM_ReferenceDawn)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+
+void BM_Definitions(benchmark::State& state) {
+  Case& dawn = dawnCase();
+  const sg::Rig& rig = dawn.gen.in.rig;
+  const sg::RuleSet& rules = dawn.gen.in.rules;
+  const sg::RigShape shape = sg::shapeOfRig(rig, rules);
+  const sg::rt::Mesh mesh = sg::quantizeForRig(rig, dawn.scene.mesh);
+  const sg::UniformValues uniforms = sg::poseUniforms(rig, dawn.scene.poses[0]);
+  std::vector<std::string> semantics;
+  for (const auto& o : dawn.gen.glsl.outputs) semantics.insert(semantics.end(), o.semantics.begin(), o.semantics.end());
+  sg::Interpreter interp(rules, shape, mesh, uniforms);
+  interp.setThreads(static_cast<unsigned>(state.range(0)));
+  // The tree walker on every 60th vertex (it takes seconds on the whole mesh).
+  sg::rt::Mesh sample;
+  sample.vertexCount = (mesh.vertexCount + 59) / 60;
+  for (const auto& [sem, values] : mesh.streams)
+    for (size_t v = 0; v < values.size(); v += 60) sample.streams[sem].push_back(values[v]);
+  sg::Interpreter tree(rules, shape, sample, uniforms);
+  auto t0 = Clock::now();
+  tree.evaluateByTree(semantics);
+  const double treeMs = msSince(t0) * static_cast<double>(mesh.vertexCount) / static_cast<double>(sample.vertexCount);
+  interp.evaluate(semantics);  // warm-up
+  double ms = 0, runMs = 0, glmMs = 0;
+  for (auto _ : state) {
+    auto t = Clock::now();
+    benchmark::DoNotOptimize(interp.evaluate(semantics));
+    ms += msSince(t);
+    state.PauseTiming();
+    sg::RunReport r;
+    validateMs(dawn, &r);
+    runMs += r.timings.runMs;
+    glmMs += referenceOnlyMs(dawn);
+    state.ResumeTiming();
+  }
+  const double n = static_cast<double>(state.iterations());
+  state.counters["ms"] = ms / n;
+  state.counters["run_ms"] = runMs / n;
+  state.counters["ref_vs_run"] = ms / runMs;
+  state.counters["vs_glm"] = ms / glmMs;
+  state.counters["tree_ms"] = treeMs;
+  state.counters["vs_tree"] = ms / n / treeMs;
+}
+BENCHMARK(BM_Definitions)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 
 // A* on the Dawn problem with the heuristic given by the argument (0 blind, 1 hmax, 2 lmcut).
 const char* const kHeuristics[] = {"blind", "hmax", "lmcut"};

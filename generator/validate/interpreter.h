@@ -1,8 +1,10 @@
 // The reference interpreter: evaluates the `definition:` formulas of semantics
-// (rules/definition.h) on the CPU with GLM in double precision, per vertex of a mesh in a
-// pose. It reads only definitions and the rig's data; it never compiles or runs a rule's
-// GLSL, so agreement with a generated shader is evidence that the shader computes the
-// defined value. docs/validation.md, "Definitions".
+// (rules/definition.h) on the CPU in double precision, per vertex of a mesh in a pose. It
+// reads only definitions and the rig's data; it never compiles or runs a rule's GLSL, so
+// agreement with a generated shader is evidence that the shader computes the defined value.
+// evaluate() compiles the definitions into a flat program run on every core
+// (validate/definition_program.h); the tree walker (evaluateByTree) is its oracle and
+// reports errors and the inputs behind a NaN. docs/validation.md, "Definitions".
 #pragma once
 #include <map>
 #include <stdexcept>
@@ -38,7 +40,12 @@ class Interpreter {
   // Values of each semantic at every vertex: result[s][v * n + c], n = components of
   // semantic s (vectors 1..4, mat3 9, mat4 16). Throws UndefinedSemantic,
   // std::invalid_argument (bad data: joint index out of range, missing rig parameter).
+  // Semantics the requested ones share are computed once.
   std::vector<std::vector<double>> evaluate(const std::vector<std::string>& semantics);
+  // The same, walking the definition trees vertex by vertex (the compiled program's oracle).
+  std::vector<std::vector<double>> evaluateByTree(const std::vector<std::string>& semantics);
+  // Threads evaluate() uses: 0 (the default) for every core. The values do not depend on it.
+  void setThreads(unsigned threads);
 
   // A semantic that reads only uniforms (a normal matrix defined from model.matrix).
   std::vector<double> evaluateUniform(const std::string& semantic);

@@ -87,6 +87,36 @@ ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_
   return s;
 }
 
+// The reference values of one pose, kept across the runs of one validation: the chosen plan
+// and every forced alternative check the same semantics on the same mesh and poses.
+struct PoseReference {
+  UniformValues uniforms;  // what they were computed with
+  std::map<std::string, std::vector<double>> values;
+  std::map<std::string, std::string> unchecked;  // why a semantic cannot be evaluated ("" if it can)
+};
+
+struct Validator::ReferenceCache {
+  static constexpr size_t kMaxBytes = size_t{1} << 30;  // beyond, poses are recomputed per run
+  std::vector<PoseReference> poses;
+
+  // The entry of pose i, emptied if it was computed with other uniforms.
+  PoseReference& pose(size_t i, const UniformValues& uniforms) {
+    if (poses.size() <= i) poses.resize(i + 1);
+    PoseReference& p = poses[i];
+    if (p.uniforms != uniforms) {
+      p = PoseReference{};
+      p.uniforms = uniforms;
+    }
+    return p;
+  }
+  void trim(size_t i) {
+    size_t bytes = 0;
+    for (const auto& p : poses)
+      for (const auto& [sem, v] : p.values) bytes += v.size() * sizeof(double);
+    if (bytes > kMaxBytes) poses[i].values.clear();
+  }
+};
+
 Validator::Validator(const ValidateOptions& opts) : opts_(opts) {
   rt::HarnessOptions ho;
   ho.deviceName = opts.device;
@@ -103,7 +133,7 @@ RunReport Validator::runOne(const GenerateResult& r, const ValidationScene& scen
 }
 
 RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh, const ValidationScene& scene,
-                                  const std::vector<rt::Pose>& poses, const std::string& label) {
+                                  const std::vector<rt::Pose>& poses, const std::string& label, ReferenceCache* cache) {
   (void)scene;
   RunReport rep;
   rep.label = label;
@@ -127,7 +157,8 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
   size_t before = reportedMessages_;
   const RigShape shape = shapeOfRig(rig, r.in.rules);
   const RuleSet& rules = r.in.rules;
-  for (const rt::Pose& pose : poses) {
+  for (size_t pi = 0; pi < poses.size(); ++pi) {
+    const rt::Pose& pose = poses[pi];
     // The pose's uniforms (and those defined over them, as floats) and palettes; the
     // reference evaluates with the same values.
     const UniformValues uniforms = feedPose(r, mesh, pose, req);
@@ -136,70 +167,110 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
     rep.timings.uploadMs += res.timings.uploadMs;
     rep.timings.runMs += res.timings.runMs;
     rep.timings.readbackMs += res.timings.readbackMs;
-    Interpreter reference(rules, shape, mesh, uniforms);  // shares intermediates across outputs
+    // The reference of every checked output at once (outputs share their intermediates),
+    // or what an earlier run of this validation computed for the same pose.
+    auto t0 = Clock::now();
+    PoseReference local;
+    PoseReference& pr = cache ? cache->pose(pi, uniforms) : local;
+    if (!cache) pr.uniforms = uniforms;
+    Interpreter reference(rules, shape, mesh, pr.uniforms);
+    std::vector<std::string> missing;
     for (size_t oi = 0; oi < r.glsl.outputs.size(); ++oi) {
       const EmittedOutput& o = r.glsl.outputs[oi];
       OutputReport& out = rep.outputs[oi];
-      // Reference of each packed semantic, laid out component after component.
-      auto t0 = Clock::now();
-      std::vector<int> widths;
       for (const auto& sem : o.semantics) {
-        std::string why;
-        try {
-          why = reference.uncheckedReason(sem);
-          if (why.empty()) widths.push_back(reference.components(sem));
-        } catch (const std::exception& e) {
-          throw InputError(SourceLoc{}, fmt::format("cannot validate output '{}': {}", o.name, e.what()));
+        auto why = pr.unchecked.find(sem);
+        if (why == pr.unchecked.end()) {
+          try {
+            why = pr.unchecked.emplace(sem, reference.uncheckedReason(sem)).first;
+          } catch (const std::exception& e) {
+            throw InputError(SourceLoc{}, fmt::format("cannot validate output '{}': {}", o.name, e.what()));
+          }
         }
-        if (!why.empty() && !out.unchecked) {
+        if (!why->second.empty() && !out.unchecked) {
           out.unchecked = true;
-          out.uncheckedReason = why;
+          out.uncheckedReason = why->second;
         }
       }
-      if (out.unchecked) {
-        rep.referenceMs += msSince(t0);
-        continue;
-      }
-      std::vector<std::vector<double>> refs;
+      if (out.unchecked) continue;
+      for (const auto& sem : o.semantics)
+        if (!pr.values.count(sem) && std::find(missing.begin(), missing.end(), sem) == missing.end()) missing.push_back(sem);
+    }
+    if (!missing.empty()) {
+      std::vector<std::vector<double>> values;
       try {
-        refs = reference.evaluate(o.semantics);
+        values = reference.evaluate(missing);
       } catch (const std::exception& e) {
-        throw InputError(SourceLoc{}, fmt::format("cannot validate output '{}': {}", o.name, e.what()));
+        // Name the first output whose semantics cannot be evaluated.
+        for (size_t oi = 0; oi < r.glsl.outputs.size(); ++oi) {
+          if (rep.outputs[oi].unchecked) continue;
+          try {
+            reference.evaluate(r.glsl.outputs[oi].semantics);
+          } catch (const std::exception& first) {
+            throw InputError(SourceLoc{}, fmt::format("cannot validate output '{}': {}", r.glsl.outputs[oi].name, first.what()));
+          }
+        }
+        throw InputError(SourceLoc{}, fmt::format("cannot validate: {}", e.what()));
       }
-      rep.referenceMs += msSince(t0);
-      // Matrices: columns in order; arrays: elements in order (both as their semantics list them).
-      int comps = componentCount(o.type) * std::max(1, o.arraySize);
-      bool isFloat = scalarKind(o.type) == ScalarKind::Float;
-      std::vector<double> ref(static_cast<size_t>(comps)), gpu(static_cast<size_t>(comps));
-      for (size_t v = 0; v < mesh.vertexCount; ++v) {
+      for (size_t k = 0; k < missing.size(); ++k) pr.values[missing[k]] = std::move(values[k]);
+    }
+    rep.referenceMs += msSince(t0);
+    // Compare vertex by vertex, every output of a captured record together (one pass over
+    // the capture). Matrices: columns in order; arrays: elements in order (both as their
+    // semantics list them).
+    struct Compared {
+      const EmittedOutput* o;
+      OutputReport* out;
+      std::vector<std::pair<const double*, size_t>> refs;  // values, components
+      size_t comps;
+    };
+    std::vector<Compared> compared;
+    size_t widest = 0;
+    for (size_t oi = 0; oi < r.glsl.outputs.size(); ++oi) {
+      if (rep.outputs[oi].unchecked) continue;
+      const EmittedOutput& o = r.glsl.outputs[oi];
+      Compared c{&o, &rep.outputs[oi], {}, static_cast<size_t>(componentCount(o.type) * std::max(1, o.arraySize))};
+      for (const auto& sem : o.semantics)
+        c.refs.emplace_back(pr.values.at(sem).data(), static_cast<size_t>(reference.components(sem)));
+      widest = std::max(widest, c.comps);
+      compared.push_back(std::move(c));
+    }
+    std::vector<double> ref(widest), gpu(widest);
+    for (size_t v = 0; v < mesh.vertexCount; ++v) {
+      const uint8_t* record = res.captured.data() + v * r.glsl.captureStride;
+      for (Compared& cmp : compared) {
+        const EmittedOutput& o = *cmp.o;
+        OutputReport& out = *cmp.out;
+        const size_t comps = cmp.comps;
         size_t k = 0;
-        for (size_t si = 0; si < refs.size(); ++si)
-          for (int c = 0; c < widths[si] && k < ref.size(); ++c) ref[k++] = refs[si][v * static_cast<size_t>(widths[si]) + static_cast<size_t>(c)];
-        const uint8_t* rec = res.captured.data() + v * r.glsl.captureStride + o.captureOffset;
+        for (const auto& [values, width] : cmp.refs)
+          for (size_t c = 0; c < width && k < comps; ++c) ref[k++] = values[v * width + c];
+        const uint8_t* rec = record + o.captureOffset;
+        const ScalarKind kind = scalarKind(o.type);
         double scale = 1.0;
-        for (int c = 0; c < comps; ++c) {
-          if (isFloat) {
+        for (size_t c = 0; c < comps; ++c) {
+          if (kind == ScalarKind::Float) {
             float f;
             std::memcpy(&f, rec + 4 * c, 4);
-            gpu[static_cast<size_t>(c)] = f;
+            gpu[c] = f;
           } else {
             uint32_t u;
             std::memcpy(&u, rec + 4 * c, 4);
-            gpu[static_cast<size_t>(c)] = scalarKind(o.type) == ScalarKind::Int ? static_cast<int32_t>(u) : u;
+            gpu[c] = kind == ScalarKind::Int ? static_cast<int32_t>(u) : u;
           }
-          if (std::isfinite(ref[static_cast<size_t>(c)])) scale = std::max(scale, std::abs(ref[static_cast<size_t>(c)]));
+          if (std::isfinite(ref[c])) scale = std::max(scale, std::abs(ref[c]));
         }
-        for (int c = 0; c < comps; ++c) {
-          const double g = gpu[static_cast<size_t>(c)], x = ref[static_cast<size_t>(c)];
+        for (size_t c = 0; c < comps; ++c) {
+          const double g = gpu[c], x = ref[c];
           double err = std::abs(g - x);
           if (!std::isfinite(g) || !std::isfinite(x)) {
             err = INFINITY;
-            if (out.nonFinite.empty()) out.nonFinite = nonFiniteReport(reference, o, v, c, g, x);
+            if (out.nonFinite.empty()) out.nonFinite = nonFiniteReport(reference, o, v, static_cast<int>(c), g, x);
           }
           double rel = err / scale;
           if (rel > out.maxRelError || (err > out.maxAbsError && out.maxRelError == 0)) {
             out.worstVertex = v;
-            out.worstComponent = c;
+            out.worstComponent = static_cast<int>(c);
           }
           out.maxAbsError = std::max(out.maxAbsError, err);
           out.maxRelError = std::max(out.maxRelError, rel);
@@ -207,6 +278,7 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
         }
       }
     }
+    if (cache) cache->trim(pi);
   }
   const auto& msgs = harness_->validationMessages();
   rep.validationMessages.assign(msgs.begin() + static_cast<long>(before), msgs.end());
@@ -234,7 +306,8 @@ ValidateReport Validator::run(const ValidationScene& scene) {
   const rt::Mesh mesh = quantizeForRig(chosen.in.rig, scene.mesh);
   report.poses = scene.poses;
   drawDeclaredUniforms(report.poses, chosen.in.rig, chosen.in.rules);
-  report.runs.push_back(runQuantized(chosen, mesh, scene, report.poses, "chosen plan"));
+  ReferenceCache cache;
+  report.runs.push_back(runQuantized(chosen, mesh, scene, report.poses, "chosen plan", &cache));
   report.runs.back().generateMs = genMs;
 
   if (opts_.crossCheck) {
@@ -265,7 +338,8 @@ ValidateReport Validator::run(const ValidationScene& scene) {
         bool uses = false;
         for (int b : r.plan.actions) uses = uses || r.in.problem.actions[b].name == alt;
         if (!uses) continue;
-        RunReport rr = runQuantized(r, mesh, scene, report.poses, fmt::format("forced {} for {}", alt, p.facts[fact].name));
+        RunReport rr =
+            runQuantized(r, mesh, scene, report.poses, fmt::format("forced {} for {}", alt, p.facts[fact].name), &cache);
         rr.generateMs = ms;
         if (!seenPlans.insert(rr.rules).second) continue;
         report.runs.push_back(std::move(rr));

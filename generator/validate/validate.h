@@ -94,9 +94,10 @@ class Validator {
   const rt::Harness& harness() const { return *harness_; }
 
  private:
+  struct ReferenceCache;  // reference values by pose, shared by the runs of one validation
   // runOne on a mesh already quantized to the rig's attribute formats.
   RunReport runQuantized(const GenerateResult& r, const rt::Mesh& mesh, const ValidationScene& scene,
-                         const std::vector<rt::Pose>& poses, const std::string& label);
+                         const std::vector<rt::Pose>& poses, const std::string& label, ReferenceCache* cache = nullptr);
 
   ValidateOptions opts_;
   std::unique_ptr<rt::Harness> harness_;

@@ -59,11 +59,11 @@ const std::string kFaceFrag = "examples/dawn/face.frag", kFaceRules = "examples/
 // 180k-vertex runs are the slow part of this file). The packed (normal, occlusion) deltas
 // would take 180,001 x 52 x 16 bytes = 150 MB, over the 2^27-byte maxStorageBufferRange,
 // so the search reads normals (12 bytes per target) and occlusion (4) from two buffers.
-// Opt-in (SHADERGEN_VALIDATE_LARGE=1): the reference interpreter takes minutes over
-// 180,000 vertices x 52 targets on the shared machine (247 s for both, 27 Nov 2026). In
-// CI, Face52At180kVerticesPicksSplitBuffers checks the plans without running them.
+// (Opt-in until the reference was compiled: the tree walker took 247 s for both.) The size
+// is the point here, and its ~1.5 GB of streams and buffers under ASan would dominate the
+// sanitizer suite: that build checks the same code on the smaller meshes of the other tests.
 TEST(Buffers, Face52TargetsAt180kVerticesDenseAndSparse) {
-  if (!std::getenv("SHADERGEN_VALIDATE_LARGE")) GTEST_SKIP() << "set SHADERGEN_VALIDATE_LARGE=1";
+  if (kSanitized) GTEST_SKIP() << "180,000 vertices x 52 targets: run by the plain suite";
   for (const char* rig : {"face52.rig.yaml", "face52_sparse.rig.yaml"}) {
     SCOPED_TRACE(rig);
     bool sparse = std::string(rig).find("sparse") != std::string::npos;
@@ -79,7 +79,7 @@ TEST(Buffers, Face52TargetsAt180kVerticesDenseAndSparse) {
   }
 }
 
-// The plans the 180,000-vertex runs validate, without the GPU: generation only.
+// The plans of the 180,000-vertex runs at both sizes, without the GPU: generation only.
 TEST(Buffers, Face52At180kVerticesPicksSplitBuffers) {
   for (const char* rig : {"face52.rig.yaml", "face52_sparse.rig.yaml"}) {
     SCOPED_TRACE(rig);

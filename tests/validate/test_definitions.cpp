@@ -117,55 +117,14 @@ int compareOracle(const sg::Rig& rig, const rt::Mesh& mesh, const rt::Pose& pose
   return compared;
 }
 
-// A rig file for a procedural mesh built with `mo` (every stream it carries, every uniform).
-sg::Rig rigFor(const rt::MeshOptions& mo, bool model, bool uniformScale) {
-  std::string y = "rig: oracle\ndeformers:\n";
-  y += "  bones: " + std::to_string(mo.influences ? mo.bones : 0) + "\n  influences: " + std::to_string(mo.influences) +
-       "\n  morph_targets: " + std::to_string(mo.morphTargets) + "\n  uniform_scale: " + (uniformScale ? "1" : "0") + "\n";
-  if (mo.morphTargets) y += std::string("  morphs: [position") + (mo.morphNormals ? ", normal" : "") + (mo.morphTangents ? ", tangent" : "") + "]\n";
-  y += "attributes:\n  p: { format: float32x3, provides: vertex.position }\n"
-       "  n: { format: float32x4, provides: { vertex.normal: xyz, vertex.occlusion: w } }\n"
-       "  t: { format: float32x4, provides: { vertex.tangent: xyz, vertex.handedness: w } }\n";
-  if (mo.morphTargets) {
-    y += "  dp: { format: float32x3, per_target: true, provides: morph.position }\n";
-    if (mo.morphNormals) y += "  dn: { format: float32x4, per_target: true, provides: { morph.normal: xyz, morph.occlusion: w } }\n";
-    if (mo.morphTangents) y += "  dt: { format: float32x3, per_target: true, provides: morph.tangent }\n";
-  }
-  for (int s = 0; s < (mo.influences + 3) / 4; ++s)
-    y += "  j" + std::to_string(s) + ": { format: float32x4, provides: \"skin.joints[" + std::to_string(s) + "]\" }\n" +
-         "  w" + std::to_string(s) + ": { format: float32x4, provides: \"skin.weights[" + std::to_string(s) + "]\" }\n";
-  y += "uniforms:\n";
-  if (mo.influences) y += "  bones: { type: mat4, array: bones, semantic: skin.bones }\n";
-  if (mo.morphTargets) y += "  mw: { type: float, array: morph_targets, semantic: morph.weights }\n";
-  if (model) y += "  model: { type: mat4, semantic: model.matrix }\n";
-  y += "  cam: { type: vec3, semantic: camera.position }\n  view: { type: mat4, semantic: camera.view }\n"
-       "  proj: { type: mat4, semantic: camera.projection }\n  dapple: { type: mat4, semantic: dapple.matrix }\n";
-  return sg::loadRigText(y, "oracle.rig.yaml");
-}
-
 TEST(Oracle, InterpreterAgreesWithReferenceOnProceduralMeshes) {
   int compared = 0;
-  for (int influences : {0, 1, 2, 4, 8})
-    for (int targets : {0, 3})
-      for (bool uniformScale : {false, true})
-        for (const char* which : {"head", "limb"}) {
-          rt::MeshOptions mo;
-          mo.influences = influences;
-          mo.morphTargets = targets;
-          mo.morphTangents = targets > 0 && influences % 2 == 0;
-          mo.bones = 6;
-          bool model = influences == 0 && !uniformScale;
-          rt::Mesh mesh = std::string(which) == "head" ? rt::makeHead(12, 16, mo) : rt::makeLimb(10, 12, mo);
-          sg::Rig rig = rigFor(mo, model, uniformScale);
-          rt::RigShape rs = rt::rigShapeFor(mo);
-          rs.hasModelMatrix = model;
-          rs.uniformScale = uniformScale;
-          for (uint32_t seed : {3u, 4u}) {
-            SCOPED_TRACE(::testing::Message() << which << " influences " << influences << " targets " << targets
-                                              << " uniform_scale " << uniformScale << " seed " << seed);
-            compared += compareOracle(rig, mesh, rt::makeRandomPose(rs, seed, rt::hostilePoseOptions(uniformScale)), rs);
-          }
-        }
+  sgtest::forEachProceduralCase([&](const sgtest::ProceduralCase& c) {
+    for (uint32_t seed : {3u, 4u}) {
+      SCOPED_TRACE(::testing::Message() << "seed " << seed);
+      compared += compareOracle(c.rig, c.mesh, rt::makeRandomPose(c.shape, seed, rt::hostilePoseOptions(c.uniformScale)), c.shape);
+    }
+  });
   EXPECT_GT(compared, 600);
 }
 

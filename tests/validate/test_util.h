@@ -10,11 +10,27 @@
 #include <string>
 #include <vector>
 
+#include "rig/rig.h"
+#include "runtime/procedural.h"
 #include "validate/validate.h"
 
 namespace sgtest {
 
 namespace fs = std::filesystem;
+
+// The ASan + UBSan build (cmake/Sanitizers.cmake, `cmake/dev.sh sanitize`), where code runs
+// several times slower: tests whose point is not the mesh size use a smaller one there.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+inline constexpr bool kSanitized = true;
+#else
+inline constexpr bool kSanitized = false;
+#endif
+#else
+inline constexpr bool kSanitized = false;
+#endif
 
 inline std::string sourcePath(const std::string& rel) { return std::string(SG_SOURCE_DIR) + "/" + rel; }
 inline std::string dataPath(const std::string& name) { return sourcePath("tests/validate/data/" + name); }
@@ -119,6 +135,70 @@ inline ErrorMax maxErrors(const sg::ValidateReport& rep) {
       if (o.maxRelError > m.rel) m.rel = o.maxRelError, m.relAt = o.name;
     }
   return m;
+}
+
+// A rig file for a procedural mesh built with `mo` (every stream it carries, every uniform).
+inline sg::Rig rigFor(const sg::rt::MeshOptions& mo, bool model, bool uniformScale) {
+  std::string y = "rig: oracle\ndeformers:\n";
+  y += "  bones: " + std::to_string(mo.influences ? mo.bones : 0) + "\n  influences: " + std::to_string(mo.influences) +
+       "\n  morph_targets: " + std::to_string(mo.morphTargets) + "\n  uniform_scale: " + (uniformScale ? "1" : "0") + "\n";
+  if (mo.morphTargets) y += std::string("  morphs: [position") + (mo.morphNormals ? ", normal" : "") + (mo.morphTangents ? ", tangent" : "") + "]\n";
+  y += "attributes:\n  p: { format: float32x3, provides: vertex.position }\n"
+       "  n: { format: float32x4, provides: { vertex.normal: xyz, vertex.occlusion: w } }\n"
+       "  t: { format: float32x4, provides: { vertex.tangent: xyz, vertex.handedness: w } }\n";
+  if (mo.morphTargets) {
+    y += "  dp: { format: float32x3, per_target: true, provides: morph.position }\n";
+    if (mo.morphNormals) y += "  dn: { format: float32x4, per_target: true, provides: { morph.normal: xyz, morph.occlusion: w } }\n";
+    if (mo.morphTangents) y += "  dt: { format: float32x3, per_target: true, provides: morph.tangent }\n";
+  }
+  for (int s = 0; s < (mo.influences + 3) / 4; ++s)
+    y += "  j" + std::to_string(s) + ": { format: float32x4, provides: \"skin.joints[" + std::to_string(s) + "]\" }\n" +
+         "  w" + std::to_string(s) + ": { format: float32x4, provides: \"skin.weights[" + std::to_string(s) + "]\" }\n";
+  y += "uniforms:\n";
+  if (mo.influences) y += "  bones: { type: mat4, array: bones, semantic: skin.bones }\n";
+  if (mo.morphTargets) y += "  mw: { type: float, array: morph_targets, semantic: morph.weights }\n";
+  if (model) y += "  model: { type: mat4, semantic: model.matrix }\n";
+  y += "  cam: { type: vec3, semantic: camera.position }\n  view: { type: mat4, semantic: camera.view }\n"
+       "  proj: { type: mat4, semantic: camera.projection }\n  dapple: { type: mat4, semantic: dapple.matrix }\n";
+  return sg::loadRigText(y, "oracle.rig.yaml");
+}
+
+// One procedural case: the mesh, the rig file describing it, and the reference's shape.
+struct ProceduralCase {
+  std::string which;  // "head" or "limb"
+  sg::rt::MeshOptions mo;
+  bool uniformScale = false;
+  sg::rt::Mesh mesh;
+  sg::Rig rig;
+  sg::rt::RigShape shape;
+};
+
+// Every rig form on small procedural meshes: 0, 1, 2, 4 and 8 influences, with and without
+// 3 morph targets (tangents morphed for even influence counts), uniform scale or not (the
+// unskinned ones without it get a model matrix), head and limb.
+template <class F>
+void forEachProceduralCase(F f) {
+  for (int influences : {0, 1, 2, 4, 8})
+    for (int targets : {0, 3})
+      for (bool uniformScale : {false, true})
+        for (const char* which : {"head", "limb"}) {
+          ProceduralCase c;
+          c.which = which;
+          c.uniformScale = uniformScale;
+          c.mo.influences = influences;
+          c.mo.morphTargets = targets;
+          c.mo.morphTangents = targets > 0 && influences % 2 == 0;
+          c.mo.bones = 6;
+          const bool model = influences == 0 && !uniformScale;
+          c.mesh = c.which == "head" ? sg::rt::makeHead(12, 16, c.mo) : sg::rt::makeLimb(10, 12, c.mo);
+          c.rig = rigFor(c.mo, model, uniformScale);
+          c.shape = sg::rt::rigShapeFor(c.mo);
+          c.shape.hasModelMatrix = model;
+          c.shape.uniformScale = uniformScale;
+          SCOPED_TRACE(::testing::Message() << which << " influences " << influences << " targets " << targets
+                                            << " uniform_scale " << uniformScale);
+          f(c);
+        }
 }
 
 }  // namespace sgtest
