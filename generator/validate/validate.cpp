@@ -234,8 +234,8 @@ std::vector<uint8_t> buildUniforms(const Rig& rig, const EmittedGlsl& glsl, cons
   return block;
 }
 
-// A pose's uniform values: the pose's own, then those defined by a formula over them (a
-// normal matrix), rounded to float as the GPU gets them.
+}  // namespace
+
 UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape& shape, const rt::Mesh& mesh,
                             const rt::Pose& pose) {
   UniformValues uniforms = poseUniforms(rig, pose);
@@ -254,6 +254,8 @@ UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape
   }
   return uniforms;
 }
+
+namespace {
 
 // Which side produced a NaN or infinity, where, and the provided values it was computed from.
 std::string nonFiniteReport(Interpreter& reference, const EmittedOutput& o, size_t v, int c, double gpu, double ref) {
@@ -451,6 +453,7 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
         for (int c = 0; c < comps; ++c) {
           const double g = gpu[static_cast<size_t>(c)], x = ref[static_cast<size_t>(c)];
           double err = std::abs(g - x);
+          if (!std::isfinite(g) && !std::isfinite(x) && opts_.tolerance.nonFiniteAgrees) continue;
           if (!std::isfinite(g) || !std::isfinite(x)) {
             err = INFINITY;
             if (out.nonFinite.empty()) out.nonFinite = nonFiniteReport(reference, o, v, c, g, x);
@@ -459,6 +462,8 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
           if (rel > out.maxRelError || (err > out.maxAbsError && out.maxRelError == 0)) {
             out.worstVertex = v;
             out.worstComponent = c;
+            out.worstGpu = gpu;
+            out.worstReference = ref;
           }
           out.maxAbsError = std::max(out.maxAbsError, err);
           out.maxRelError = std::max(out.maxRelError, rel);

@@ -10,6 +10,7 @@
 #include "pipeline/generate.h"
 #include "runtime/mesh.h"
 #include "runtime/vk_harness.h"
+#include "validate/interpreter.h"
 
 namespace sg {
 
@@ -18,6 +19,10 @@ struct Tolerance {
   // the largest reference component of that output at that vertex.
   double abs = 1e-6;
   double rel = 1e-5;
+  // Both sides non-finite (NaN or infinity) at a component counts as agreement: rule checking
+  // (validate/rule_check.h) feeds inputs where a definition is undefined, and a rule agrees
+  // with it there when it is undefined too.
+  bool nonFiniteAgrees = false;
 };
 
 struct OutputReport {
@@ -27,6 +32,7 @@ struct OutputReport {
   double maxRelError = 0;  // |gpu - ref| / max(1, |ref|_max)
   size_t worstVertex = 0;
   int worstComponent = 0;
+  std::vector<double> worstGpu, worstReference;  // the output's components at the worst vertex
   bool pass = true;
   // A semantic it carries has no definition (and the rig does not provide it): not compared.
   bool unchecked = false;
@@ -85,6 +91,11 @@ rt::VertexStream vertexStream(const Rig& rig, const EmittedInput& in, const rt::
 std::vector<uint8_t> uniformBlock(const Rig& rig, const RuleSet& rules, const EmittedGlsl& glsl, const SpirvModule& spv,
                                   const rt::Mesh& mesh, const rt::Pose& pose);
 
+// A pose's uniform values by semantic: the pose's own, then those defined by a formula over
+// them (a normal matrix), rounded to float as the GPU gets them.
+UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape& shape, const rt::Mesh& mesh,
+                            const rt::Pose& pose);
+
 struct ValidateOptions {
   GenerateOptions gen;
   bool crossCheck = false;  // also force each alternative derivation and check it
@@ -103,6 +114,7 @@ class Validator {
   ValidateReport run(const ValidationScene& scene);
   // One generation result on the scene (no cross-check); exposed for tests and benchmarks.
   RunReport runOne(const GenerateResult& r, const ValidationScene& scene, const std::string& label);
+  std::string deviceName() const { return harness_->deviceName(); }
 
  private:
   // runOne on a mesh already quantized to the rig's attribute formats.

@@ -277,6 +277,25 @@ search)
   ;;
 
 
+check_rig)
+  # `check --rig`: every rule run alone on lavapipe against its definition (docs/rules-authoring.md).
+  expect 0 "check --rig (rules run alone)" -- "$SG" check --rig "$E/face.rig.yaml" "$SRC/rules/standard.yaml"
+  grep -q '^rules run alone on .* against their definitions (.* hostile vertices, 5 poses): [0-9]* agree, 0 disagree$' last.err &&
+    ok "summary: agree, 0 disagree" || fail "check --rig printed: $(head -3 last.err)"
+  grep -q '^  object_position_unmorphed: when .!has(morph.position). is false' last.err && ok "lists rules not applicable" ||
+    fail "no not-applicable list: $(cat last.err)"
+  expect 0 "check --rig --no-run" -- "$SG" check --rig "$E/face.rig.yaml" "$SRC/rules/standard.yaml" --no-run
+  grep -q 'rules run alone' last.err && fail "--no-run still ran the rules" || ok "--no-run skips the device"
+  # A drifted copy: the buffer-fed tangent rule without the fallback is located at the rule.
+  mkdir -p drift && cp "$SRC"/rules/*.yaml drift/
+  sed -i 's/^      @use tangent_orthonormal(\${out}, \${object.normal})$/      ${out} = normalize(${out} - dot(${out}, ${object.normal}) * ${object.normal});/' drift/buffers.yaml
+  expect 1 "check --rig with a drifted rule" -- "$SG" check --rig "$E/face.rig.yaml" drift/standard.yaml
+  grep -q "^drift/buffers.yaml:[0-9]*:[0-9]*: error: rule 'object_tangent_morphed_buffer_gram_schmidt' disagrees with the definition of 'object.tangent' .* at input " last.err &&
+    ok "the disagreement is located at the rule, with its input" || fail "check printed: $(head -5 last.err)"
+  grep -q "^drift/buffers.yaml:[0-9]*:[0-9]*: error: rule 'object_tangent_morphed_sparse_gram_schmidt' disagrees" last.err &&
+    ok "and the sparse form too" || fail "check printed: $(head -5 last.err)"
+  ;;
+
 build)
   # `shadergen build`: one process, cache across runs (and between two concurrent builds),
   # unchanged outputs untouched, byte-identical to `generate --set`, located errors.
