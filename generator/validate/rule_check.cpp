@@ -216,10 +216,16 @@ class Checker {
     }
     // Needs the rig does not provide: vectors are fed from their definitions, evaluated in
     // each pose; matrices and integers come from the rules the search picks for them.
-    std::vector<std::string> fed;
+    // A need defined over uniforms alone (camera.view_projection) becomes a uniform of the
+    // variant rig, computed from its definition as validation computes such uniforms.
+    std::vector<std::string> fed, fedUniforms;
     for (const auto& n : inst.needs) {
       if (shape.provided.count(n)) continue;
       const SemanticDecl* d = rules_.findSemantic(splitIndexed(n).first);
+      if (d && d->definition && d->arrayParam.empty() && d->count.empty() && isUniformValue(cr.rig, shape, mesh, poses, n)) {
+        fedUniforms.push_back(n);
+        continue;
+      }
       if (!d || !d->bufferOf.empty() || isMatrix(d->type) || scalarKind(d->type) != ScalarKind::Float) continue;
       if (!d->definition) {
         res.status = RuleCheckResult::Status::Unchecked;
@@ -241,7 +247,16 @@ class Checker {
       a.loc = SourceLoc{rig.file, 0, 0};
       rig.attributes.push_back(a);
     }
+    for (size_t k = 0; k < fedUniforms.size(); ++k) {
+      RigUniform u;
+      u.name = fmt::format("check_uniform{}", k);
+      u.semantic = fedUniforms[k];
+      u.type = rules_.findSemantic(fedUniforms[k])->type;
+      u.loc = SourceLoc{rig.file, 0, 0};
+      rig.uniforms.push_back(u);
+    }
     res.fed = fed;
+    res.fed.insert(res.fed.end(), fedUniforms.begin(), fedUniforms.end());
 
     GenerateOptions gen;
     gen.capture = true;
@@ -291,6 +306,19 @@ class Checker {
   }
 
  private:
+  // Can `semantic` be evaluated from the pose's uniforms alone?
+  bool isUniformValue(const Rig& rig, const RigShape& shape, const rt::Mesh& mesh, const std::vector<NamedPose>& poses,
+                      const std::string& semantic) {
+    try {
+      UniformValues u = uniformValues(rig, rules_, shape, mesh, poses.front().pose);
+      Interpreter in(rules_, shape, mesh, u);
+      in.evaluateUniform(semantic);
+      return true;
+    } catch (const std::exception&) {
+      return false;
+    }
+  }
+
   // The mesh with each fed need's definition evaluated in `pose` (the values depend on the
   // pose: morph weights, bones) as a stream of its own.
   rt::Mesh fedMesh(const Rig& rig, const RigShape& shape, const rt::Mesh& mesh, const rt::Pose& pose,
