@@ -385,12 +385,10 @@ RuleCheckReport checkRulesOnDevice(const RuleCheckOptions& opts) {
 
   report.results.resize(rules.rules.size());
   std::vector<std::string> whyNot(rules.rules.size());
-  std::vector<bool> done(rules.rules.size(), false);
+  std::vector<bool> done(rules.rules.size(), false), selected(rules.rules.size(), true);
   for (size_t i = 0; i < rules.rules.size(); ++i) {
-    if (!opts.only.empty() && std::find(opts.only.begin(), opts.only.end(), rules.rules[i].name) == opts.only.end()) {
-      done[i] = true;
-      report.results[i].detail = "not selected";
-    }
+    selected[i] = opts.only.empty() || std::find(opts.only.begin(), opts.only.end(), rules.rules[i].name) != opts.only.end();
+    done[i] = !selected[i];
     report.results[i].rule = rules.rules[i].name;
     report.results[i].produces = rules.rules[i].produces;
     report.results[i].loc = rules.rules[i].loc;
@@ -427,15 +425,16 @@ RuleCheckReport checkRulesOnDevice(const RuleCheckOptions& opts) {
       done[i] = true;
     }
   }
+  std::vector<RuleCheckResult> results;
   for (size_t i = 0; i < rules.rules.size(); ++i) {
+    if (!selected[i]) continue;
     RuleCheckResult& res = report.results[i];
     if (!done[i]) res.detail = whyNot[i];
     if (res.status == RuleCheckResult::Status::Disagrees)
       report.errors.push_back(Diagnostic{Severity::Error, res.loc, res.detail});
+    results.push_back(std::move(res));
   }
-  report.results.erase(std::remove_if(report.results.begin(), report.results.end(),
-                                      [](const RuleCheckResult& r) { return r.detail == "not selected"; }),
-                       report.results.end());
+  report.results = std::move(results);
   return report;
 }
 
