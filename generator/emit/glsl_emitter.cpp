@@ -316,6 +316,17 @@ class Emitter {
         start = nl + 1;
       }
     };
+    // An attribute read in parts (a_normal.xyz and a_normal.w) is loaded once into a local
+    // of the same name, which hides the input: each part of an input variable would be a
+    // load of its own, and spirv-opt does not rebuild vec4(a.xyz, a.w) into a.
+    for (const auto& in : out_.inputs) {
+      bool parts = false;
+      for (size_t f = 0; f < p_.facts.size(); ++f)
+        parts = parts || (used_[f] && p_.facts[f].source == Fact::Source::Attribute &&
+                          p_.facts[f].rigIndex == in.attribute && p_.facts[f].target == in.target &&
+                          !p_.facts[f].swizzle.empty());
+      if (parts) push(fmt::format("  {} {} = {};", glslName(in.type), in.name, in.name));
+    }
     for (int a : plan_.actions) {
       const Action& act = p_.actions[a];
       const Fact& f = p_.facts[act.add];

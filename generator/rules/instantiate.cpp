@@ -87,17 +87,23 @@ size_t editDistance(const std::string& a, const std::string& b) {
 
 }  // namespace
 
-std::string didYouMeanSemantic(const RuleSet& rules, const std::string& name) {
+std::string didYouMean(const std::string& name, const std::vector<std::string>& names) {
   std::string best;
   size_t bestD = std::max<size_t>(2, name.size() / 4) + 1;
-  for (const auto& d : rules.semantics) {
-    size_t dist = editDistance(name, d.name);
+  for (const auto& n : names) {
+    size_t dist = editDistance(name, n);
     if (dist < bestD) {
       bestD = dist;
-      best = d.name;
+      best = n;
     }
   }
   return best.empty() ? "" : fmt::format(" (did you mean '{}'?)", best);
+}
+
+std::string didYouMeanSemantic(const RuleSet& rules, const std::string& name) {
+  std::vector<std::string> names;
+  for (const auto& d : rules.semantics) names.push_back(d.name);
+  return didYouMean(name, names);
 }
 
 std::vector<Diagnostic> ruleReferenceErrors(const RuleSet& rules, int r) {

@@ -51,6 +51,8 @@ std::vector<Diagnostic> ruleReferenceErrors(const RuleSet& rules, int rule);
 
 // " (did you mean 'x'?)" for the declared semantic closest to `name`, or "".
 std::string didYouMeanSemantic(const RuleSet& rules, const std::string& name);
+// The same over any list of names.
+std::string didYouMean(const std::string& name, const std::vector<std::string>& names);
 
 struct RuleInstance {
   std::vector<std::string> needs;  // semantic instances, sorted, unique

@@ -94,6 +94,17 @@ struct NamingConvention {
   SourceLoc loc;
 };
 
+// A shared snippet (`snippets:`, docs/rules-format.md "Shared snippets"): one computation's
+// text that several rules insert with `@use name(arg, ...)` after fetching its inputs in
+// their own way, so that a fix lands in every fetch form. Expanded when a rule loads.
+struct SharedSnippet {
+  std::string name;
+  std::vector<std::string> params;  // ${param} in the text is replaced by the argument
+  std::vector<TemplateLine> glsl;
+  std::string doc;
+  SourceLoc loc;
+};
+
 // A rule a later file replaced (`override: true`) or removed (`disable:`).
 struct RuleChange {
   std::string rule;
@@ -109,10 +120,12 @@ struct RuleSet {
   std::vector<VaryingMapping> varyings;
   std::vector<NamingConvention> conventions;
   std::vector<RuleChange> changes;  // overrides and disables, in load order
+  std::vector<SharedSnippet> snippets;
 
   const SemanticDecl* findSemantic(const std::string& name) const;
   const VaryingMapping* findVarying(const std::string& name) const;
   const NamingConvention* findConvention(const std::string& name) const;
+  const SharedSnippet* findSnippet(const std::string& name) const;
 };
 
 // Loads rule files (and their `include:`s, relative to the including file) into one set.

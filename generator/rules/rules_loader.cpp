@@ -4,10 +4,12 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include "common/yaml_util.h"
+#include "rules/instantiate.h"
 #include "rules/loader_parts.h"
 #include "rules/rules.h"
 
@@ -217,6 +219,158 @@ std::vector<TemplateLine> snippetLines(const YamlCtx& y, const YAML::Node& n, co
   return out;
 }
 
+bool validSnippetName(const std::string& s) {
+  if (s.empty() || std::isdigit(static_cast<unsigned char>(s[0]))) return false;
+  for (char c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) return false;
+  return true;
+}
+
+// `@use NAME(ARG, ...)` parsed: the name, where it is, and the arguments' text (split at
+// top-level commas; brackets and ${...} nest).
+struct UseDirective {
+  std::string name;
+  SourceLoc nameLoc;
+  std::vector<std::string> args;
+};
+std::optional<UseDirective> parseUse(const TemplateLine& line) {
+  const std::string& t = line.text;
+  size_t at = t.find_first_not_of(" \t");
+  if (at == std::string::npos || t.compare(at, 4, "@use") != 0 ||
+      (at + 4 < t.size() && t[at + 4] != ' ' && t[at + 4] != '\t'))
+    return std::nullopt;
+  auto locAt = [&](size_t col) { return SourceLoc{line.loc.file, line.loc.line, line.loc.col + static_cast<int>(col)}; };
+  auto bad = [&](size_t col) -> InputError {
+    return InputError(locAt(col), "malformed @use: write '@use NAME(ARG, ...)' (one shared snippet per line)");
+  };
+  UseDirective u;
+  size_t p = t.find_first_not_of(" \t", at + 4);
+  if (p == std::string::npos) throw bad(at);
+  size_t e = p;
+  while (e < t.size() && (std::isalnum(static_cast<unsigned char>(t[e])) || t[e] == '_')) ++e;
+  u.name = t.substr(p, e - p);
+  u.nameLoc = locAt(p);
+  if (u.name.empty()) throw bad(p);
+  e = t.find_first_not_of(" \t", e);
+  if (e == std::string::npos || t[e] != '(') throw bad(e == std::string::npos ? t.size() : e);
+  int depth = 0;
+  std::string cur;
+  size_t i = e + 1;
+  for (; i < t.size(); ++i) {
+    char c = t[i];
+    if (depth == 0 && (c == ',' || c == ')')) {
+      size_t b = cur.find_first_not_of(" \t"), f = cur.find_last_not_of(" \t");
+      std::string arg = b == std::string::npos ? "" : cur.substr(b, f - b + 1);
+      if (arg.empty() && !(c == ')' && u.args.empty())) throw InputError(locAt(i), "@use: an empty argument");
+      if (!arg.empty()) u.args.push_back(arg);
+      cur.clear();
+      if (c == ')') break;
+      continue;
+    }
+    if (c == '(' || c == '[' || c == '{') ++depth;
+    if (c == ')' || c == ']' || c == '}') --depth;
+    cur += c;
+  }
+  if (i >= t.size() || t.find_first_not_of(" \t", i + 1) != std::string::npos) throw bad(std::min(i, t.size()));
+  return u;
+}
+
+// `${param}` replaced by its argument (other ${...} left for the snippet expansion).
+std::string substituteParams(const std::string& text, const SharedSnippet& s, const std::vector<std::string>& args) {
+  std::string out;
+  size_t i = 0;
+  while (i < text.size()) {
+    size_t b = text.find("${", i);
+    size_t e = b == std::string::npos ? std::string::npos : text.find('}', b);
+    if (e == std::string::npos) break;
+    out += text.substr(i, b - i);
+    std::string inner = text.substr(b + 2, e - b - 2);
+    auto p = std::find(s.params.begin(), s.params.end(), inner);
+    out += p == s.params.end() ? text.substr(b, e - b + 1) : args[static_cast<size_t>(p - s.params.begin())];
+    i = e + 1;
+  }
+  return out + text.substr(std::min(i, text.size()));
+}
+
+// Every `@use` line replaced by the shared snippet's lines (which keep their own place in
+// the rules files, so GLSL errors point at the one text); nested uses expand in turn.
+// `stack`: the snippets being expanded (a use of one of them is a cycle).
+std::vector<TemplateLine> expandUses(const RuleSet& set, const std::vector<TemplateLine>& lines,
+                                     std::vector<std::string>& stack) {
+  std::vector<TemplateLine> out;
+  for (const auto& line : lines) {
+    std::optional<UseDirective> u = parseUse(line);
+    if (!u) {
+      out.push_back(line);
+      continue;
+    }
+    const SharedSnippet* s = set.findSnippet(u->name);
+    if (!s) {
+      std::vector<std::string> names;
+      for (const auto& x : set.snippets) names.push_back(x.name);
+      throw InputError(u->nameLoc, fmt::format("@use of unknown snippet '{}'{}", u->name, didYouMean(u->name, names)));
+    }
+    if (std::find(stack.begin(), stack.end(), s->name) != stack.end()) {
+      std::string cycle;
+      for (auto it = std::find(stack.begin(), stack.end(), s->name); it != stack.end(); ++it) cycle += *it + " -> ";
+      throw InputError(u->nameLoc, fmt::format("snippet cycle: {}{}", cycle, s->name));
+    }
+    if (u->args.size() != s->params.size()) {
+      std::string params;
+      for (const auto& p : s->params) params += (params.empty() ? "" : ", ") + p;
+      throw InputError(u->nameLoc, fmt::format("snippet '{}' takes {} argument{} ({}), given {} (defined at {}:{})", s->name,
+                                               s->params.size(), s->params.size() == 1 ? "" : "s", params,
+                                               u->args.size(), s->loc.file, s->loc.line));
+    }
+    std::vector<TemplateLine> body = s->glsl;
+    for (auto& b : body) b.text = substituteParams(b.text, *s, u->args);
+    stack.push_back(s->name);
+    for (auto& b : expandUses(set, body, stack)) out.push_back(std::move(b));
+    stack.pop_back();
+  }
+  return out;
+}
+
+void loadSharedSnippets(RuleSet& set, const YamlCtx& y, const YAML::Node& section, const std::vector<std::string>& raw) {
+  y.expectMap(section, "'snippets'");
+  const size_t first = set.snippets.size();
+  for (auto it = section.begin(); it != section.end(); ++it) {
+    SharedSnippet s;
+    s.name = y.scalar(it->first, "a snippet name");
+    s.loc = locOf(it->first, y.file);
+    if (!validSnippetName(s.name))
+      y.fail(it->first, fmt::format("'{}' is not a valid snippet name (letters, digits and '_')", s.name));
+    if (const SharedSnippet* prev = set.findSnippet(s.name)) {
+      if (prev->loc.file == s.loc.file && prev->loc.line == s.loc.line) continue;  // same file included twice
+      y.fail(it->first, fmt::format("snippet '{}' is defined twice (first at {}:{})", s.name, prev->loc.file, prev->loc.line));
+    }
+    YAML::Node body = it->second;  // a copy: it->second lives in a temporary proxy
+    y.expectMap(body, "a shared snippet");
+    y.checkKeys(body, {"params", "glsl", "doc"});
+    if (YAML::Node ps = body["params"]) {
+      y.expectSeq(ps, "'params'");
+      for (const auto& p : ps) {
+        std::string name = y.scalar(p, "a parameter name");
+        if (!validSnippetName(name)) y.fail(p, fmt::format("'{}' is not a valid parameter name (letters, digits and '_')", name));
+        if (name == "out") y.fail(p, "'out' is the using rule's product, not a parameter");
+        if (std::find(s.params.begin(), s.params.end(), name) != s.params.end())
+          y.fail(p, fmt::format("parameter '{}' is listed twice", name));
+        s.params.push_back(name);
+      }
+    }
+    if (!body["glsl"]) y.fail(body, fmt::format("snippet '{}' has no 'glsl'", s.name));
+    s.glsl = snippetLines(y, body["glsl"], raw);
+    if (body["doc"]) s.doc = y.scalar(body["doc"], "'doc'");
+    set.snippets.push_back(std::move(s));
+  }
+  // Every use inside this file's snippets resolves, with the right arity and no cycle,
+  // even if no rule uses them.
+  for (size_t i = first; i < set.snippets.size(); ++i) {
+    std::vector<std::string> stack{set.snippets[i].name};
+    expandUses(set, set.snippets[i].glsl, stack);
+  }
+}
+
 void loadRule(RuleSet& set, const YamlCtx& y, const YAML::Node& r, const std::vector<std::string>& raw) {
   y.expectMap(r, "a rule");
   y.checkKeys(r, {"name", "produces", "needs", "when", "cost", "glsl", "doc", "override"});
@@ -253,7 +407,8 @@ void loadRule(RuleSet& set, const YamlCtx& y, const YAML::Node& r, const std::ve
   if (cost == "auto") rule.costAuto = true;
   else rule.cost = Expr::parse(cost, exprLoc(r["cost"], y.file));
   if (!r["glsl"]) y.fail(r, fmt::format("rule '{}' has no 'glsl' snippet", rule.name));
-  rule.glsl = snippetLines(y, r["glsl"], raw);
+  std::vector<std::string> stack;
+  rule.glsl = expandUses(set, snippetLines(y, r["glsl"], raw), stack);
   if (r["doc"]) rule.doc = y.scalar(r["doc"], "'doc'");
   if (existing) replaceRule(set, y, r["name"], *existing, std::move(rule), overrides);
   else set.rules.push_back(std::move(rule));
@@ -280,7 +435,7 @@ void loadParsed(RuleSet& set, const std::string& text, const std::string& path, 
   YAML::Node root = parseYaml(text, path);
   if (!root.IsDefined() || root.IsNull()) throw InputError(SourceLoc{path, 1, 1}, "empty rules file");
   y.expectMap(root, "a rules file");
-  y.checkKeys(root, {"include", "semantics", "varyings", "conventions", "disable", "rules", "doc"});
+  y.checkKeys(root, {"include", "semantics", "snippets", "varyings", "conventions", "disable", "rules", "doc"});
   set.files.push_back(path);
   std::vector<std::string> raw = splitLines(text);
   if (auto inc = root["include"]) {
@@ -305,6 +460,7 @@ void loadParsed(RuleSet& set, const std::string& text, const std::string& path, 
     }
   }
   if (auto s = root["semantics"]) loadSemantics(set, y, s, raw);
+  if (auto sn = root["snippets"]) loadSharedSnippets(set, y, sn, raw);
   if (auto v = root["varyings"]) loadVaryings(set, y, v);
   if (auto c = root["conventions"]) loadConventions(set, y, c);
   if (auto d = root["disable"]) applyDisable(set, y, d);
@@ -327,6 +483,12 @@ void loadFile(RuleSet& set, const std::string& path, std::vector<std::string>& s
 
 const SemanticDecl* RuleSet::findSemantic(const std::string& name) const {
   for (const auto& s : semantics)
+    if (s.name == name) return &s;
+  return nullptr;
+}
+
+const SharedSnippet* RuleSet::findSnippet(const std::string& name) const {
+  for (const auto& s : snippets)
     if (s.name == name) return &s;
   return nullptr;
 }

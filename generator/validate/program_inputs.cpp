@@ -211,8 +211,8 @@ std::vector<uint8_t> buildUniforms(const Rig& rig, const EmittedGlsl& glsl, cons
   return block;
 }
 
-// A pose's uniform values: the pose's own, then those defined by a formula over them (a
-// normal matrix), rounded to float as the GPU gets them.
+}  // namespace
+
 UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape& shape, const rt::Mesh& mesh,
                             const rt::Pose& pose) {
   UniformValues uniforms = poseUniforms(rig, pose);
@@ -232,11 +232,7 @@ UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape
   return uniforms;
 }
 
-}  // namespace
-
 rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh) { return quantizedMesh(rig, mesh); }
-
-
 
 std::vector<rt::DescriptorBinding> declaredDescriptors(const std::vector<ShaderDescriptor>& reflected) {
   std::vector<rt::DescriptorBinding> out;

@@ -22,6 +22,11 @@ rt::ProgramInputs programInputs(const GenerateResult& r, const rt::Mesh& mesh, c
 // block and the palettes. Returns the uniform values it fed (the reference uses the same).
 UniformValues feedPose(const GenerateResult& r, const rt::Mesh& mesh, const rt::Pose& pose, rt::ProgramInputs& inputs);
 
+// A pose's uniform values by semantic: the pose's own, then those defined by a formula over
+// them (a normal matrix), rounded to float as the GPU gets them.
+UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape& shape, const rt::Mesh& mesh,
+                            const rt::Pose& pose);
+
 // The descriptors of a shader's reflection, as the runtime checks them.
 std::vector<rt::DescriptorBinding> declaredDescriptors(const std::vector<ShaderDescriptor>& reflected);
 

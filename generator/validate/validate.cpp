@@ -263,6 +263,7 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
         for (size_t c = 0; c < comps; ++c) {
           const double g = gpu[c], x = ref[c];
           double err = std::abs(g - x);
+          if (!std::isfinite(g) && !std::isfinite(x) && opts_.tolerance.nonFiniteAgrees) continue;
           if (!std::isfinite(g) || !std::isfinite(x)) {
             err = INFINITY;
             if (out.nonFinite.empty()) out.nonFinite = nonFiniteReport(reference, o, v, static_cast<int>(c), g, x);
@@ -271,6 +272,8 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
           if (rel > out.maxRelError || (err > out.maxAbsError && out.maxRelError == 0)) {
             out.worstVertex = v;
             out.worstComponent = static_cast<int>(c);
+            out.worstGpu.assign(gpu.begin(), gpu.begin() + static_cast<long>(comps));
+            out.worstReference.assign(ref.begin(), ref.begin() + static_cast<long>(comps));
           }
           out.maxAbsError = std::max(out.maxAbsError, err);
           out.maxRelError = std::max(out.maxRelError, rel);

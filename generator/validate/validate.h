@@ -11,6 +11,7 @@
 #include "runtime/mesh.h"
 #include "runtime/vk_harness.h"
 #include "validate/program_inputs.h"
+#include "validate/interpreter.h"
 
 namespace sg {
 
@@ -19,6 +20,10 @@ struct Tolerance {
   // the largest reference component of that output at that vertex.
   double abs = 1e-6;
   double rel = 1e-5;
+  // Both sides non-finite (NaN or infinity) at a component counts as agreement: rule checking
+  // (validate/rule_check.h) feeds inputs where a definition is undefined, and a rule agrees
+  // with it there when it is undefined too.
+  bool nonFiniteAgrees = false;
 };
 
 struct OutputReport {
@@ -28,6 +33,7 @@ struct OutputReport {
   double maxRelError = 0;  // |gpu - ref| / max(1, |ref|_max)
   size_t worstVertex = 0;
   int worstComponent = 0;
+  std::vector<double> worstGpu, worstReference;  // the output's components at the worst vertex
   bool pass = true;
   // A semantic it carries has no definition (and the rig does not provide it): not compared.
   bool unchecked = false;
@@ -92,6 +98,7 @@ class Validator {
   RunReport runOne(const GenerateResult& r, const ValidationScene& scene, const std::string& label);
   // The device it runs on (render and bench draw on the same one).
   const rt::Harness& harness() const { return *harness_; }
+  std::string deviceName() const { return harness_->deviceName(); }
 
  private:
   struct ReferenceCache;  // reference values by pose, shared by the runs of one validation

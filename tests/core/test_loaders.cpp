@@ -567,11 +567,29 @@ TEST(RulesLoader, StandardLibraryAndDawnIncludes) {
     if (r.name == "skin_matrix_blend") blend = &r;
   ASSERT_TRUE(blend);
   std::string skinning = readText(kSrc + "/rules/skinning.yaml");
-  Pos first = posOf(skinning, "${out} = ${skin.weights[0]}");
-  ASSERT_FALSE(blend->glsl.empty());
-  EXPECT_EQ(blend->glsl[0].loc.file, kSrc + "/rules/skinning.yaml");
-  EXPECT_EQ(blend->glsl[0].loc.line, first.line);
-  EXPECT_EQ(blend->glsl[0].loc.col, first.col);
+  Pos first = posOf(skinning, "mat4 b${k}_ = ${skin.bones}[");
+  ASSERT_GT(blend->glsl.size(), 3u);
+  EXPECT_EQ(blend->glsl[2].text, "  mat4 b${k}_ = ${skin.bones}[${skin.joints[k / 4]}[${k % 4}]];");
+  EXPECT_EQ(blend->glsl[2].loc.file, kSrc + "/rules/skinning.yaml");
+  EXPECT_EQ(blend->glsl[2].loc.line, first.line);
+  EXPECT_EQ(blend->glsl[2].loc.col, first.col - 2);  // the text keeps the indentation past the block's
+  // Its `@use bone_blend()` is expanded at load: the shared snippet's lines, each at its own
+  // place in skinning.yaml (one text for every fetch form).
+  Pos last = posOf(skinning, "${out} = mat4(c0_, c1_, c2_, c3_);");
+  auto line = std::find_if(blend->glsl.begin(), blend->glsl.end(),
+                           [](const sg::TemplateLine& l) { return l.text == "${out} = mat4(c0_, c1_, c2_, c3_);"; });
+  ASSERT_NE(line, blend->glsl.end());
+  EXPECT_EQ(line->loc.line, last.line);
+  for (const auto& l : blend->glsl) EXPECT_EQ(l.text.find("@use"), std::string::npos) << l.text;
+  // Arguments replace the parameters: the sparse tangent rule's text reads its own sum.
+  std::string morph = readText(kSrc + "/rules/morph.yaml");
+  for (const auto& r : set.rules) {
+    if (r.name != "object_tangent_morphed_sparse_gram_schmidt") continue;
+    auto t = std::find_if(r.glsl.begin(), r.glsl.end(), [](const sg::TemplateLine& l) { return l.text == "  vec3 t_ = ${out};"; });
+    ASSERT_NE(t, r.glsl.end());
+    EXPECT_EQ(t->loc.file, kSrc + "/rules/morph.yaml");
+    EXPECT_EQ(t->loc.line, posOf(morph, "vec3 t_ = ${t};").line);
+  }
   // Loading the same file twice is a no-op.
   size_t nRules = set.rules.size();
   sg::loadRulesInto(set, kSrc + "/rules/morph.yaml");

@@ -105,7 +105,8 @@ TEST(DawnExamples, DepthOnlyComputesNoNormalsOrTangents) {
   EXPECT_TRUE(has(planRules(r), "world_position_linear_blend"));
 }
 
-TEST(DawnExamples, GeneratedFaceIsNoLargerThanTheHandPortAfterOptimisation) {
+// Issue 23: with the degenerate-tangent fallback, at most 0.8 of the hand port (docs/comparison.md).
+TEST(DawnExamples, GeneratedFaceIsAtMostFourFifthsOfTheHandPortAfterOptimisation) {
   GenerateOptions o = dawnOptions(kDawn + "face.rig.yaml", "face.frag");
   o.optimize = true;
   GenerateResult r = generate(o);
@@ -114,7 +115,8 @@ TEST(DawnExamples, GeneratedFaceIsNoLargerThanTheHandPortAfterOptimisation) {
   ASSERT_TRUE(c.ok);
   size_t handCount = countInstructions(optimizeSpirv(c.spirv, TargetEnv::Vulkan1_0));
   size_t genCount = countInstructions(r.spirv.words);
-  EXPECT_LE(genCount, handCount);
+  EXPECT_LE(genCount * 10, handCount * 8) << genCount << " instructions against the hand port's " << handCount;
+  EXPECT_TRUE(has(planRules(r), "object_tangent_gram_schmidt"));  // the fallback is in the plan
   EXPECT_GT(genCount, 100u);  // a real shader, not an empty one
 }
 

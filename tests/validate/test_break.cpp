@@ -98,12 +98,12 @@ TEST(BreakRules, MorphWeightWrongIndex) {
   EXPECT_TRUE(sil->worstComponent == 1 || sil->worstComponent == 2) << sil->worstComponent;
 }
 
-// Swapped index: influence k's weight applied to influence k-1's joint. skin.matrix moves
+// Swapped index: influence k's weight applied to influence k-1's joint (within the group of four). skin.matrix moves
 // every world-space value; only the pass-through SkinUVST survives.
 TEST(BreakRules, SkinJointWrongComponent) {
   RulesCopy rules("skin_joint");
-  ASSERT_TRUE(rules.edit("skinning.yaml", "${skin.bones}[${skin.joints[(k + 1) / 4]}[${(k + 1) % 4}]];",
-                         "${skin.bones}[${skin.joints[k / 4]}[${k % 4}]];"));
+  ASSERT_TRUE(rules.edit("skinning.yaml", "mat4 b${k}_ = ${skin.bones}[${skin.joints[k / 4]}[${k % 4}]];",
+                         "mat4 b${k}_ = ${skin.bones}[${skin.joints[k / 4]}[${(k + 3) % 4}]];"));
   Set expected = kAll;
   expected.erase("SkinUVST");
   expectBroken(validateDawn(rules), "skin_matrix_blend", expected);
