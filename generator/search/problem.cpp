@@ -13,6 +13,7 @@
 #include "rig/rig.h"
 #include "rules/rules.h"
 #include "rules/instantiate.h"
+#include "search/plan.h"
 
 namespace sg {
 
@@ -44,6 +45,48 @@ int64_t weighTerms(const TermWeights& w, const TermAmounts& a) {
     if (__builtin_mul_overflow(w[t], a[t], &x) || __builtin_add_overflow(sum, x, &sum) || sum > kCap) return kCap;
   }
   return sum;
+}
+
+Problem inputsAsFacts(const Problem& p) {
+  Problem q = p;
+  std::vector<bool> isInit(p.facts.size(), false), passThrough(p.resources.size(), false);
+  for (int f : p.init) isInit[f] = true;
+  for (int g : p.goals)
+    if (isInit[g] && p.facts[g].resource >= 0) passThrough[p.facts[g].resource] = true;
+  std::vector<int> factOf(p.resources.size(), -1);
+  for (size_t r = 0; r < p.resources.size(); ++r) {
+    if (p.resources[r].cost <= 0) continue;
+    if (passThrough[r]) {  // read by every plan
+      q.fixedCost += p.resources[r].cost;
+      q.resources[r].cost = 0;
+      continue;
+    }
+    factOf[r] = static_cast<int>(q.facts.size());
+    Fact f;
+    f.name = "read " + p.resources[r].name;
+    q.facts.push_back(f);
+    Action a;
+    a.name = f.name;
+    a.add = factOf[r];
+    a.cost = p.resources[r].cost;
+    q.actions.push_back(std::move(a));
+    q.resources[r].cost = 0;  // paid by its action now
+  }
+  for (size_t a = 0; a < p.actions.size(); ++a) {
+    std::vector<int>& pre = q.actions[a].pre;
+    for (int f : p.actions[a].pre)
+      if (int r = p.facts[f].resource; r >= 0 && factOf[r] >= 0) pre.push_back(factOf[r]);
+    std::sort(pre.begin(), pre.end());
+    pre.erase(std::unique(pre.begin(), pre.end()), pre.end());
+  }
+  return q;
+}
+
+Plan planOnInputs(const Problem& p, const Plan& onFacts) {
+  std::vector<int> actions;
+  for (int a : onFacts.actions)
+    if (a < static_cast<int>(p.actions.size())) actions.push_back(a);
+  return tidyPlan(p, actions);
 }
 
 int vertexInputLocations(Type t) { return t == Type::Mat4 ? 4 : t == Type::Mat3 ? 3 : 1; }

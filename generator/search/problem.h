@@ -13,6 +13,7 @@
 
 namespace sg {
 
+struct Plan;
 struct Rig;
 struct RuleSet;
 struct Varying;
@@ -169,6 +170,17 @@ std::vector<int64_t> resourceUsage(const Problem& p, const std::vector<int>& act
 void priceProblem(Problem& p, const TermWeights& w);
 // Whether some resource item has a cost (the search must then track the items a plan reads).
 bool hasItemCosts(const Problem& p);
+// The A* engines' view of priced inputs (docs/search.md, "Device profiles"): every rig
+// input with a cost becomes a fact of its own, produced by one action ("read <input>") that
+// costs the input's cost and needs nothing, and every action reading the input also needs
+// that fact. A delete-free plan produces a fact once, so the input is paid once however
+// many rules read it, and the heuristics (LM-cut, h_max, landmarks) see the shared cost the
+// way they see any shared intermediate value. Inputs of pass-through goals are read by every
+// plan: their costs join fixedCost. No item has a cost in the result, and a plan of it costs
+// what it costs in `p`. Actions keep their indices; planOnInputs maps a plan back.
+Problem inputsAsFacts(const Problem& p);
+Plan planOnInputs(const Problem& p, const Plan& onFacts);
+
 // Vertex input locations of a shader input type (Vulkan: a matrix takes one per column,
 // a 64-bit vector of 3 or 4 components two).
 int vertexInputLocations(Type t);

@@ -40,7 +40,6 @@ struct RankedTask {
   // Per rank, itemWords words: items every derivation of the fact reads (resource
   // landmarks), for pruning partial plans that no completion can keep within the limits.
   std::vector<uint64_t> itemLandmarks;
-  bool pricedItems = false;  // some item has a cost: estimates add the unread item landmarks'
 
   const uint64_t* landmarksOf(int r) const { return &landmarks[static_cast<size_t>(r) * words]; }
 };
@@ -131,13 +130,7 @@ RankedTask rankTask(const Problem& p) {
   };
   for (int i : t.items) count(i);
   for (int i : t.goalItems) count(i);
-  // Priced items (a device profile) join the state too: the cost of a decision then
-  // depends on the items earlier decisions already read.
-  bool priced = false;
-  for (int i : t.items) priced = priced || p.resources[i].cost > 0;
-  for (int i : t.goalItems) priced = priced || p.resources[i].cost > 0;
-  t.pricedItems = priced;
-  if (exceededLimit(p, all) >= 0 || priced) t.itemWords = static_cast<int>((p.resources.size() + 63) / 64);
+  if (exceededLimit(p, all) >= 0) t.itemWords = static_cast<int>((p.resources.size() + 63) / 64);
   if (t.itemWords) {
     const size_t IW = static_cast<size_t>(t.itemWords);
     t.itemLandmarks.assign(static_cast<size_t>(t.n) * IW, 0);
@@ -335,6 +328,11 @@ bool regressionApplies(const Problem& p) { return !rankTask(p).cyclic; }
 
 std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuristic, SearchStats* stats,
                                      const SearchLimits& limits) {
+  if (hasItemCosts(p)) {  // priced inputs: searched as facts, paid once (docs/search.md, "Device profiles")
+    std::optional<Plan> plan = regressionSearch(inputsAsFacts(p), heuristic, stats, limits);
+    if (!plan) return plan;
+    return planOnInputs(p, *plan);  // same cost, without the "read" actions
+  }
   OpenSetHeuristic::Kind kind;
   if (heuristic == "blind") kind = OpenSetHeuristic::Kind::Blind;
   else if (heuristic == "hmax") kind = OpenSetHeuristic::Kind::HMax;
@@ -352,7 +350,7 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
   if (t.cyclic) throw std::invalid_argument("regression search needs an acyclic relevant rule graph");
   st.relevantActions = static_cast<int64_t>(t.ops.size());
   // Node i's state: its open set (W words), then the resource items its decisions read
-  // (t.itemWords words, none when no limit can bind and no item has a cost) and its usage per limit: two partial
+  // (t.itemWords words, none when no limit can bind) and its usage per limit: two partial
   // plans with the same open set but different items are different states, since the
   // items decide which completions still fit (docs/search.md, "Resource limits").
   std::vector<uint64_t> states;
@@ -381,41 +379,19 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
   if (t.unsolvable) return finish(std::nullopt);
 
   OpenSetHeuristic h(t, kind);
-  // Item costs are paid apart from action costs, so the unread items every completion must
-  // still read (the open facts' item landmarks) add to any admissible estimate of the
-  // action costs (docs/search.md, "Device profiles").
-  std::vector<uint64_t> lmItems(static_cast<size_t>(t.itemWords));
-  auto unreadLandmarkCost = [&](const uint64_t* s) {
-    const size_t IW = static_cast<size_t>(t.itemWords);
-    std::fill(lmItems.begin(), lmItems.end(), 0);
-    forEachBit(s, t.words, [&](int r) {
-      for (size_t w = 0; w < IW; ++w) lmItems[w] |= t.itemLandmarks[static_cast<size_t>(r) * IW + w];
-    });
-    int64_t c = 0;
-    for (size_t w = 0; w < IW; ++w) lmItems[w] &= ~s[OW + w];
-    forEachBit(lmItems.data(), t.itemWords, [&](int i) { c += p.resources[i].cost; });
-    return c;
-  };
-  auto estimate = [&](const uint64_t* s) {
-    return timed(st.heuristicSeconds, [&] {
-      int64_t v = h.estimate(s);
-      return t.pricedItems && v < kInfiniteCost ? v + unreadLandmarkCost(s) : v;
-    });
-  };
+  auto estimate = [&](const uint64_t* s) { return timed(st.heuristicSeconds, [&] { return h.estimate(s); }); };
   states.assign(W, 0);
   for (int g : t.goals) states[static_cast<size_t>(g) >> 6] |= uint64_t{1} << (g & 63);
   usage.assign(L, 0);
-  // Reads `items` into the state words at `s` (resource part) and `use`, adding the cost of
-  // each item not read before to `cost`; false if a limit breaks.
-  auto readItems = [&](uint64_t* s, int64_t* use, const int* begin, const int* end, int64_t& cost) {
-    if (!t.itemWords) return true;
+  // Reads `items` into the state words at `s` (resource part) and `use`; false if a limit breaks.
+  auto readItems = [&](uint64_t* s, int64_t* use, const int* begin, const int* end) {
+    if (!L) return true;
     for (const int* it = begin; it != end; ++it) {
       uint64_t& w = s[OW + (static_cast<size_t>(*it) >> 6)];
       const uint64_t bit = uint64_t{1} << (*it & 63);
       if (w & bit) continue;
       w |= bit;
       const ResourceItem& item = p.resources[*it];
-      cost += item.cost;
       if (static_cast<size_t>(item.limit) >= L) continue;
       use[item.limit] += item.amount;
       if (use[item.limit] > p.limits[item.limit].max) return false;
@@ -441,10 +417,9 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
     });
     return fits;
   };
-  // Every plan pays the fixed terms and the items of the goals the rig provides.
-  int64_t g0 = p.fixedCost;
-  if (!readItems(states.data(), usage.data(), t.goalItems.data(), t.goalItems.data() + t.goalItems.size(), g0))
+  if (!readItems(states.data(), usage.data(), t.goalItems.data(), t.goalItems.data() + t.goalItems.size()))
     return finish(std::nullopt);  // the pass-through inputs alone break a limit
+  const int64_t g0 = p.fixedCost;  // what every plan pays (a device profile's fixed terms)
   int64_t h0 = estimate(stateOf(0));
   st.initialH = g0 + h0;
   nodes.push_back(Node{g0, h0, -1, -1, false});
@@ -476,11 +451,10 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
         child[static_cast<size_t>(t.pre[i]) >> 6] |= uint64_t{1} << (t.pre[i] & 63);
       std::copy(usage.begin() + static_cast<long>(e.node * L), usage.begin() + static_cast<long>((e.node + 1) * L),
                 childUse.begin());
-      int64_t step = op.cost;
-      if (!readItems(child.data(), childUse.data(), t.items.data() + op.itemBegin, t.items.data() + op.itemEnd, step))
+      if (!readItems(child.data(), childUse.data(), t.items.data() + op.itemBegin, t.items.data() + op.itemEnd))
         continue;  // over a device limit: no completion of this partial plan is feasible
       if (L && !landmarksFit(child.data(), childUse.data())) continue;
-      const int64_t ng = g + step;
+      const int64_t ng = g + op.cost;
       ++st.generated;
       budget.checkTime(st.expanded);
       const int id = static_cast<int>(nodes.size());
@@ -497,7 +471,7 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
         continue;
       }
       // Pathmax: a child's estimate never drops below its parent's less the step cost.
-      int64_t hv = std::max(estimate(stateOf(id)), hParent - step);
+      int64_t hv = std::max(estimate(stateOf(id)), hParent - op.cost);
       nodes.push_back(Node{ng, hv, e.node, o, false});
       usage.insert(usage.end(), childUse.begin(), childUse.end());
       index.insert(id);

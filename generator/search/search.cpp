@@ -16,16 +16,17 @@ std::optional<Plan> findPlan(const Problem& p, const SearchOptions& opts, Search
   if (e == "regression" || (e == "auto" && regressionApplies(p)))
     return regressionSearch(p, opts.heuristic, stats, opts.limits);
   if (e != "auto" && e != "forward") throw std::invalid_argument("unknown search engine '" + e + "'");
+  // Priced inputs (a device profile) are searched as facts, so each is paid once.
+  if (hasItemCosts(p)) {
+    const Problem q = inputsAsFacts(p);
+    SearchOptions o = opts;
+    o.engine = "forward";
+    std::optional<Plan> plan = findPlan(q, o, stats);
+    if (!plan) return plan;
+    return planOnInputs(p, *plan);  // same cost, without the "read" actions
+  }
   auto h = makeHeuristic(opts.heuristic, p);
   if (!h) throw std::invalid_argument("unknown heuristic '" + opts.heuristic + "' for forward search");
-  // Forward states are sets of facts; what an input costs depends on whether an earlier
-  // rule already read it, which they do not record. Under a device profile, the integer
-  // program (whose objective has the inputs, docs/search.md) is the exact engine.
-  if (hasItemCosts(p)) {
-    std::optional<Plan> plan = integerProgramSearch(p, stats, opts.limits);
-    if (stats) stats->engine = "ip (forward search cannot price inputs once per plan)";
-    return plan;
-  }
   std::optional<Plan> plan = astarSearch(p, *h, stats, opts.limits);
   // Forward states are sets of produced facts and know nothing of device limits: its plan
   // is the cheapest overall. If that breaks a limit, the integer program (which has the
