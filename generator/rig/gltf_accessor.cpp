@@ -112,6 +112,11 @@ std::optional<size_t> mulSize(size_t a, size_t b) {
 
 std::string mib(size_t bytes) { return fmt::format("{:.1f} MiB", static_cast<double>(bytes) / (1024.0 * 1024.0)); }
 
+size_t decodedBudget(size_t inputBytes, size_t maxBytes) {
+  inputBytes = std::min(inputBytes, kMaxGltfDecodedBytes);  // keeps the product below in range
+  return std::min(maxBytes, kMinGltfDecodedBudget + inputBytes * kGltfDecodedPerInputByte);
+}
+
 void Reader::charge(size_t count, size_t bytesEach, const std::string& what) {
   auto bytes = mulSize(count, bytesEach);
   if (!bytes || *bytes > budget_ - used_)

@@ -21,6 +21,8 @@ const char* typeName(int t);
 std::optional<size_t> addSize(size_t a, size_t b);
 std::optional<size_t> mulSize(size_t a, size_t b);
 std::string mib(size_t bytes);
+// The decoded-data budget of an import reading `inputBytes` (gltf_import.h), at most `maxBytes`.
+size_t decodedBudget(size_t inputBytes, size_t maxBytes);
 // One component as the GPU reads it (see gltf_accessor.cpp); an index of an index accessor.
 float readComponent(const unsigned char* p, int ct, bool normalized);
 uint32_t readIndex(const unsigned char* p, int ct);

@@ -15,6 +15,7 @@
 
 #include "rig/gltf_accessor.h"
 #include "rig/gltf_load.h"
+#include "rig/gltf_meshopt.h"
 #include "rig/gltf_scene.h"
 
 namespace sg {
@@ -139,12 +140,46 @@ void noteDegenerateFrames(GltfImport& imp) {
                                     badTangents, total));
 }
 
+// The storage KHR_mesh_quantization's table allows an attribute (float always). Integers are
+// read as the GPU reads them (gltf_accessor.cpp) and re-expanded to float for the shader.
+enum class Storage {
+  Float,             // float only (core glTF)
+  SignedNormalized,  // + normalized byte/short (NORMAL, TANGENT and their deltas)
+  Signed,            // + byte/short, normalized or not (POSITION and TEXCOORD deltas)
+  Any,               // + (unsigned) byte/short, normalized or not (POSITION, TEXCOORD_n)
+};
+bool storageAllowed(const tinygltf::Accessor& a, int type, Storage s) {
+  if (a.type != type) return false;
+  const int ct = a.componentType;
+  if (ct == TINYGLTF_COMPONENT_TYPE_FLOAT) return true;
+  const bool isSigned = ct == TINYGLTF_COMPONENT_TYPE_BYTE || ct == TINYGLTF_COMPONENT_TYPE_SHORT;
+  const bool isUnsigned = ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+  switch (s) {
+    case Storage::Float: return false;
+    case Storage::SignedNormalized: return isSigned && a.normalized;
+    case Storage::Signed: return isSigned;
+    case Storage::Any: return isSigned || isUnsigned;
+  }
+  return false;
+}
+const char* storageText(Storage s) {
+  switch (s) {
+    case Storage::Float: return "float";
+    case Storage::SignedNormalized: return "float, or normalized byte or short (KHR_mesh_quantization)";
+    case Storage::Signed: return "float, or byte or short, normalized or not (KHR_mesh_quantization)";
+    case Storage::Any: return "float, or (unsigned) byte or short, normalized or not (KHR_mesh_quantization)";
+  }
+  return "";
+}
+
 GltfImport importModel(const tinygltf::Model& model, const std::string& file, const GltfImportOptions& opts) {
   GltfImport imp;
   GltfModelData& data = imp.data;
   data.file = file;
   data.stem = std::filesystem::path(file).stem().string();
   Reader reader(model, file, opts.maxDecodedBytes);
+  if (size_t decompressed = gltf::fallbackBytes(model))
+    reader.charge(decompressed, 1, "the buffers EXT_meshopt_compression decompressed into");
 
   if (opts.mesh < 0 || static_cast<size_t>(opts.mesh) >= model.meshes.size())
     fail(file, fmt::format("the model has {} mesh(es); there is no mesh {}", model.meshes.size(), opts.mesh));
@@ -209,6 +244,14 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   auto isFloat = [](const tinygltf::Accessor* a, int type) {
     return a->componentType == TINYGLTF_COMPONENT_TYPE_FLOAT && a->type == type;
   };
+  // Quantized storage the table allows: noted, then read (dequantized) as float.
+  auto stored = [&](const std::string& name, const tinygltf::Accessor* a, int type, Storage st) {
+    if (!storageAllowed(*a, type, st)) return false;
+    if (a->componentType != TINYGLTF_COMPONENT_TYPE_FLOAT)
+      imp.notes.push_back(fmt::format("{} is stored {} (KHR_mesh_quantization): expanded to float for the shader",
+                                      name, formatText(imp.attributes[infoIndex.at(name)])));
+    return true;
+  };
   auto carried = [&](const std::string& name, const std::string& rigName, VertexFormat f) {
     auto& i = imp.attributes[infoIndex.at(name)];
     i.rigAttribute = rigName;
@@ -242,26 +285,26 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   }
 
   // POSITION
-  if (!isFloat(posAcc, TINYGLTF_TYPE_VEC3))
-    fail(file, fmt::format("{}: POSITION is {}; only float VEC3 positions are supported (KHR_mesh_quantization is not)",
-                           where, formatText(imp.attributes[infoIndex.at("POSITION")])));
+  if (!stored("POSITION", posAcc, TINYGLTF_TYPE_VEC3, Storage::Any))
+    fail(file, fmt::format("{}: POSITION is {}; positions are VEC3 of {}", where,
+                           formatText(imp.attributes[infoIndex.at("POSITION")]), storageText(Storage::Any)));
   rig.attributes.push_back(makeAttribute("position", VertexFormat::Float32x3, {{"vertex.position", ""}}, file));
   carried("POSITION", "position", VertexFormat::Float32x3);
   data.streams["vertex.position"] = reader.stream(readAttr("POSITION"), 0, 3, where + " attribute POSITION");
 
   bool hasNormal = false, hasTangent = false;
   if (const auto* a = accessorOf("NORMAL")) {
-    if (isFloat(a, TINYGLTF_TYPE_VEC3)) {
+    if (stored("NORMAL", a, TINYGLTF_TYPE_VEC3, Storage::SignedNormalized)) {
       hasNormal = true;
       rig.attributes.push_back(makeAttribute("normal", VertexFormat::Float32x3, {{"vertex.normal", ""}}, file));
       carried("NORMAL", "normal", VertexFormat::Float32x3);
       data.streams["vertex.normal"] = reader.stream(readAttr("NORMAL"), 0, 3, where + " attribute NORMAL");
     } else {
-      skip("NORMAL", "only float VEC3 normals are supported");
+      skip("NORMAL", fmt::format("normals are VEC3 of {}", storageText(Storage::SignedNormalized)));
     }
   }
   if (const auto* a = accessorOf("TANGENT")) {
-    if (isFloat(a, TINYGLTF_TYPE_VEC4)) {
+    if (stored("TANGENT", a, TINYGLTF_TYPE_VEC4, Storage::SignedNormalized)) {
       hasTangent = true;
       rig.attributes.push_back(makeAttribute("tangent", VertexFormat::Float32x4,
                                              {{"vertex.tangent", "xyz"}, {"vertex.handedness", "w"}}, file));
@@ -270,20 +313,20 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
       data.streams["vertex.tangent"] = reader.stream(d, 0, 3, where + " attribute TANGENT");
       data.streams["vertex.handedness"] = reader.stream(d, 3, 1, where + " attribute TANGENT");
     } else {
-      skip("TANGENT", "only float VEC4 tangents are supported");
+      skip("TANGENT", fmt::format("tangents are VEC4 of {}", storageText(Storage::SignedNormalized)));
     }
   }
   for (int t = 0; t < 2; ++t) {
     std::string name = fmt::format("TEXCOORD_{}", t);
     if (const auto* a = accessorOf(name)) {
-      if (isFloat(a, TINYGLTF_TYPE_VEC2)) {
+      if (stored(name, a, TINYGLTF_TYPE_VEC2, Storage::Any)) {
         std::string rn = fmt::format("texcoord{}", t);
         rig.attributes.push_back(
             makeAttribute(rn, VertexFormat::Float32x2, {{fmt::format("vertex.texcoord{}", t), ""}}, file));
         carried(name, rn, VertexFormat::Float32x2);
         data.streams[fmt::format("vertex.texcoord{}", t)] = reader.stream(readAttr(name), 0, 2, where + " attribute " + name);
       } else {
-        skip(name, "the rig formats have no normalized 2-component format (expand to float32x2)");
+        skip(name, fmt::format("texture coordinates are VEC2 of {}", storageText(Storage::Any)));
       }
     }
   }
@@ -435,14 +478,15 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
     const char* semantic;
     bool baseCarried;
     VertexFormat format = VertexFormat::Float32x3;  // of the deltas (float VEC3, or SCALAR)
+    Storage storage = Storage::Float;                // quantized deltas the table allows
   };
   std::vector<std::string> morphed;
   bool occlusionMorphed = false;  // baked occlusion deltas (docs/bake.md), like listing 3-3's normal.w
-  for (const MorphKind& k : {MorphKind{"POSITION", "position", "morph.position", true},
-                             MorphKind{"NORMAL", "normal", "morph.normal", hasNormal},
-                             MorphKind{"TANGENT", "tangent", "morph.tangent", hasTangent},
-                             MorphKind{"_OCCLUSION", "occlusion", "morph.occlusion", hasOcclusion,
-                                       VertexFormat::Float32x1}}) {
+  for (const MorphKind& k :
+       {MorphKind{"POSITION", "position", "morph.position", true, VertexFormat::Float32x3, Storage::Signed},
+        MorphKind{"NORMAL", "normal", "morph.normal", hasNormal, VertexFormat::Float32x3, Storage::SignedNormalized},
+        MorphKind{"TANGENT", "tangent", "morph.tangent", hasTangent, VertexFormat::Float32x3, Storage::SignedNormalized},
+        MorphKind{"_OCCLUSION", "occlusion", "morph.occlusion", hasOcclusion, VertexFormat::Float32x1}}) {
     if (!moved.count(k.gltf)) continue;
     if (!k.baseCarried) {
       imp.notes.push_back(fmt::format("morph target {} deltas are left out: the rig does not carry {}", k.gltf, k.gltf));
@@ -464,10 +508,10 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
         fail(file, fmt::format("{} refers to accessor {}, which does not exist", what, it->second));
       const auto& a = model.accessors[static_cast<size_t>(it->second)];
       int type = n == 1 ? TINYGLTF_TYPE_SCALAR : TINYGLTF_TYPE_VEC3;
-      if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || a.type != type)
-        fail(file, fmt::format("{} is {}{} {}; only float {} deltas are supported", what,
-                               a.normalized ? "normalized " : "", componentTypeName(a.componentType), typeName(a.type),
-                               typeName(type)));
+      if (!storageAllowed(a, type, k.storage))
+        fail(file, fmt::format("{} is {}{} {}; deltas are {} of {}", what, a.normalized ? "normalized " : "",
+                               componentTypeName(a.componentType), typeName(a.type), typeName(type),
+                               storageText(k.storage)));
       if (a.count != data.vertexCount)
         fail(file, fmt::format("{} has {} elements but POSITION has {}", what, a.count, data.vertexCount));
       AccessorData d = reader.read(it->second, what);
@@ -539,8 +583,7 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
 GltfImport importLoaded(const tinygltf::Model& model, const std::string& file, const GltfImportOptions& opts,
                         size_t inputBytes) {
   GltfImportOptions o = opts;
-  inputBytes = std::min(inputBytes, kMaxGltfDecodedBytes);  // keeps the product below in range
-  o.maxDecodedBytes = std::min(opts.maxDecodedBytes, kMinGltfDecodedBudget + inputBytes * kGltfDecodedPerInputByte);
+  o.maxDecodedBytes = gltf::decodedBudget(inputBytes, opts.maxDecodedBytes);
   return importModel(model, file, o);
 }
 

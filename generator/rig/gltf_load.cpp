@@ -11,11 +11,16 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <optional>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
 
 #include "common/diagnostics.h"
 #include "rig/gltf_accessor.h"
 #include "rig/gltf_import.h"
+#include "rig/gltf_meshopt.h"
 
 namespace sg::gltf {
 namespace {
@@ -166,9 +171,84 @@ std::pair<size_t, size_t> checkGlb(const std::string& b, const std::string& file
   fail(file, "cannot load the glTF model: " + err);
 }
 
+// Extensions whose required use does not change the vertex data, skinning or animation
+// shadergen reads (materials and textures are not read at all).
+bool readableExtension(const std::string& name) {
+  return name == "KHR_mesh_quantization" || name == "EXT_meshopt_compression" ||
+         name.rfind("KHR_materials_", 0) == 0 || name.rfind("KHR_texture_", 0) == 0 ||
+         name.rfind("EXT_texture_", 0) == 0;
+}
+
+// 1-based line and column of the first `needle` at or after `from` in the JSON text.
+std::pair<int, int> lineColumn(const char* p, size_t n, const std::string& needle, size_t from = 0) {
+  std::string_view all(p, n);
+  size_t at = all.find(needle, from);
+  if (at == std::string_view::npos) return {0, 0};
+  int line = 1, col = 1;
+  for (size_t i = 0; i < at; ++i) {
+    if (p[i] == '\n') ++line, col = 1;
+    else ++col;
+  }
+  return {line, col};
+}
+
+// The JSON as tinygltf should see it: refuses a required extension it cannot read (naming
+// it, with its line and column in a .gltf), and gives EXT_meshopt_compression's fallback
+// buffers (no uri, no data: gltfpack -c) a one-byte data URI, recording their declared length
+// for decodeMeshopt. Returns "" when the JSON is to be loaded unchanged (also when it does
+// not parse: tinygltf reports that with its location).
+std::string prepareJson(const char* p, size_t n, bool glb, const std::string& file, std::map<int, size_t>& fallbacks) {
+  nlohmann::json j = nlohmann::json::parse(p, p + n, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return "";
+  if (auto req = j.find("extensionsRequired"); req != j.end() && req->is_array())
+    for (const auto& e : *req) {
+      if (!e.is_string() || readableExtension(e.get<std::string>())) continue;
+      const std::string name = e.get<std::string>();
+      std::string msg = fmt::format("the model requires the extension {} (extensionsRequired), which shadergen cannot "
+                                    "read; it reads KHR_mesh_quantization and EXT_meshopt_compression",
+                                    name);
+      std::string_view all(p, n);
+      auto [line, col] = lineColumn(p, n, "\"" + name + "\"", all.find("\"extensionsRequired\""));
+      if (!glb && line > 0) throw InputError(SourceLoc{file, line, col}, msg);
+      fail(file, line > 0 ? fmt::format("{} (JSON chunk line {}, column {})", msg, line, col) : msg);
+    }
+  auto buffers = j.find("buffers");
+  if (buffers == j.end() || !buffers->is_array()) return "";
+  bool changed = false;
+  for (size_t i = 0; i < buffers->size(); ++i) {
+    auto& b = (*buffers)[i];
+    if (!b.is_object() || b.contains("uri")) continue;
+    auto ext = b.find("extensions");
+    if (ext == b.end() || !ext->is_object()) continue;
+    auto mo = ext->find("EXT_meshopt_compression");
+    if (mo == ext->end() || !mo->is_object() || mo->value("fallback", false) != true) continue;
+    auto len = b.find("byteLength");
+    if (len == b.end() || !len->is_number_unsigned())
+      fail(file, fmt::format("buffer {}: a fallback buffer needs a non-negative integer byteLength", i));
+    fallbacks[static_cast<int>(i)] = len->get<size_t>();
+    b["byteLength"] = 1;  // tinygltf refuses an empty data URI: one zero byte, replaced by decodeMeshopt
+    b["uri"] = "data:application/octet-stream;base64,AA==";
+    changed = true;
+  }
+  return changed ? j.dump() : "";
+}
+
+// A GLB with its JSON chunk replaced (padded with spaces to 4 bytes, as GLB requires).
+std::string replaceGlbJson(const std::string& glb, size_t jsonAt, size_t jsonSize, std::string json) {
+  while (json.size() % 4) json += ' ';
+  std::string out = glb.substr(0, 12);
+  auto put32 = [&](uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+  put32(static_cast<uint32_t>(json.size()));
+  put32(0x4E4F534A);
+  out += json;
+  out.append(glb, jsonAt + jsonSize, std::string::npos);
+  uint32_t total = static_cast<uint32_t>(out.size());
+  std::memcpy(&out[8], &total, 4);
+  return out;
+}
+
 }  // namespace
 
-// Reads and parses the model with every check; returns the bytes of the file and its buffers.
 size_t loadChecked(const std::string& file, const std::string* text, const std::string& baseDir,
                    tinygltf::Model& model, std::vector<std::string>* buffersRead) {
   std::string bytes, why;
@@ -192,15 +272,23 @@ size_t loadChecked(const std::string& file, const std::string* text, const std::
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(skipImage, nullptr);
   loader.SetFsCallbacks(tinygltf::FsCallbacks{bufferFileExists, keepPath, readBufferFile, writeNothing, &files});
+  std::map<int, size_t> fallbacks;
+  std::string patchedJson = prepareJson(b.data() + jsonAt, jsonSize, glb, file, fallbacks);
+  std::string patched = patchedJson.empty() ? "" : glb ? replaceGlbJson(b, jsonAt, jsonSize, patchedJson) : patchedJson;
+  const std::string& given = patched.empty() ? b : patched;
+  if (given.size() > UINT32_MAX) fail(file, "the glTF model is too large");
   std::string err, warn;
-  const auto* data = reinterpret_cast<const unsigned char*>(b.data());
+  const auto* data = reinterpret_cast<const unsigned char*>(given.data());
   std::string base = files.root.string();
-  bool ok = glb ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, static_cast<unsigned int>(b.size()), base)
-                : loader.LoadASCIIFromString(&model, &err, &warn, b.data(), static_cast<unsigned int>(b.size()), base);
+  bool ok = glb ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, static_cast<unsigned int>(given.size()), base)
+                : loader.LoadASCIIFromString(&model, &err, &warn, given.data(), static_cast<unsigned int>(given.size()),
+                                             base);
   if (!ok) failLoad(file, err, glb, files);
   if (buffersRead) *buffersRead = files.read;
+  // The budget follows the compressed input: decompressed bytes are decoded data.
   size_t input = b.size();
   for (const auto& buf : model.buffers) input += buf.data.size();
+  decodeMeshopt(model, fallbacks, decodedBudget(input, kMaxGltfDecodedBytes), file);
   return input;
 }
 

@@ -10,7 +10,9 @@
 
 namespace sg::gltf {
 
-// Reads and parses the model with every check; returns the bytes of the file and its buffers.
+// Reads and parses the model with every check, refuses required extensions it cannot read,
+// and decodes EXT_meshopt_compression views; returns the bytes of the file and its buffers
+// as stored (compressed), which set the decoded-data budget.
 // `text`: the JSON itself (file only names it; buffer files only inside baseDir).
 size_t loadChecked(const std::string& file, const std::string* text, const std::string& baseDir,
                    tinygltf::Model& model, std::vector<std::string>* buffersRead = nullptr);
