@@ -221,7 +221,9 @@ std::string prepareJson(const char* p, size_t n, bool glb, const std::string& fi
     auto ext = b.find("extensions");
     if (ext == b.end() || !ext->is_object()) continue;
     auto mo = ext->find("EXT_meshopt_compression");
-    if (mo == ext->end() || !mo->is_object() || mo->value("fallback", false) != true) continue;
+    if (mo == ext->end() || !mo->is_object()) continue;
+    auto fallback = mo->find("fallback");
+    if (fallback == mo->end() || *fallback != true) continue;
     auto len = b.find("byteLength");
     if (len == b.end() || !len->is_number_unsigned())
       fail(file, fmt::format("buffer {}: a fallback buffer needs a non-negative integer byteLength", i));
@@ -241,7 +243,7 @@ std::string replaceGlbJson(const std::string& glb, size_t jsonAt, size_t jsonSiz
   put32(static_cast<uint32_t>(json.size()));
   put32(0x4E4F534A);
   out += json;
-  out.append(glb, jsonAt + jsonSize, std::string::npos);
+  out.append(glb, jsonAt + jsonSize, le32(glb, 8) - (jsonAt + jsonSize));  // the BIN chunk, if any
   uint32_t total = static_cast<uint32_t>(out.size());
   std::memcpy(&out[8], &total, 4);
   return out;

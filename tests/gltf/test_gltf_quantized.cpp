@@ -353,6 +353,9 @@ TEST(GltfMeshopt, HostileViewsGetClearErrors) {
       // A fallback buffer claiming 16 GiB: refused before anything is allocated.
       {[](nlohmann::json& j) { j["buffers"][1]["byteLength"] = uint64_t{1} << 34; },
        "buffer 1: decompressing into its 17179869184 bytes would take the decoded data past this model's limit"},
+      // Not a fallback buffer (the flag is no boolean): then it needs data of its own.
+      {[](nlohmann::json& j) { j["buffers"][1]["extensions"]["EXT_meshopt_compression"]["fallback"] = "yes"; },
+       "hostile.gltf: error: buffer file '' refused"},
       {[](nlohmann::json& j) { j["bufferViews"][0]["extensions"]["EXT_meshopt_compression"]["byteLength"] = 100000; },
        "buffer view 0: the compressed bytes 0..+100000 lie outside buffer 0"},
       {[](nlohmann::json& j) { j["bufferViews"][0]["extensions"]["EXT_meshopt_compression"]["buffer"] = 1; },
