@@ -16,7 +16,7 @@ packages=(
   glslang-dev glslang-tools spirv-tools
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers
   libglm-dev libyaml-cpp-dev libfmt-dev libcli11-dev
-  libtinygltf-dev nlohmann-json3-dev
+  libtinygltf-dev nlohmann-json3-dev libmeshoptimizer-dev
   libgtest-dev libgmock-dev libbenchmark-dev graphviz
   clang-14 libclang-rt-14-dev
   libglpk-dev

@@ -1,5 +1,5 @@
 // glTF side of the occlusion baker. tinygltf's implementation is compiled once, in
-// rig/gltf_import.cpp; vertex data is decoded by the rig import (sparse accessors,
+// rig/gltf_load.cpp; vertex data is decoded by the rig import (sparse accessors,
 // normalized formats) so the baker sees exactly what `rig import` and validation see.
 // The same configuration as the implementation (the class's defaults depend on it).
 #define TINYGLTF_NO_STB_IMAGE

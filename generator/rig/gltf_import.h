@@ -2,7 +2,9 @@
 // (attributes and formats, skin size, influences, morph targets) and decode everything the
 // validator needs to pose it (vertex data with sparse accessors applied and normalized
 // formats dequantized, node hierarchy, skins, animations). The decoded model is plain data:
-// nothing here exposes tinygltf, which stays private to gltf_import.cpp.
+// nothing here exposes tinygltf, which stays private to the reader (rig/gltf_*.cpp:
+// gltf_load loads, gltf_accessor decodes accessors, gltf_scene reads the scene and
+// animations, gltf_import derives the rig).
 #pragma once
 #include <array>
 #include <cstddef>
@@ -160,7 +162,7 @@ GltfImport importGltfText(const std::string& json, const std::string& fileName, 
 
 // The checked loader behind importGltf (bounded read, JSON depth, GLB layout, buffer files
 // confined to the model's folder), for tools that rewrite a model (bake/gltf_bake.cpp). The
-// caller includes tiny_gltf.h with the configuration of gltf_import.cpp.
+// caller includes tiny_gltf.h with the configuration of rig/gltf_tinygltf.h.
 // Returns the bytes read (the model and its buffer files), for importGltfModel's budget.
 size_t loadGltfModel(const std::string& file, tinygltf::Model& model);
 // importGltf on a model loadGltfModel loaded: tools that import every primitive parse the
