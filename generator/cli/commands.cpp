@@ -30,6 +30,7 @@ void registerCommands(CLI::App& app, CliState& state) {
   registerRig(app, state);
   registerBake(app, state);
   registerRender(app, state);
+  registerCalibrate(app, state);
   registerBuild(app, state);
 }
 

@@ -47,5 +47,6 @@ void registerRig(CLI::App& app, CliState& state);      // cmd_rig.cpp: rig impor
 void registerBuild(CLI::App& app, CliState& state);    // cmd_build.cpp: variant manifests
 void registerBake(CLI::App& app, CliState& state);     // cmd_bake.cpp: bake occlusion
 void registerRender(CLI::App& app, CliState& state);   // cmd_render.cpp: render + bench (GPU timing)
+void registerCalibrate(CLI::App& app, CliState& state);  // cmd_calibrate.cpp: device profiles
 
 }  // namespace sg

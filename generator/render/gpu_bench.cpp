@@ -178,6 +178,23 @@ double pearson(const std::vector<double>& x, const std::vector<double>& y) {
 
 double spearman(const std::vector<double>& x, const std::vector<double>& y) { return pearson(ranks(x), ranks(y)); }
 
+double spearmanWithinSpread(const std::vector<double>& x, const std::vector<double>& y, double spread) {
+  std::vector<size_t> order(y.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return y[a] < y[b]; });
+  std::vector<double> tied(y.size());
+  for (size_t i = 0; i < order.size();) {
+    size_t j = i;
+    while (j + 1 < order.size() && y[order[j + 1]] <= y[order[i]] * (1 + spread)) ++j;
+    for (size_t k = i; k <= j; ++k) tied[order[k]] = y[order[i]];
+    i = j + 1;
+  }
+  return spearman(x, tied);
+}
+
+// Two timings of one program on one device differ by up to this much (relative): docs/performance.md.
+constexpr double kRunToRunSpread = 0.005;
+
 GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   const TargetEnv env = opts.render.gen.targetEnv;
   GenerateOptions gen = opts.render.gen;
@@ -203,6 +220,9 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     p.capture = generateFrom(in, capture);
     p.row.hasCost = true;
     p.row.planCost = p.render.plan.cost;
+    p.row.amounts = planTermAmounts(p.render.plan, p.render.in.problem);
+    if (p.render.in.profile)
+      p.row.predictedNsPerVertex = predictPlanCost(p.render.plan, p.render.in.problem, *p.render.in.profile).totalNanoseconds;
     p.row.spirvInstructions = countInstructions(p.render.spirv.words);
     programs.push_back(std::move(p));
     return true;
@@ -327,6 +347,16 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   rep.spearmanOn = spearman(cost, on);
   rep.pearsonOff = pearson(cost, off);
   rep.spearmanOff = spearman(cost, off);
+  std::vector<double> predicted, measured;
+  double fastest = INFINITY;
+  for (const auto& r : rep.rows)
+    if (r.hasCost && r.validation == "pass" && r.rasterOnNsPerVertex > 0) {
+      fastest = std::min(fastest, r.rasterOnNsPerVertex);
+      if (r.predictedNsPerVertex >= 0) predicted.push_back(r.predictedNsPerVertex), measured.push_back(r.rasterOnNsPerVertex);
+    }
+  rep.spearmanPredictedOn = spearmanWithinSpread(predicted, measured, kRunToRunSpread);
+  if (!rep.rows.empty() && rep.rows.front().label == "generated" && rep.rows.front().rasterOnNsPerVertex > 0 && predicted.size())
+    rep.generatedOverFastestOn = rep.rows.front().rasterOnNsPerVertex / fastest;
   const auto& msgs = validator.harness().validationMessages();
   if (!msgs.empty()) throw std::runtime_error("validation layer: " + msgs.front());
   return rep;
@@ -345,11 +375,15 @@ std::string formatGpuBench(const GpuBenchReport& r) {
   };
   s += "ns per vertex (x: relative to the generated program); timestamps = GPU timestamp queries, "
        "host = submit-to-fence wall time\n\n";
-  s += "| program | on device | plan cost | SPIR-V instr. | raster on, timestamps | raster off (xfb), timestamps | raster on, host | raster off, host |\n";
-  s += "|---|---|---:|---:|---:|---:|---:|---:|\n";
+  s += "| program | on device | plan cost | locations | bytes | predicted | SPIR-V instr. | raster on, timestamps | raster off (xfb), timestamps | raster on, host | raster off, host |\n";
+  s += "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const auto& row : r.rows)
-    s += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", row.label, row.validation.empty() ? "—" : row.validation,
-                     row.hasCost ? std::to_string(row.planCost) : "—", row.spirvInstructions, cell(row.rasterOnNsPerVertex, gen ? gen->rasterOnNsPerVertex : -1),
+    s += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", row.label, row.validation.empty() ? "—" : row.validation,
+                     row.hasCost ? std::to_string(row.planCost) : "—",
+                     row.hasCost ? std::to_string(row.amounts[kTermLocations]) : "—",
+                     row.hasCost ? std::to_string(row.amounts[kTermAttributeBytes] + row.amounts[kTermBufferBytes]) : "—",
+                     row.predictedNsPerVertex >= 0 ? fmt::format("{:.4f}", row.predictedNsPerVertex) : "—",
+                     row.spirvInstructions, cell(row.rasterOnNsPerVertex, gen ? gen->rasterOnNsPerVertex : -1),
                      cell(row.rasterOffNsPerVertex, gen ? gen->rasterOffNsPerVertex : -1),
                      cell(row.rasterOnWallNsPerVertex, gen ? gen->rasterOnWallNsPerVertex : -1),
                      cell(row.rasterOffWallNsPerVertex, gen ? gen->rasterOffWallNsPerVertex : -1));
@@ -357,6 +391,10 @@ std::string formatGpuBench(const GpuBenchReport& r) {
                    "raster off (timestamps) Pearson {:.2f}, Spearman {:.2f}; raster off (host) Pearson {:.2f}, Spearman {:.2f}\n",
                    std::count_if(r.rows.begin(), r.rows.end(), [](const GpuBenchRow& x) { return x.hasCost && x.validation == "pass"; }), r.pearsonOn,
                    r.spearmanOn, r.pearsonOff, r.spearmanOff, r.pearsonOffWall, r.spearmanOffWall);
+  if (!std::isnan(r.spearmanPredictedOn) || !std::isnan(r.generatedOverFastestOn))
+    s += fmt::format("device profile: predicted vs measured (raster on, timestamps; within 0.5 %: ties) Spearman {:.2f}; the generated program takes "
+                     "{:.3f}x the fastest generated one\n",
+                     r.spearmanPredictedOn, r.generatedOverFastestOn);
   return s;
 }
 

@@ -8,11 +8,13 @@
 // programInputs); a program that fails is reported and not timed.
 // docs/performance.md has the tables and what they say about the cost model.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "render/render.h"
+#include "search/device_profile.h"
 
 namespace sg {
 
@@ -36,7 +38,9 @@ struct GpuBenchRow {
   // Validation on the device before timing: "pass", "FAIL: <output ...>" (then not timed),
   // or "" for the floors, which write constants on purpose.
   std::string validation;
-  // The cost model's predicted time per vertex (a device profile, issue 21); -1 = none.
+  // What the plan pays per term (search/device_profile.h; generated programs), and the
+  // predicted time per vertex under the generation's device profile (-1 = no profile).
+  TermAmounts amounts{};
   double predictedNsPerVertex = -1;
   double rasterOnNsPerVertex = -1;   // median frame / (draws x vertices); -1 = not measured
   double rasterOffNsPerVertex = -1;
@@ -53,6 +57,10 @@ struct GpuBenchReport {
   // plan cost with time per vertex, and Spearman (rank) correlation; NaN if < 3 rows.
   double pearsonOn = 0, spearmanOn = 0, pearsonOff = 0, spearmanOff = 0;
   double pearsonOffWall = 0, spearmanOffWall = 0;  // the same against host time, raster off
+  // With a device profile: Spearman of predicted against measured time (raster on,
+  // timestamps), and the generated program's time over the fastest generated one's.
+  double spearmanPredictedOn = NAN;
+  double generatedOverFastestOn = NAN;
 };
 
 GpuBenchReport runGpuBench(const GpuBenchOptions& opts);
@@ -63,6 +71,9 @@ std::string formatGpuBench(const GpuBenchReport& report);
 // Correlations (exposed for tests): NaN if fewer than 3 points or no variance.
 double pearson(const std::vector<double>& x, const std::vector<double>& y);
 double spearman(const std::vector<double>& x, const std::vector<double>& y);
+// Spearman where measured values `y` closer than `spread` (relative) to the smallest of their
+// run of neighbours count as ties: differences inside the run-to-run spread rank nothing.
+double spearmanWithinSpread(const std::vector<double>& x, const std::vector<double>& y, double spread);
 
 // Adds transform-feedback qualifiers to a hand-written vertex shader whose outputs are
 // `layout(location = N) out TYPE NAME;` lines, at the offsets of `capture` (a capture build

@@ -1,0 +1,77 @@
+// `shadergen calibrate`: measure a device's cost per term and write its device profile
+// (docs/device-profiles.md).
+#include <fmt/format.h>
+
+#include <iostream>
+
+#include "cli/commands.h"
+#include "render/calibrate.h"
+
+namespace sg {
+namespace {
+
+struct CalibrateCommand {
+  CalibrationOptions co;
+  std::string output;
+  std::string meshes = "dawn,head";
+  bool noLayers = false;
+
+  int run() {
+    co.validationLayers = !noLayers;
+    co.meshes.clear();
+    size_t start = 0;
+    while (start <= meshes.size()) {
+      size_t comma = meshes.find(',', start);
+      std::string m = meshes.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      if (m != "dawn" && m != "head" && m != "small")
+        throw CLI::ValidationError("--meshes", "expected a comma-separated list of dawn, head, small; got '" + meshes + "'");
+      co.meshes.push_back(m);
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+    if (!co.plans.rigPath.empty() && (co.plans.fragmentPath.empty() || co.plans.rulesPaths.empty()))
+      throw CLI::ValidationError("--rig", "plans need --rig, --fragment and --rules together");
+    if (!output.empty()) {
+      std::vector<InputFile> inputs;
+      if (!co.plans.rigPath.empty()) inputs = {{co.plans.rigPath, "the rig"}, {co.plans.fragmentPath, "the fragment shader"}};
+      for (const auto& r : co.plans.rulesPaths) inputs.push_back({r, "a rules file"});
+      refuseClobbering({output}, inputs);
+    }
+    CalibrationReport rep = calibrateDevice(co);
+    std::cout << formatCalibration(rep);
+    size_t failed = 0;
+    for (const auto& s : rep.samples) failed += !s.validated;
+    if (!output.empty()) {
+      writeFilesAtomically({{output, deviceProfileYaml(rep)}});
+      std::cout << fmt::format("{}: device profile of {}\n", output, rep.device);
+    }
+    if (failed) std::cerr << fmt::format("shadergen: error: {} probe(s) disagreed with their expected outputs and were not timed\n", failed);
+    return failed ? 1 : 0;
+  }
+};
+
+}  // namespace
+
+void registerCalibrate(CLI::App& app, CliState& state) {
+  auto cmd = std::make_shared<CalibrateCommand>();
+  CLI::App* sub = app.add_subcommand("calibrate", "Measure what a Vulkan device pays per term of the cost model and write "
+                                                   "its device profile (docs/device-profiles.md)");
+  sub->add_option("--device", cmd->co.device, "Vulkan device name (substring); default lavapipe");
+  sub->add_option("-o,--output", cmd->output, "Device profile (YAML) to write");
+  sub->add_option("--meshes", cmd->meshes, "Procedural meshes, comma-separated; the first one's fit is the profile "
+                                           "(default dawn,head: 180,000 and 2,009 vertices)");
+  sub->add_option("--rig", cmd->co.plans.rigPath, "Also time the plan of this rig and its forced alternatives (as bench does)");
+  sub->add_option("--fragment,-f", cmd->co.plans.fragmentPath, "With --rig: the fragment shader");
+  sub->add_option("--rules,-r", cmd->co.plans.rulesPaths, "With --rig: rules file(s)");
+  sub->add_option("--max-attributes", cmd->co.plans.maxAttributes, "With --rig: vertex input attributes (default 16)")
+      ->check(CLI::Range(1, 4096));
+  sub->add_option("--templates", cmd->co.plans.templateDir, "With --rig: directory with vertex.glsl templates");
+  sub->add_option("--draws", cmd->co.drawsPerFrame, "Draws of the mesh between two timestamps (default 16)")
+      ->check(CLI::Range(1, 4096));
+  sub->add_option("--frames", cmd->co.frames, "Timed frames; the median counts (default 9)")->check(CLI::Range(1, 1000));
+  sub->add_option("--rounds", cmd->co.rounds, "Timings per program; the best counts (default 2)")->check(CLI::Range(1, 100));
+  sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer (use for timings)");
+  sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
+}
+
+}  // namespace sg

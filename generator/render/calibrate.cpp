@@ -1,0 +1,518 @@
+#include "render/calibrate.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+#include <map>
+
+#include "analysis/cost.h"
+#include "common/glsl_compile.h"
+#include "common/nnls.h"
+#include "runtime/procedural.h"
+#include "runtime/vk_render.h"
+#include "validate/program_inputs.h"
+
+namespace sg {
+namespace {
+
+// ---- Probe programs -------------------------------------------------------------------
+
+// How a probe's extra attributes are stored (location 0, the position, is always float32x4).
+struct Encoding {
+  const char* name;
+  VkFormat format;
+  uint32_t bytes;
+  double (*decode)(uint32_t raw);  // raw: the stored integer of one component (float: bits)
+};
+double decodeFloat(uint32_t raw) {
+  float f;
+  std::memcpy(&f, &raw, 4);
+  return f;
+}
+const Encoding kFloat32x4{"float32x4", VK_FORMAT_R32G32B32A32_SFLOAT, 16, decodeFloat};
+const Encoding kUnorm16x4{"unorm16x4", VK_FORMAT_R16G16B16A16_UNORM, 8, [](uint32_t r) { return r / 65535.0; }};
+const Encoding kUnorm8x4{"unorm8x4", VK_FORMAT_R8G8B8A8_UNORM, 4, [](uint32_t r) { return r / 255.0; }};
+
+// Deterministic data: a hash of (stream, vertex, component) in [0, 1).
+uint32_t mix(uint32_t x) {
+  x ^= x >> 16;
+  x *= 0x7feb352dU;
+  x ^= x >> 15;
+  x *= 0x846ca68bU;
+  return x ^ (x >> 16);
+}
+double unit(uint32_t stream, uint32_t v, uint32_t c) { return (mix(stream * 0x9e3779b9U ^ mix(v * 4 + c)) >> 8) / 16777216.0; }
+
+struct Probe {
+  std::string label;
+  TermAmounts amounts{};
+  std::string decl, body;  // GLSL: declarations after the position input; main's statements
+  int outputs = 1;         // vec4 outputs o0..o{n-1} (gl_Position is also captured)
+  rt::ProgramInputs inputs;  // streams (location 0 first), uniform block, storage buffers
+  std::vector<double> expected;  // per vertex: gl_Position then the outputs, 4 components each
+  double tolerance = 1e-5;       // relative to max(1, |expected| of that output)
+};
+
+struct ProbeMesh {
+  std::string name;
+  rt::Mesh mesh;
+  std::vector<uint32_t> indices;
+};
+
+ProbeMesh probeMesh(const std::string& name) {
+  rt::MeshOptions mo;
+  mo.influences = 0;
+  mo.tangents = false;
+  mo.occlusion = false;
+  ProbeMesh m;
+  m.name = name;
+  int rings = 40, segments = 48;  // validate's head: 2,009 vertices (cached on a GPU)
+  if (name == "dawn") rings = 299, segments = 599;  // 180,000 vertices
+  else if (name == "small") rings = 8, segments = 8;  // tests
+  else if (name != "head") throw std::invalid_argument(fmt::format("calibration mesh '{}': head, dawn or small", name));
+  m.mesh = rt::makeHead(rings, segments, mo);
+  // Triangles of the (rings + 1) x (segments + 1) grid, as render's gridIndices.
+  for (int r = 0; r < rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      uint32_t a = uint32_t(r * (segments + 1) + s), b = a + 1, c = a + uint32_t(segments + 1), d = c + 1;
+      m.indices.insert(m.indices.end(), {a, c, b, b, c, d});
+    }
+  return m;
+}
+
+// Where the probe puts a vertex: the head's positions scaled into the clip volume.
+glm::dvec4 clipPosition(const glm::vec4& p) { return {p.x * 0.45, -p.y * 0.45, 0.5 + 0.2 * p.z, 1.0}; }
+const char* kClipPosition = "  gl_Position = vec4(a0.x * 0.45, -a0.y * 0.45, 0.5 + 0.2 * a0.z, 1.0);\n";
+
+// Common parts: the position stream at location 0 and the expected gl_Position.
+Probe baseProbe(const ProbeMesh& m, const std::string& label, int outputs) {
+  Probe p;
+  p.label = label;
+  p.outputs = outputs;
+  const auto& pos = m.mesh.streams.at("vertex.position");
+  rt::VertexStream s;
+  s.location = 0;
+  s.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+  s.stride = 16;
+  s.data.resize(pos.size() * 16);
+  std::memcpy(s.data.data(), pos.data(), s.data.size());
+  p.inputs.streams.push_back(std::move(s));
+  p.expected.assign(m.mesh.vertexCount * size_t(4 * (1 + outputs)), 0.0);
+  for (size_t v = 0; v < m.mesh.vertexCount; ++v) {
+    glm::dvec4 c = clipPosition(pos[v]);
+    for (int k = 0; k < 4; ++k) p.expected[v * size_t(4 * (1 + outputs)) + size_t(k)] = c[k];
+  }
+  p.amounts[kTermLocations] = 1;
+  p.amounts[kTermAttributeBytes] = 16;
+  p.amounts[kTermOutputs] = 4 + 4 * outputs;
+  p.amounts[kTermVertices] = 1;
+  return p;
+}
+
+double& expectedAt(Probe& p, size_t v, int output, int c) {
+  return p.expected[v * size_t(4 * (1 + p.outputs)) + size_t(4 * (1 + output) + c)];
+}
+
+// A stream of decoded values at `location` (4 components) with the encoding; returns them.
+std::vector<glm::dvec4> addStream(Probe& p, const ProbeMesh& m, uint32_t location, const Encoding& e, double lo, double hi) {
+  rt::VertexStream s;
+  s.location = location;
+  s.format = e.format;
+  s.stride = e.bytes;
+  s.data.resize(m.mesh.vertexCount * e.bytes);
+  std::vector<glm::dvec4> values(m.mesh.vertexCount);
+  for (uint32_t v = 0; v < m.mesh.vertexCount; ++v)
+    for (uint32_t c = 0; c < 4; ++c) {
+      double x = lo + (hi - lo) * unit(location, v, c);
+      uint8_t* at = s.data.data() + size_t(v) * e.bytes + c * (e.bytes / 4);
+      if (e.bytes == 16) {
+        float f = static_cast<float>(x);
+        std::memcpy(at, &f, 4);
+        values[v][int(c)] = f;
+      } else {
+        const uint32_t max = e.bytes == 8 ? 65535 : 255;
+        uint32_t raw = static_cast<uint32_t>(std::lround(std::clamp(x, 0.0, 1.0) * max));
+        if (e.bytes == 8) {
+          uint16_t r16 = static_cast<uint16_t>(raw);
+          std::memcpy(at, &r16, 2);
+        } else {
+          *at = static_cast<uint8_t>(raw);
+        }
+        values[v][int(c)] = e.decode(raw);
+      }
+    }
+  p.decl += fmt::format("layout(location = {}) in vec4 a{};\n", location, location);
+  p.amounts[kTermLocations] += 1;
+  p.amounts[kTermAttributeBytes] += e.bytes;
+  p.inputs.streams.push_back(std::move(s));
+  return values;
+}
+
+// k locations in all (the position and k - 1 streams of `e`), summed into o0.
+Probe fetchProbe(const ProbeMesh& m, int k, const Encoding& e) {
+  Probe p = baseProbe(m, fmt::format("locations {} ({} after the position)", k, e.name), 1);
+  p.body = "  o0 = vec4(0.0)";
+  for (int l = 1; l < k; ++l) {
+    auto values = addStream(p, m, uint32_t(l), e, 0.0, 1.0);
+    p.body += fmt::format(" + a{}", l);
+    for (size_t v = 0; v < values.size(); ++v)
+      for (int c = 0; c < 4; ++c) expectedAt(p, v, 0, c) += values[v][c];
+  }
+  p.body += ";\n";
+  return p;
+}
+
+// A chain of n dependent multiply-adds: x = x * a1 + a2, x starting at the position.
+Probe chainProbe(const ProbeMesh& m, int n) {
+  Probe p = baseProbe(m, fmt::format("arithmetic chain {}", n), 1);
+  auto y = addStream(p, m, 1, kFloat32x4, 0.5, 0.9);
+  auto z = addStream(p, m, 2, kFloat32x4, 0.0, 0.1);
+  p.body = "  vec4 x = a0;\n";
+  for (int i = 0; i < n; ++i) p.body += "  x = x * a1 + a2;\n";
+  p.body += "  o0 = x;\n";
+  const auto& pos = m.mesh.streams.at("vertex.position");
+  for (size_t v = 0; v < pos.size(); ++v) {
+    glm::dvec4 x(pos[v]);
+    for (int i = 0; i < n; ++i) x = x * y[v] + z[v];
+    for (int c = 0; c < 4; ++c) expectedAt(p, v, 0, c) = x[c];
+  }
+  p.tolerance = 1e-6 * (4 + n);  // float rounding per step, fused or not
+  return p;
+}
+
+// n storage-buffer loads per vertex (vec4 elements v[vertex * n + i]) summed into o0.
+Probe bufferProbe(const ProbeMesh& m, int n) {
+  Probe p = baseProbe(m, fmt::format("storage-buffer loads {}", n), 1);
+  p.decl += "layout(std430, set = 0, binding = 1) readonly buffer Elements { vec4 v[]; } elements;\n";
+  p.body = "  o0 = vec4(0.0);\n";
+  for (int i = 0; i < n; ++i) p.body += fmt::format("  o0 += elements.v[gl_VertexIndex * {} + {}];\n", n, i);
+  const size_t padded = m.mesh.vertexCount + (m.mesh.vertexCount & 1);
+  rt::StorageBufferData b;
+  b.binding = 1;
+  b.data.resize(padded * size_t(n) * 16);
+  for (size_t v = 0; v < padded; ++v)
+    for (int i = 0; i < n; ++i)
+      for (int c = 0; c < 4; ++c) {
+        float f = static_cast<float>(unit(100 + uint32_t(i), uint32_t(v), uint32_t(c)));
+        std::memcpy(b.data.data() + (v * size_t(n) + size_t(i)) * 16 + size_t(c) * 4, &f, 4);
+        if (v < m.mesh.vertexCount) expectedAt(p, v, 0, c) += f;
+      }
+  p.inputs.storageBuffers.push_back(std::move(b));
+  p.amounts[kTermBufferLoads] = n;
+  p.amounts[kTermBufferBytes] = 16 * n;
+  return p;
+}
+
+// n loads of a mat4 palette (64 entries, std140) at an index read per vertex (a uint
+// attribute), or at the same indices taken from the uniform block; each times the position.
+Probe paletteProbe(const ProbeMesh& m, int n, bool perVertex) {
+  Probe p = baseProbe(m, fmt::format("palette loads {} at a {} index", n, perVertex ? "per-vertex" : "uniform"), 1);
+  constexpr int kEntries = 64;
+  p.decl += fmt::format("layout(std140, set = 0, binding = 0) uniform Block {{ mat4 palette[{}]; uint base; }} u;\n", kEntries);
+  // Both variants read the index attribute (same locations and bytes); only the first uses it.
+  p.decl += "layout(location = 1) in uvec4 joint;\n";
+  rt::VertexStream s;
+  s.location = 1;
+  s.format = VK_FORMAT_R8G8B8A8_UINT;
+  s.stride = 4;
+  s.data.resize(m.mesh.vertexCount * 4);
+  for (size_t v = 0; v < m.mesh.vertexCount; ++v)
+    for (int c = 0; c < 4; ++c) s.data[v * 4 + size_t(c)] = static_cast<uint8_t>(mix(uint32_t(v * 4 + size_t(c))) % kEntries);
+  p.inputs.streams.push_back(s);
+  p.amounts[kTermLocations] += 1;
+  p.amounts[kTermAttributeBytes] += 4;
+  const uint32_t base = 5;
+  std::vector<glm::dmat4> palette(kEntries);
+  p.inputs.uniformData.assign(kEntries * 64 + 16, 0);
+  for (int e = 0; e < kEntries; ++e)
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) {
+        float f = static_cast<float>(2 * unit(200 + uint32_t(e), uint32_t(c), uint32_t(r)) - 1);
+        palette[size_t(e)][c][r] = f;
+        std::memcpy(p.inputs.uniformData.data() + size_t(e) * 64 + size_t(c) * 16 + size_t(r) * 4, &f, 4);
+      }
+  std::memcpy(p.inputs.uniformData.data() + kEntries * 64, &base, 4);
+  const char* index = perVertex ? "joint.x" : "u.base";
+  p.body = "  o0 = vec4(joint) * 0.001;\n";
+  for (int i = 0; i < n; ++i) p.body += fmt::format("  o0 += u.palette[({} + {}u) & {}u] * a0;\n", index, i, kEntries - 1);
+  const auto& pos = m.mesh.streams.at("vertex.position");
+  for (size_t v = 0; v < m.mesh.vertexCount; ++v) {
+    glm::dvec4 o = glm::dvec4(s.data[v * 4], s.data[v * 4 + 1], s.data[v * 4 + 2], s.data[v * 4 + 3]) * 0.001;
+    const uint32_t idx = perVertex ? s.data[v * 4] : base;
+    for (int i = 0; i < n; ++i) o += palette[(idx + uint32_t(i)) & (kEntries - 1)] * glm::dvec4(pos[v]);
+    for (int c = 0; c < 4; ++c) expectedAt(p, v, 0, c) = o[c];
+  }
+  p.amounts[kTermIndexedUniformLoads] = perVertex ? n : 0;
+  return p;
+}
+
+// n vec4 outputs, output i = position * (i + 1).
+Probe outputProbe(const ProbeMesh& m, int n) {
+  Probe p = baseProbe(m, fmt::format("outputs {} x vec4", n), n);
+  const auto& pos = m.mesh.streams.at("vertex.position");
+  for (int i = 0; i < n; ++i) {
+    p.body += fmt::format("  o{} = a0 * {}.0;\n", i, i + 1);
+    for (size_t v = 0; v < m.mesh.vertexCount; ++v)
+      for (int c = 0; c < 4; ++c) expectedAt(p, v, i, c) = double(pos[v][c]) * (i + 1);
+  }
+  return p;
+}
+
+std::vector<Probe> makeProbes(const ProbeMesh& m) {
+  std::vector<Probe> probes;
+  for (int k : {1, 2, 4, 6, 8, 12, 16}) probes.push_back(fetchProbe(m, k, kFloat32x4));  // locations
+  probes.push_back(fetchProbe(m, 8, kUnorm8x4));   // bytes at 8 locations: 16 + 7 x 4
+  probes.push_back(fetchProbe(m, 8, kUnorm16x4));  // 16 + 7 x 8
+  probes.push_back(fetchProbe(m, 16, kUnorm8x4));  // 16 locations at 76 bytes (4 float32x4: 64)
+  for (int n : {0, 16, 64, 256}) probes.push_back(chainProbe(m, n));
+  for (int n : {1, 4, 8, 16}) probes.push_back(bufferProbe(m, n));
+  for (int n : {1, 4, 8})
+    for (bool perVertex : {true, false}) probes.push_back(paletteProbe(m, n, perVertex));
+  for (int n : {1, 4, 8, 15}) probes.push_back(outputProbe(m, n));
+  return probes;
+}
+
+std::string probeGlsl(const Probe& p, bool capture) {
+  const int stride = 16 * (1 + p.outputs);
+  std::string s = "#version 450\nlayout(location = 0) in vec4 a0;\n" + p.decl;
+  if (capture)
+    s += fmt::format("out gl_PerVertex {{\n  layout(xfb_buffer = 0, xfb_offset = 0, xfb_stride = {}) vec4 gl_Position;\n}};\n", stride);
+  for (int i = 0; i < p.outputs; ++i)
+    s += capture ? fmt::format("layout(location = {}, xfb_buffer = 0, xfb_offset = {}, xfb_stride = {}) out vec4 o{};\n", i,
+                               16 * (1 + i), stride, i)
+                 : fmt::format("layout(location = {}) out vec4 o{};\n", i, i);
+  return s + "void main() {\n" + kClipPosition + p.body + "}\n";
+}
+
+// A fragment shader that reads every output of the probe: a driver links the stages and
+// would otherwise drop outputs nothing reads, and with them the work that feeds them.
+std::string probeFragmentGlsl(const Probe& p) {
+  std::string s = "#version 450\nlayout(location = 0) out vec4 color;\n";
+  std::string sum = "vec4(0.0)";
+  for (int i = 0; i < p.outputs; ++i) {
+    s += fmt::format("layout(location = {}) in vec4 o{};\n", i, i);
+    sum += fmt::format(" + o{}", i);
+  }
+  return s + "void main() { color = vec4(0.5) + 1e-6 * (" + sum + "); }\n";
+}
+
+GlslShader compileProbe(Stage stage, const std::string& text, const std::string& label) {
+  GlslShader s(GlslUnit{stage, text, "calibration probe '" + label + "'", {}}, TargetEnv::Vulkan1_1);
+  if (!s.ok()) throwDiagnostics(s.diagnostics(), "calibration probe", "a calibration probe does not compile");
+  return s;
+}
+
+// "" when the captured outputs agree with the expected values, else where they first differ.
+std::string compareCapture(const Probe& p, const std::vector<uint8_t>& captured, size_t vertices) {
+  const size_t n = size_t(4 * (1 + p.outputs));
+  if (captured.size() < vertices * n * 4) return "captured fewer bytes than the outputs need";
+  for (size_t v = 0; v < vertices; ++v)
+    for (size_t o = 0; o <= size_t(p.outputs); ++o) {
+      double scale = 1;
+      for (size_t c = 0; c < 4; ++c) scale = std::max(scale, std::abs(p.expected[v * n + o * 4 + c]));
+      for (size_t c = 0; c < 4; ++c) {
+        float g;
+        std::memcpy(&g, captured.data() + (v * n + o * 4 + c) * 4, 4);
+        double want = p.expected[v * n + o * 4 + c];
+        if (!(std::abs(g - want) <= p.tolerance * scale))
+          return fmt::format("vertex {}, {} component {}: device {} , expected {}", v, o ? fmt::format("o{}", o - 1) : "gl_Position",
+                             c, g, want);
+      }
+    }
+  return "";
+}
+
+double medianOf(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+}  // namespace
+
+DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, const std::string& mesh,
+                               const std::string& deviceName) {
+  std::vector<const CalibrationSample*> rows;
+  for (const auto& s : samples)
+    if (s.mesh == mesh && s.validated && s.measuredNs > 0) rows.push_back(&s);
+  if (rows.empty()) throw std::runtime_error(fmt::format("calibration: no validated timing on mesh '{}' to fit", mesh));
+  // Relative errors weigh equally: row i divided by its measured time.
+  std::vector<double> a(rows.size() * kTermCount), b(rows.size(), 1.0);
+  for (size_t i = 0; i < rows.size(); ++i)
+    for (int t = 0; t < kTermCount; ++t) a[i * kTermCount + size_t(t)] = double(rows[i]->amounts[size_t(t)]) / rows[i]->measuredNs;
+  NnlsResult fit = nnls(a, rows.size(), kTermCount, b);
+  DeviceProfile profile;
+  profile.device = deviceName;
+  for (int t = 0; t < kTermCount; ++t)
+    profile.nanoseconds[size_t(t)] = std::min(fit.x[size_t(t)], kMaxProfileWeightNs);
+  return profile;
+}
+
+std::vector<CalibrationFit> evaluateFit(std::vector<CalibrationSample>& samples, const DeviceProfile& profile,
+                                        const std::vector<std::string>& meshes) {
+  std::vector<CalibrationFit> fits;
+  for (const auto& mesh : meshes) {
+    CalibrationFit f;
+    f.mesh = mesh;
+    std::vector<double> predicted, measured;
+    double sq = 0;
+    for (auto& s : samples) {
+      if (s.mesh != mesh) continue;
+      s.predictedNs = 0;
+      for (int t = 0; t < kTermCount; ++t) s.predictedNs += profile.nanoseconds[size_t(t)] * double(s.amounts[size_t(t)]);
+      if (!s.validated || s.measuredNs <= 0) continue;
+      double rel = (s.predictedNs - s.measuredNs) / s.measuredNs;
+      sq += rel * rel;
+      f.maxRelativeError = std::max(f.maxRelativeError, std::abs(rel));
+      predicted.push_back(s.predictedNs);
+      measured.push_back(s.measuredNs);
+    }
+    f.samples = measured.size();
+    f.rmsRelativeError = f.samples ? std::sqrt(sq / double(f.samples)) : 0;
+    f.spearman = spearmanWithinSpread(predicted, measured, 0.005);
+    fits.push_back(f);
+  }
+  return fits;
+}
+
+CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
+  if (opts.meshes.empty()) throw std::invalid_argument("calibration: no mesh");
+  rt::HarnessOptions ho;
+  ho.deviceName = opts.device;
+  ho.validation = opts.validationLayers;
+  rt::Harness harness(ho);
+  rt::Renderer renderer(harness);
+  CalibrationReport rep;
+  rep.device = harness.deviceName();
+  rep.driver = renderer.driver();
+  const bool hostClock = rep.device.find("llvmpipe") != std::string::npos;
+  rep.clock = hostClock ? "host submit-to-fence time (a CPU device)" : "GPU timestamps";
+
+  for (const auto& meshName : opts.meshes) {
+    ProbeMesh m = probeMesh(meshName);
+    std::vector<Probe> probes = opts.probes ? makeProbes(m) : std::vector<Probe>{};
+    for (auto& p : probes) {
+      CalibrationSample s;
+      s.label = p.label;
+      s.mesh = meshName;
+      s.amounts = p.amounts;
+      try {
+        GlslShader renderShader = compileProbe(Stage::Vertex, probeGlsl(p, false), p.label);
+        std::vector<uint32_t> render = renderShader.spirv();
+        std::vector<uint32_t> capture = compileProbe(Stage::Vertex, probeGlsl(p, true), p.label).spirv();
+        s.amounts[kTermArithmetic] = measureSpirv(optimizeSpirv(render, TargetEnv::Vulkan1_1)).total;
+        p.inputs.vertexCount = static_cast<uint32_t>(m.mesh.vertexCount);
+        p.inputs.declared = declaredDescriptors(renderShader.descriptors());
+        rt::RunRequest run;
+        static_cast<rt::ProgramInputs&>(run) = p.inputs;
+        run.spirv = capture;
+        run.capture.strideBytes = uint32_t(16 * (1 + p.outputs));
+        s.failure = compareCapture(p, harness.run(run).captured, m.mesh.vertexCount);
+        s.validated = s.failure.empty();
+        if (s.validated) {
+          rt::DrawRequest req;
+          static_cast<rt::ProgramInputs&>(req) = p.inputs;
+          req.vertexSpirv = render;
+          req.fragmentSpirv = compileProbe(Stage::Fragment, probeFragmentGlsl(p), p.label).spirv();
+          req.indices = m.indices;
+          req.width = req.height = 512;
+          rt::TimingRequest t;
+          t.drawsPerFrame = opts.drawsPerFrame;
+          t.frames = opts.frames + 1;
+          for (uint32_t r = 0; r < std::max<uint32_t>(1, opts.rounds); ++r) {
+            rt::Timing tm = renderer.time(req, t);
+            // A CPU device (lavapipe) runs work outside the timestamps' reach: its host time is the honest one.
+            const std::vector<double>& clock = hostClock ? tm.wallNs : tm.frameNs;
+            std::vector<double> frames(clock.begin() + 1, clock.end());
+            double ns = medianOf(frames) / (double(opts.drawsPerFrame) * double(tm.verticesPerDraw));
+            s.measuredNs = s.measuredNs < 0 ? ns : std::min(s.measuredNs, ns);
+          }
+        }
+      } catch (const std::exception& e) {
+        s.validated = false;
+        s.failure = e.what();
+      }
+      rep.samples.push_back(std::move(s));
+    }
+  }
+  // Generated plans: bench's programs (each validated on the device before it is timed).
+  // Without a profile a generation does not count its plans' buffer and indexed loads; one
+  // that prices arithmetic alone chooses the slot model's plans (docs/device-profiles.md) and counts them.
+  std::string slotsProfile;
+  if (!opts.plans.rigPath.empty() && opts.plans.deviceProfilePath.empty()) {
+    slotsProfile = (std::filesystem::temp_directory_path() / fmt::format("shadergen-slots-{}.yaml", ::getpid())).string();
+    std::ofstream(slotsProfile) << "device: instruction slots\nweights:\n  arithmetic: 0.000001\n";
+  }
+  struct Remove {
+    std::string path;
+    ~Remove() {
+      if (!path.empty()) std::filesystem::remove(path);
+    }
+  } removeSlots{slotsProfile};
+  if (!opts.plans.rigPath.empty())
+    for (const auto& meshName : opts.meshes) {
+      GpuBenchOptions bo;
+      bo.render.gen = opts.plans;
+      if (!slotsProfile.empty()) bo.render.gen.deviceProfilePath = slotsProfile;
+      bo.render.device = opts.device;
+      bo.render.validationLayers = opts.validationLayers;
+      bo.render.mesh = meshName == "small" ? "head" : meshName;
+      bo.floor = false;
+      bo.rasterOff = false;
+      bo.drawsPerFrame = opts.drawsPerFrame;
+      bo.frames = opts.frames;
+      bo.rounds = opts.rounds;
+      for (const auto& row : runGpuBench(bo).rows) {
+        if (!row.hasCost) continue;
+        CalibrationSample s;
+        s.label = "plan: " + row.label;
+        s.mesh = meshName;
+        s.amounts = row.amounts;
+        s.validated = row.validation == "pass";
+        s.failure = s.validated ? "" : row.validation;
+        s.measuredNs = !s.validated ? -1 : hostClock ? row.rasterOnWallNsPerVertex : row.rasterOnNsPerVertex;
+        rep.samples.push_back(std::move(s));
+      }
+    }
+  rep.profile = fitDeviceProfile(rep.samples, opts.meshes.front(), rep.device + " (" + rep.driver + ")");
+  rep.fits = evaluateFit(rep.samples, rep.profile, opts.meshes);
+  return rep;
+}
+
+std::string formatCalibration(const CalibrationReport& r) {
+  std::string s = fmt::format("device: {} (driver: {}); clock: {}\n\n| mesh | program | ", r.device, r.driver, r.clock);
+  for (int t = 0; t < kTermCount; ++t) s += fmt::format("{} | ", termName(t));
+  s += "measured ns/vertex | predicted |\n|---|---|";
+  for (int t = 0; t < kTermCount; ++t) s += "---:|";
+  s += "---:|---:|\n";
+  for (const auto& x : r.samples) {
+    s += fmt::format("| {} | {} | ", x.mesh, x.label);
+    for (int t = 0; t < kTermCount; ++t) s += fmt::format("{} | ", x.amounts[size_t(t)]);
+    s += x.validated ? fmt::format("{:.4f} | {:.4f} |\n", x.measuredNs, x.predictedNs)
+                     : fmt::format("FAILED, not timed: {} | — |\n", x.failure);
+  }
+  s += "\nweights (ns per unit per vertex), fitted on mesh '" + (r.fits.empty() ? std::string() : r.fits.front().mesh) + "':\n";
+  for (int t = 0; t < kTermCount; ++t) s += fmt::format("  {}: {:.6g}\n", termName(t), r.profile.nanoseconds[size_t(t)]);
+  for (const auto& f : r.fits)
+    s += fmt::format("fit on '{}': {} samples, RMS relative error {:.1f} %, max {:.1f} %, Spearman {:.3f}\n", f.mesh, f.samples,
+                     100 * f.rmsRelativeError, 100 * f.maxRelativeError, f.spearman);
+  return s;
+}
+
+std::string deviceProfileYaml(const CalibrationReport& r) {
+  std::string s = "# Measured by `shadergen calibrate` (docs/device-profiles.md): ns per vertex per unit of each\n"
+                  "# term, the non-negative least-squares fit of every validated probe's and plan's time.\n";
+  s += fmt::format("# clock: {}; driver: {}\n", r.clock, r.driver);
+  for (const auto& f : r.fits)
+    s += fmt::format("# fit on mesh '{}': {} samples, RMS relative error {:.1f} %, max {:.1f} %, Spearman {:.3f}\n", f.mesh, f.samples,
+                     100 * f.rmsRelativeError, 100 * f.maxRelativeError, f.spearman);
+  s += fmt::format("device: \"{}\"\nunit: ns\nweights:\n", r.profile.device);
+  for (int t = 0; t < kTermCount; ++t) s += fmt::format("  {}: {:.6g}\n", termName(t), r.profile.nanoseconds[size_t(t)]);
+  return s;
+}
+
+}  // namespace sg

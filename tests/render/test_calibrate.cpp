@@ -1,0 +1,121 @@
+// Device calibration (docs/device-profiles.md): every probe computes what it claims on a
+// real device (lavapipe), its amounts are what it was built to vary, the fit recovers known
+// weights, and the written profile reads back. No timing is asserted.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "render/calibrate.h"
+#include "render/gpu_bench.h"
+
+namespace sg {
+namespace {
+
+const CalibrationSample* find(const CalibrationReport& r, const std::string& label) {
+  for (const auto& s : r.samples)
+    if (s.label == label) return &s;
+  return nullptr;
+}
+
+TEST(Calibrate, EveryProbeAgreesWithItsExpectedOutputsOnLavapipeAndVariesOneTerm) {
+  CalibrationOptions o;
+  o.meshes = {"small"};
+  o.drawsPerFrame = 1;
+  o.frames = 1;
+  o.rounds = 1;
+  CalibrationReport r = calibrateDevice(o);
+  ASSERT_GE(r.samples.size(), 20u);
+  for (const auto& s : r.samples) {
+    EXPECT_TRUE(s.validated) << s.label << ": " << s.failure;
+    EXPECT_GT(s.measuredNs, 0) << s.label;
+    EXPECT_EQ(s.amounts[kTermVertices], 1) << s.label;
+  }
+  // Locations at fixed bytes and bytes at fixed locations, as built.
+  const CalibrationSample* f16 = find(r, "locations 16 (float32x4 after the position)");
+  const CalibrationSample* u8 = find(r, "locations 16 (unorm8x4 after the position)");
+  ASSERT_TRUE(f16 && u8);
+  EXPECT_EQ(f16->amounts[kTermLocations], 16);
+  EXPECT_EQ(u8->amounts[kTermLocations], 16);
+  EXPECT_EQ(f16->amounts[kTermAttributeBytes], 16 * 16);
+  EXPECT_EQ(u8->amounts[kTermAttributeBytes], 16 + 15 * 4);
+  // The chain's arithmetic grows by one slot per multiply-add (measured on its SPIR-V).
+  const CalibrationSample* c0 = find(r, "arithmetic chain 0");
+  const CalibrationSample* c64 = find(r, "arithmetic chain 64");
+  ASSERT_TRUE(c0 && c64);
+  EXPECT_EQ(c64->amounts[kTermArithmetic] - c0->amounts[kTermArithmetic], 64);
+  EXPECT_EQ(c64->amounts[kTermLocations], c0->amounts[kTermLocations]);
+  // Palette loads: the per-vertex index is charged, the uniform one is not; the rest is equal.
+  const CalibrationSample* pv = find(r, "palette loads 4 at a per-vertex index");
+  const CalibrationSample* pu = find(r, "palette loads 4 at a uniform index");
+  ASSERT_TRUE(pv && pu);
+  EXPECT_EQ(pv->amounts[kTermIndexedUniformLoads], 4);
+  EXPECT_EQ(pu->amounts[kTermIndexedUniformLoads], 0);
+  EXPECT_EQ(pv->amounts[kTermLocations], pu->amounts[kTermLocations]);
+  const CalibrationSample* b16 = find(r, "storage-buffer loads 16");
+  ASSERT_TRUE(b16);
+  EXPECT_EQ(b16->amounts[kTermBufferLoads], 16);
+  EXPECT_EQ(b16->amounts[kTermBufferBytes], 256);
+  const CalibrationSample* o15 = find(r, "outputs 15 x vec4");
+  ASSERT_TRUE(o15);
+  EXPECT_EQ(o15->amounts[kTermOutputs], 4 + 15 * 4);
+
+  // The profile written reads back with the fitted weights (printed to 6 significant digits).
+  DeviceProfile back = parseDeviceProfile(deviceProfileYaml(r), "calibrated.yaml");
+  for (int t = 0; t < kTermCount; ++t) {
+    EXPECT_GE(back.nanoseconds[size_t(t)], 0) << termName(t);
+    EXPECT_NEAR(back.nanoseconds[size_t(t)], r.profile.nanoseconds[size_t(t)], 1e-5 * (1 + r.profile.nanoseconds[size_t(t)]))
+        << termName(t);
+  }
+}
+
+TEST(Calibrate, TheFitRecoversKnownNonNegativeWeights) {
+  // Samples timed by a known linear device: 0.5 ns per location, 0.01 per slot, 2 ns fixed,
+  // nothing for the other terms. The fit must give those weights and predict exactly.
+  const double truth[kTermCount] = {0.01, 0.5, 0, 0, 0, 0, 0, 2.0};
+  std::vector<CalibrationSample> samples;
+  for (int locations = 1; locations <= 16; locations += 3)
+    for (int slots : {0, 40, 200}) {
+      CalibrationSample s;
+      s.label = fmt::format("l{} a{}", locations, slots);
+      s.mesh = "m";
+      s.validated = true;
+      s.amounts[kTermLocations] = locations;
+      s.amounts[kTermAttributeBytes] = 16 * locations;
+      s.amounts[kTermArithmetic] = slots;
+      s.amounts[kTermOutputs] = 8;
+      s.amounts[kTermVertices] = 1;
+      s.measuredNs = 0;
+      for (int t = 0; t < kTermCount; ++t) s.measuredNs += truth[t] * double(s.amounts[size_t(t)]);
+      samples.push_back(s);
+    }
+  // A sample that failed validation is never fitted, however wrong its time.
+  CalibrationSample bad = samples.front();
+  bad.validated = false;
+  bad.measuredNs = 1e6;
+  samples.push_back(bad);
+  DeviceProfile p = fitDeviceProfile(samples, "m", "linear device");
+  // Bytes are 16 x locations here: only their sum is determined, so check predictions and
+  // the terms the samples separate.
+  std::vector<CalibrationFit> fits = evaluateFit(samples, p, {"m"});
+  ASSERT_EQ(fits.size(), 1u);
+  EXPECT_EQ(fits[0].samples, samples.size() - 1);
+  EXPECT_LT(fits[0].rmsRelativeError, 1e-9);
+  EXPECT_NEAR(p.nanoseconds[kTermArithmetic], 0.01, 1e-9);
+  EXPECT_NEAR(p.nanoseconds[kTermLocations] + 16 * p.nanoseconds[kTermAttributeBytes], 0.5, 1e-9);
+  EXPECT_NEAR(p.nanoseconds[kTermVertices] + 8 * p.nanoseconds[kTermOutputs], 2.0, 1e-9);
+  EXPECT_DOUBLE_EQ(fits[0].spearman, 1.0);
+}
+
+TEST(Calibrate, SpearmanTreatsTimesWithinTheSpreadAsTies) {
+  // Measured 1.000 and 1.004 are one tie at a 0.5 % spread: ranks (1.5, 1.5, 3) against the
+  // predictions' (1, 2, 3) correlate at sqrt(3)/2 (Pearson of the ranks), not 1.
+  std::vector<double> predicted{1, 2, 3}, measured{1.0, 1.004, 2.0};
+  EXPECT_DOUBLE_EQ(spearman(predicted, measured), 1.0);
+  EXPECT_NEAR(spearmanWithinSpread(predicted, measured, 0.005), std::sqrt(3.0) / 2, 1e-12);
+  EXPECT_DOUBLE_EQ(spearmanWithinSpread(predicted, measured, 0.001), 1.0);
+}
+
+}  // namespace
+}  // namespace sg
