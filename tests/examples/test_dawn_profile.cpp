@@ -98,5 +98,22 @@ TEST(DawnProfile, ExpensiveLocationsMoveThePlanToBuffers) {
   EXPECT_NE(json.find("\"locations\": {\"amount\": " + std::to_string(c.amounts[kTermLocations])), std::string::npos);
 }
 
+// The profile measured on an NVIDIA H200 (devices/nvidia-h200.yaml, `shadergen calibrate`,
+// docs/device-profiles.md) reads back and chooses a plan of at most 6 input locations (the
+// bench there timed it at 0.37x the hand port of listing 3-3: bench/data/h200-calibrate.log);
+// the IP oracle agrees it is the optimum under that profile.
+TEST(DawnProfile, TheMeasuredH200ProfileReadsFewLocations) {
+  GenerateResult r = generate(faceOptions(std::string(SG_SOURCE_DIR) + "/devices/nvidia-h200.yaml"));
+  ASSERT_TRUE(r.in.profile);
+  EXPECT_NE(r.in.profile->device.find("H200"), std::string::npos);
+  const PlanCostPrediction c = predictPlanCost(r.plan, r.in.problem, *r.in.profile);
+  EXPECT_LE(c.amounts[kTermLocations], 6);
+  SearchOptions o;
+  o.engine = "ip";
+  auto plan = findPlan(r.in.problem, o);
+  ASSERT_TRUE(plan);
+  EXPECT_EQ(plan->cost, r.plan.cost);
+}
+
 }  // namespace
 }  // namespace sg
