@@ -34,7 +34,7 @@ seeds() {
                sed -E 's/^(when|cost|count): *//; s/^"(.*)"$/\1/' | sort -u)
       add "$SRC"/tests/bad-input/expr/**/* ;;
     fragment) add "$SRC"/examples/**/*.frag "$SRC"/tests/**/*.frag ;;
-    gltf) add "$SRC"/tests/bad-input/gltf/**/*.gltf "$SRC"/tests/bad-input/gltf/**/*.glb \
+    gltf) add "$SRC"/tests/bad-input/gltf/**/*.gltf "$SRC"/tests/bad-input/gltf/**/*.glb "$SRC"/tests/gltf/data/gltfpack/*.glb \
             "$SRC"/../shared/models/**/*.gltf "$SRC"/../shared/models/**/*.glb ;;
     generate)  # rig %% fragment %% rules triples from the examples
       local ex=$SRC/examples
