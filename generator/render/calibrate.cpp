@@ -76,12 +76,7 @@ ProbeMesh probeMesh(const std::string& name) {
   else if (name == "small") rings = 8, segments = 8;  // tests
   else if (name != "head") throw std::invalid_argument(fmt::format("calibration mesh '{}': head, dawn or small", name));
   m.mesh = rt::makeHead(rings, segments, mo);
-  // Triangles of the (rings + 1) x (segments + 1) grid, as render's gridIndices.
-  for (int r = 0; r < rings; ++r)
-    for (int s = 0; s < segments; ++s) {
-      uint32_t a = uint32_t(r * (segments + 1) + s), b = a + 1, c = a + uint32_t(segments + 1), d = c + 1;
-      m.indices.insert(m.indices.end(), {a, c, b, b, c, d});
-    }
+  m.indices = gridIndices(rings, segments);
   return m;
 }
 
