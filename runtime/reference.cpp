@@ -208,6 +208,15 @@ struct ReferenceEvaluator::State {
     return *objOcc;
   }
 
+  // normalize(t − dot(t, N)·N) for a unit normal N; degenerate (|g|² <= 1e-6·|t|²): the
+  // tangent of the orthonormal basis of N (Duff et al. 2017)
+  static dvec3 orthonormalTangent(const dvec3& t, const dvec3& N) {
+    const dvec3 g = t - glm::dot(t, N) * N;
+    if (glm::dot(g, g) > 1e-6 * glm::dot(t, t)) return glm::normalize(g);
+    const double s = N.z >= 0.0 ? 1.0 : -1.0, a = -1.0 / (s + N.z);
+    return dvec3(1.0 + s * N.x * N.x * a, s * N.x * N.y * a, -s * N.x);
+  }
+
   // object.tangent = normalize(t − dot(t, N)·N), t = vertex.tangent + Σ_i w_i·morph.tangent[i],
   // N = object.normal; degenerate (|g|² <= 1e-6·|t|²): the orthonormal basis of N
   const std::vector<dvec3>& objectTangent() {
@@ -219,14 +228,7 @@ struct ReferenceEvaluator::State {
     for (size_t v = 0; v < n; ++v) {
       dvec3 t = xyz(base[v]);
       for (const auto& [w, s] : terms) t += w * xyz((*s)[v]);
-      const dvec3& N = normals[v];
-      const dvec3 g = t - glm::dot(t, N) * N;
-      if (glm::dot(g, g) > 1e-6 * glm::dot(t, t)) {
-        out[v] = glm::normalize(g);
-      } else {  // degenerate: the tangent of the orthonormal basis of N (Duff et al. 2017)
-        const double s = N.z >= 0.0 ? 1.0 : -1.0, a = -1.0 / (s + N.z);
-        out[v] = dvec3(1.0 + s * N.x * N.x * a, s * N.x * N.y * a, -s * N.x);
-      }
+      out[v] = orthonormalTangent(t, normals[v]);
     }
     objTangent = std::move(out);
     return *objTangent;
@@ -319,8 +321,9 @@ struct ReferenceEvaluator::State {
     return *worldTangent;
   }
 
-  // world.handedness = vertex.handedness; without it, the sign of a stored binormal
-  // against the bind-pose frame: sign(dot(cross(vertex.normal, vertex.tangent), vertex.binormal)).
+  // world.handedness = vertex.handedness; without it, the side of a stored binormal B of the
+  // bind-pose frame: sign(dot(cross(N, T), B)), N = normalize(vertex.normal), T = the tangent
+  // orthonormalised against N as object.tangent is (defined where vertex.tangent ∥ N).
   const std::vector<glm::vec4>& handedness() {
     if (mesh.has("vertex.handedness") || !mesh.has("vertex.binormal")) return stream("vertex.handedness");
     if (derivedHandedness.empty()) {
@@ -328,8 +331,11 @@ struct ReferenceEvaluator::State {
       const auto& T = stream("vertex.tangent");
       const auto& B = stream("vertex.binormal");
       derivedHandedness.resize(n);
-      for (size_t v = 0; v < n; ++v)
-        derivedHandedness[v].x = glm::dot(glm::cross(dvec3(N[v]), dvec3(T[v])), dvec3(B[v])) < 0.0 ? -1.0f : 1.0f;
+      for (size_t v = 0; v < n; ++v) {
+        const dvec3 normal = glm::normalize(xyz(N[v]));
+        const dvec3 frameTangent = orthonormalTangent(xyz(T[v]), normal);
+        derivedHandedness[v].x = glm::dot(glm::cross(normal, frameTangent), xyz(B[v])) < 0.0 ? -1.0f : 1.0f;
+      }
     }
     return derivedHandedness;
   }
