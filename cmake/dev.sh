@@ -11,18 +11,24 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 what=${1:-test}
 
+# What the CLI needs to build and run; the suite adds its frameworks, the sanitized tree Clang.
 packages=(
   build-essential cmake ninja-build pkg-config
   glslang-dev glslang-tools spirv-tools
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers
   libglm-dev libyaml-cpp-dev libfmt-dev libcli11-dev
   libtinygltf-dev nlohmann-json3-dev libmeshoptimizer-dev
-  libgtest-dev libgmock-dev libbenchmark-dev graphviz
-  clang-14 libclang-rt-14-dev
   libglpk-dev
   libembree-dev
   libpng-dev
 )
+test_packages=(libgtest-dev libgmock-dev libbenchmark-dev graphviz)
+sanitize_packages=(clang-14 libclang-rt-14-dev)
+case "$what" in
+  dawn) ;;
+  build) packages+=("${test_packages[@]}") ;;
+  *) packages+=("${test_packages[@]}" "${sanitize_packages[@]}") ;;
+esac
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -50,9 +56,12 @@ build=${SHADERGEN_BUILD_DIR:-build}
 # Release: debug information costs a third of the compile time and most of the link time;
 # configure a tree of your own with RelWithDebInfo or Debug to debug.
 build_type=${SHADERGEN_BUILD_TYPE:-Release}
-plain_build() {  # plain_build [target...]
+plain_build() {  # plain_build [target...]: only those targets, and then without the suite
+  local suite=ON
+  [ $# -gt 0 ] && suite=OFF
   # -O2 for Release too: CMake's -O3 compiles slower and bought nothing measurable here.
-  cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" -DCMAKE_CXX_FLAGS_RELEASE="-O2 -DNDEBUG" >/dev/null
+  cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" -DCMAKE_CXX_FLAGS_RELEASE="-O2 -DNDEBUG" \
+    -DSHADERGEN_BUILD_TESTS=$suite -DSHADERGEN_BUILD_BENCH=$suite >/dev/null
   if [ $# -gt 0 ]; then cmake --build "$build" --target "$@"; else cmake --build "$build"; fi
 }
 # One instrumented tree serves both the sanitizer suite and the fuzz targets.
