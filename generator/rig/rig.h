@@ -9,6 +9,7 @@
 
 #include "common/diagnostics.h"
 #include "common/types.h"
+#include "rig/vertex_format.h"
 
 namespace sg {
 
@@ -22,16 +23,6 @@ constexpr int kMaxBones = 1024;
 constexpr size_t kMaxRigAttributes = 64;
 constexpr size_t kMaxRigUniforms = 256;
 
-// How the application stores a vertex attribute (maps 1:1 to a VkFormat).
-enum class VertexFormat {
-  Float32x1, Float32x2, Float32x3, Float32x4,
-  Unorm8x4, Uint8x4, Unorm16x4, Uint16x4, Uint32x4,
-};
-const char* formatName(VertexFormat f);  // "float32x3", "unorm8x4", ...
-bool parseFormat(const std::string& name, VertexFormat& out);
-int formatComponents(VertexFormat f);
-int formatBytes(VertexFormat f);
-bool formatIsInteger(VertexFormat f);  // read as uint in the shader (uint8/16/32)
 
 // A semantic provided by (part of) an attribute: e.g. "vertex.occlusion" is the "w" of "normal".
 struct ProvidedPart {

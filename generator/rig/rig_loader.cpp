@@ -11,26 +11,6 @@
 namespace sg {
 namespace {
 
-struct FormatInfo {
-  VertexFormat format;
-  const char* name;
-  int components;
-  int bytes;
-  bool integer;
-};
-constexpr std::array<FormatInfo, 9> kFormats{{
-    {VertexFormat::Float32x1, "float32", 1, 4, false},
-    {VertexFormat::Float32x2, "float32x2", 2, 8, false},
-    {VertexFormat::Float32x3, "float32x3", 3, 12, false},
-    {VertexFormat::Float32x4, "float32x4", 4, 16, false},
-    {VertexFormat::Unorm8x4, "unorm8x4", 4, 4, false},
-    {VertexFormat::Uint8x4, "uint8x4", 4, 4, true},
-    {VertexFormat::Unorm16x4, "unorm16x4", 4, 8, false},
-    {VertexFormat::Uint16x4, "uint16x4", 4, 8, true},
-    {VertexFormat::Uint32x4, "uint32x4", 4, 16, true},
-}};
-const FormatInfo& finfo(VertexFormat f) { return kFormats[static_cast<size_t>(f)]; }
-
 bool validSwizzle(const std::string& s, int components) {
   if (s.empty() || s.size() > 4) return false;
   static const std::string xyzw = "xyzw";
@@ -56,19 +36,6 @@ bool validIdentifier(const std::string& s) {
 }
 
 }  // namespace
-
-const char* formatName(VertexFormat f) { return finfo(f).name; }
-int formatComponents(VertexFormat f) { return finfo(f).components; }
-int formatBytes(VertexFormat f) { return finfo(f).bytes; }
-bool formatIsInteger(VertexFormat f) { return finfo(f).integer; }
-bool parseFormat(const std::string& name, VertexFormat& out) {
-  for (const auto& i : kFormats)
-    if (name == i.name) {
-      out = i.format;
-      return true;
-    }
-  return false;
-}
 
 int64_t Rig::param(const std::string& key, int64_t fallback) const {
   auto it = params.find(key);
@@ -144,11 +111,8 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
     y.checkKeys(body, {"format", "provides", "per_target", "doc"});
     if (!body["format"]) y.fail(body, fmt::format("attribute '{}' has no 'format'", a.name));
     std::string fmtName = y.scalar(body["format"], "'format'");
-    if (!parseFormat(fmtName, a.format)) {
-      std::string all;
-      for (const auto& f : kFormats) all += (all.empty() ? "" : ", ") + std::string(f.name);
-      y.fail(body["format"], fmt::format("unknown vertex format '{}' (expected one of: {})", fmtName, all));
-    }
+    if (!parseFormat(fmtName, a.format))
+      y.fail(body["format"], fmt::format("unknown vertex format '{}' (expected one of: {})", fmtName, formatNames()));
     int n = formatComponents(a.format);
     a.shaderType = *vectorType(formatIsInteger(a.format) ? ScalarKind::UInt : ScalarKind::Float, n);
     if (body["per_target"]) a.perMorphTarget = y.boolean(body["per_target"], "'per_target'");

@@ -22,36 +22,20 @@ VkFormat vkFormat(VertexFormat f) {
     case VertexFormat::Unorm16x4: return VK_FORMAT_R16G16B16A16_UNORM;
     case VertexFormat::Uint16x4: return VK_FORMAT_R16G16B16A16_UINT;
     case VertexFormat::Uint32x4: return VK_FORMAT_R32G32B32A32_UINT;
+    case VertexFormat::Float16x2: return VK_FORMAT_R16G16_SFLOAT;
+    case VertexFormat::Float16x4: return VK_FORMAT_R16G16B16A16_SFLOAT;
+    case VertexFormat::Snorm8x2: return VK_FORMAT_R8G8_SNORM;
+    case VertexFormat::Snorm8x4: return VK_FORMAT_R8G8B8A8_SNORM;
+    case VertexFormat::Snorm16x2: return VK_FORMAT_R16G16_SNORM;
+    case VertexFormat::Snorm16x4: return VK_FORMAT_R16G16B16A16_SNORM;
+    case VertexFormat::Unorm8x2: return VK_FORMAT_R8G8_UNORM;
+    case VertexFormat::Unorm16x2: return VK_FORMAT_R16G16_UNORM;
+    case VertexFormat::Unorm10_10_10_2: return VK_FORMAT_A2B10G10R10_UNORM_PACK32;
+    case VertexFormat::Snorm10_10_10_2: return VK_FORMAT_A2B10G10R10_SNORM_PACK32;
+    case VertexFormat::Uint8x2: return VK_FORMAT_R8G8_UINT;
+    case VertexFormat::Uint16x2: return VK_FORMAT_R16G16_UINT;
   }
   return VK_FORMAT_UNDEFINED;
-}
-
-// The value a format stores for v (what the GPU will read back), as a float.
-float quantize(VertexFormat f, float v) {
-  switch (f) {
-    case VertexFormat::Unorm8x4: return std::round(std::clamp(v, 0.0f, 1.0f) * 255.0f) / 255.0f;
-    case VertexFormat::Unorm16x4: return std::round(std::clamp(v, 0.0f, 1.0f) * 65535.0f) / 65535.0f;
-    case VertexFormat::Uint8x4: return std::clamp(std::round(v), 0.0f, 255.0f);
-    case VertexFormat::Uint16x4: return std::clamp(std::round(v), 0.0f, 65535.0f);
-    case VertexFormat::Uint32x4: return std::max(0.0f, std::round(v));
-    default: return v;
-  }
-}
-
-// Writes v in format f at `dst`; returns the bytes written.
-size_t putComponent(uint8_t* dst, VertexFormat f, float v) {
-  auto put = [&](auto x) {
-    std::memcpy(dst, &x, sizeof(x));
-    return sizeof(x);
-  };
-  switch (f) {
-    case VertexFormat::Unorm8x4: return put(static_cast<uint8_t>(std::lround(v * 255.0f)));
-    case VertexFormat::Uint8x4: return put(static_cast<uint8_t>(v));
-    case VertexFormat::Unorm16x4: return put(static_cast<uint16_t>(std::lround(v * 65535.0f)));
-    case VertexFormat::Uint16x4: return put(static_cast<uint16_t>(v));
-    case VertexFormat::Uint32x4: return put(static_cast<uint32_t>(v));
-    default: return put(v);
-  }
 }
 
 std::string partSemantic(const RigAttribute& a, const ProvidedPart& p, int target) {
@@ -60,21 +44,24 @@ std::string partSemantic(const RigAttribute& a, const ProvidedPart& p, int targe
 
 int swizzleIndex(char c) { return c == 'x' ? 0 : c == 'y' ? 1 : c == 'z' ? 2 : 3; }
 
-// Quantizes, in the mesh, every stream an integer/normalized attribute carries, so the
-// reference sees exactly the values the GPU reads.
+// Replaces, in the mesh, every value an attribute of a non-float32 format carries by the
+// value the device reads back from its stored form, so the reference sees exactly what the
+// GPU reads. A part's stream component k is the attribute's component of its swizzle's
+// k-th letter (10-10-10-2 stores w in 2 bits, x, y and z in 10).
 rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
   rt::Mesh m = mesh;
   for (const auto& a : rig.attributes) {
-    if (a.format == VertexFormat::Float32x1 || a.format == VertexFormat::Float32x2 ||
-        a.format == VertexFormat::Float32x3 || a.format == VertexFormat::Float32x4)
-      continue;
+    if (formatIsFloat32(a.format)) continue;
+    const int n = formatComponents(a.format);
     int targets = a.perMorphTarget ? rig.morphTargets() : 1;
     for (int t = 0; t < targets; ++t)
       for (const auto& p : a.provides) {
         auto it = m.streams.find(partSemantic(a, p, a.perMorphTarget ? t : -1));
         if (it == m.streams.end()) continue;
+        const std::string swz = p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(n)) : p.swizzle;
         for (auto& v : it->second)
-          for (int c = 0; c < 4; ++c) v[c] = quantize(a.format, v[c]);
+          for (size_t k = 0; k < swz.size(); ++k)
+            v[static_cast<int>(k)] = storedValue(a.format, swizzleIndex(swz[k]), v[static_cast<int>(k)]);
       }
   }
   return m;
@@ -100,8 +87,8 @@ rt::VertexStream buildStream(const Rig& rig, const EmittedInput& in, const rt::M
         comps[v * static_cast<size_t>(n) + static_cast<size_t>(swizzleIndex(swz[k]))] = src[v][static_cast<int>(k)];
   }
   s.data.resize(mesh.vertexCount * s.stride);
-  uint8_t* dst = s.data.data();
-  for (float x : comps) dst += putComponent(dst, a.format, x);
+  for (size_t v = 0; v < mesh.vertexCount; ++v)
+    encodeElement(a.format, comps.data() + v * static_cast<size_t>(n), s.data.data() + v * s.stride);
   return s;
 }
 

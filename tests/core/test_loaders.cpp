@@ -2,6 +2,9 @@
 // snippet templates, fragment-shader reflection and varying binding, problem building.
 // Every error case asserts the exact file:line:col of the diagnostic and a key phrase.
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -201,6 +204,61 @@ TEST(RigLoader, DawnFaceUniforms) {
   EXPECT_EQ(findUniform(rig, "dapple_xf")->semantic, "dapple.matrix");
 }
 
+// What the device reads back from each stored format, against the Vulkan spec's
+// conversions worked by hand ("Fixed-Point Data Conversions": unorm c / (2^b - 1), snorm
+// max(c / (2^(b-1) - 1), -1), round to nearest; binary16 round to nearest even).
+TEST(VertexFormats, StoredValuesFollowTheVulkanConversions) {
+  using sg::VertexFormat;
+  using sg::storedValue;
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Unorm8x4, 0, 0.5f), 128.0f / 255.0f);
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Unorm8x2, 1, 1.7f), 1.0f);  // clamped
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Unorm16x2, 0, 0.25f), 16384.0f / 65535.0f);
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Snorm8x4, 0, -1.0f), -1.0f);
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Snorm8x4, 2, -0.5f), -64.0f / 127.0f);  // -63.5 rounds away from 0
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Snorm8x2, 1, 0.3f), 38.0f / 127.0f);    // 38.1
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Snorm16x2, 0, -0.3f), -9830.0f / 32767.0f);  // -9830.1
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Snorm16x4, 3, -3.0f), -1.0f);
+  // 10-10-10-2: x, y, z in 10 bits, w in 2.
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Unorm10_10_10_2, 0, 0.5f), 512.0f / 1023.0f);
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Unorm10_10_10_2, 3, 0.5f), 2.0f / 3.0f);  // 1.5 -> 2 of 3
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Snorm10_10_10_2, 1, 0.5f), 256.0f / 511.0f);  // 255.5 -> 256
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Snorm10_10_10_2, 3, -0.4f), 0.0f);  // 2-bit snorm: -1, 0, 1
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Snorm10_10_10_2, 3, -0.6f), -1.0f);
+  // binary16: 0.1 is 0x2E66 = 1638 / 16384; 1 + 2^-11 is a tie, to even: 1.
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Float16x2, 0, 0.1f), 1638.0f / 16384.0f);
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Float16x4, 1, 1.0f + 0x1p-11f), 1.0f);
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Float16x4, 1, 1.0f + 3 * 0x1p-12f), 1.0f + 0x1p-10f);
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Uint8x2, 0, 300.0f), 255.0f);
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Uint16x2, 1, 2.5f), 3.0f);
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Float32x3, 2, 0.1f), 0.1f);
+  // NaN stores as 0 in a fixed-point format, never as an undefined integer conversion.
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Snorm8x4, 0, std::nanf("")), 0.0f);
+}
+
+// The bytes of one element, as Vulkan reads A2B10G10R10 (one little-endian word, x in the
+// low bits) and the byte-per-component formats.
+TEST(VertexFormats, ElementBytes) {
+  uint8_t b[16] = {};
+  const float xyzw[4] = {1.0f, 0.0f, 0.0f, 1.0f};
+  sg::encodeElement(sg::VertexFormat::Unorm10_10_10_2, xyzw, b);
+  uint32_t word = 0;
+  std::memcpy(&word, b, 4);
+  EXPECT_EQ(word, 0xC00003FFu);
+  const float neg[4] = {-1.0f, 0.0f, 1.0f, -1.0f};
+  sg::encodeElement(sg::VertexFormat::Snorm10_10_10_2, neg, b);
+  std::memcpy(&word, b, 4);
+  // x = -511 (0x201 in 10 bits), z = 511 at bit 20, w = -1 (0b11) at bit 30.
+  EXPECT_EQ(word, 0x201u | (0x1FFu << 20) | (0x3u << 30));
+  const float s8[2] = {-0.5f, 1.0f};
+  sg::encodeElement(sg::VertexFormat::Snorm8x2, s8, b);
+  EXPECT_EQ(b[0], 0xC0);  // -64
+  EXPECT_EQ(b[1], 0x7F);
+  const float h[2] = {1.0f, -2.0f};
+  sg::encodeElement(sg::VertexFormat::Float16x2, h, b);
+  EXPECT_EQ(b[0] | (b[1] << 8), 0x3C00);
+  EXPECT_EQ(b[2] | (b[3] << 8), 0xC000);
+}
+
 TEST(RigLoader, Formats) {
   struct F {
     const char* name;
@@ -216,7 +274,19 @@ TEST(RigLoader, Formats) {
                      F{"uint8x4", sg::VertexFormat::Uint8x4, 4, 4, true},
                      F{"unorm16x4", sg::VertexFormat::Unorm16x4, 4, 8, false},
                      F{"uint16x4", sg::VertexFormat::Uint16x4, 4, 8, true},
-                     F{"uint32x4", sg::VertexFormat::Uint32x4, 4, 16, true}}) {
+                     F{"uint32x4", sg::VertexFormat::Uint32x4, 4, 16, true},
+                     F{"float16x2", sg::VertexFormat::Float16x2, 2, 4, false},
+                     F{"float16x4", sg::VertexFormat::Float16x4, 4, 8, false},
+                     F{"snorm8x2", sg::VertexFormat::Snorm8x2, 2, 2, false},
+                     F{"snorm8x4", sg::VertexFormat::Snorm8x4, 4, 4, false},
+                     F{"snorm16x2", sg::VertexFormat::Snorm16x2, 2, 4, false},
+                     F{"snorm16x4", sg::VertexFormat::Snorm16x4, 4, 8, false},
+                     F{"unorm8x2", sg::VertexFormat::Unorm8x2, 2, 2, false},
+                     F{"unorm16x2", sg::VertexFormat::Unorm16x2, 2, 4, false},
+                     F{"unorm10-10-10-2", sg::VertexFormat::Unorm10_10_10_2, 4, 4, false},
+                     F{"snorm10-10-10-2", sg::VertexFormat::Snorm10_10_10_2, 4, 4, false},
+                     F{"uint8x2", sg::VertexFormat::Uint8x2, 2, 2, true},
+                     F{"uint16x2", sg::VertexFormat::Uint16x2, 2, 4, true}}) {
     sg::VertexFormat out{};
     ASSERT_TRUE(sg::parseFormat(f.name, out)) << f.name;
     EXPECT_EQ(out, f.f) << f.name;

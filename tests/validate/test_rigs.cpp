@@ -129,6 +129,9 @@ INSTANTIATE_TEST_SUITE_P(
         RigCase{"limb2", "limb2.rig.yaml", "world.frag", "limb", {"skin_matrix_blend"}, kLinearBlends},
         RigCase{"limb8", "limb8.rig.yaml", "world.frag", "limb", {"skin_matrix_blend"}, kLinearBlends},
         RigCase{"limb4_unorm8", "limb4_unorm8.rig.yaml", "world.frag", "limb", {"skin_matrix_blend"}, kLinearBlends},
+        // Every packed vertex format, read back on the device as the reference assumes.
+        RigCase{"formats_a", "formats_a.rig.yaml", "formats.frag", "limb", {"skin_matrix_blend"}, kLinearBlends},
+        RigCase{"formats_b", "formats_b.rig.yaml", "formats.frag", "limb", {"skin_matrix_blend"}, kLinearBlends},
         RigCase{"rigid1", "rigid1.rig.yaml", "eye.frag", "limb",
                 {"skin_matrix_rigid", "eye_position", "eye_normal"}, {"dapple_normal_z_full"}},
         RigCase{"rigid1_world", "rigid1.rig.yaml", "world.frag", "limb",
