@@ -37,6 +37,8 @@ const std::map<std::string, int>& computedSemantics() {
       {"eye.normal", 3},          {"view.ndotv", 1},
       {"view.one_minus_ndotv", 1}, {"view.one_minus_ndotv_sq", 1},
       {"dapple.normal_z", 1},     {"clip.position", 4},
+      {"eye.to_camera", 3},       {"eye.tangent", 3},
+      {"eye.binormal", 3},
       {"camera.position", 3},
   };
   return table;
@@ -440,6 +442,25 @@ std::vector<glm::vec4> ReferenceEvaluator::State::evaluate(const std::string& se
     const dmat3 view3(dmat4(pose.view));
     const auto& N = worldNormalValues();
     return fill([&](size_t v) { return view3 * N[v]; });
+  }
+  // three.js's view-space varyings, written the way its shader chunks compute them (not as
+  // the vocabulary defines them): vViewPosition = -mvPosition.xyz; vTangent the tangent
+  // rotated into view space; vBitangent = tangent.w * normalize(cross(vNormal, vTangent)),
+  // a cross product taken in view space.
+  if (sem == "eye.to_camera") {
+    const dmat4 view(pose.view);
+    const auto& p = worldPosition();
+    return fill([&](size_t v) { return -dvec3(view * dvec4(p[v], 1.0)); });
+  }
+  if (sem == "eye.tangent" || sem == "eye.binormal") {
+    const dmat3 view3(dmat4(pose.view));
+    const auto& T = worldTangentValues();
+    if (sem == "eye.tangent") return fill([&](size_t v) { return view3 * T[v]; });
+    const auto& N = worldNormalValues();
+    const auto& h = handedness();
+    return fill([&](size_t v) {
+      return static_cast<double>(h[v].x) * glm::normalize(glm::cross(view3 * N[v], view3 * T[v]));
+    });
   }
   if (sem == "view.ndotv" || sem == "view.one_minus_ndotv" || sem == "view.one_minus_ndotv_sq") {
     // view.ndotv = abs(dot(world.normal, world.eye_dir))

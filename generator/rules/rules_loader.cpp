@@ -214,6 +214,19 @@ std::vector<TemplateLine> snippetLines(const YamlCtx& y, const YAML::Node& n, co
         throw InputError(bad, fmt::format("control character 0x{:02x} in a GLSL snippet", u));
       }
     }
+    // A directive is not local to its snippet: pasted into main(), '#define' or '#if' would
+    // apply to every later snippet and the template.
+    size_t hash = tl.text.find_first_not_of(" \t");
+    if (hash != std::string::npos && tl.text[hash] == '#') {
+      size_t end = tl.text.find_first_not_of("abcdefghijklmnopqrstuvwxyz", tl.text.find_first_not_of(" \t", hash + 1));
+      std::string word = tl.text.substr(hash, std::min(end, tl.text.size()) - hash);
+      SourceLoc bad = tl.loc;
+      if (block && bad.col > 0) bad.col += static_cast<int>(hash);
+      throw InputError(bad, fmt::format("preprocessor directive '{}' in a GLSL snippet: snippets are pasted into one "
+                                        "function, so it would apply to every later snippet; use '@if' / '@for' "
+                                        "(docs/rules-format.md) or a constant",
+                                        word));
+    }
     out.push_back(std::move(tl));
   }
   return out;

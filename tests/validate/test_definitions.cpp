@@ -85,7 +85,8 @@ int compareOracle(const sg::Rig& rig, const rt::Mesh& mesh, const rt::Pose& pose
   for (const char* sem : {"object.position", "object.normal", "object.occlusion", "object.tangent", "world.position",
                           "world.normal", "world.tangent", "world.handedness", "world.binormal", "frame.row_x",
                           "frame.row_y", "frame.row_z", "world.eye_dir", "eye.position", "eye.normal", "view.ndotv",
-                          "view.one_minus_ndotv", "view.one_minus_ndotv_sq", "dapple.normal_z", "clip.position"}) {
+                          "view.one_minus_ndotv", "view.one_minus_ndotv_sq", "dapple.normal_z", "clip.position",
+                          "eye.to_camera", "eye.tangent", "eye.binormal"}) {
     if (std::string(sem) == "dapple.normal_z" && !uniforms.count("dapple.matrix")) continue;
     std::vector<glm::vec4> expected;
     bool refOk = true;
@@ -110,8 +111,11 @@ int compareOracle(const sg::Rig& rig, const rt::Mesh& mesh, const rt::Pose& pose
       for (int c = 0; c < n; ++c)
         worst = std::max(worst, std::abs(got[v * n + c] - expected[v][c]) / scale);
     }
-    // The reference rounds its result to float: half an ulp of the scale.
-    EXPECT_LT(worst, 1.2e-7) << sem << " on " << mesh.name;
+    // The reference rounds its result to float: half an ulp of the scale. eye.binormal is
+    // written as three.js computes it (a cross product in view space) and defined as the
+    // world binormal rotated: equal for an exact rotation, but the view matrix is a float
+    // rotation, orthonormal to ~1e-7 only.
+    EXPECT_LT(worst, std::string(sem) == "eye.binormal" ? 4e-7 : 1.2e-7) << sem << " on " << mesh.name;
     ++compared;
   }
   return compared;
