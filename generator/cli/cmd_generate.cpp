@@ -3,10 +3,12 @@
 
 #include <filesystem>
 #include <iostream>
+#include <algorithm>
 #include <set>
 
 #include "cli/commands.h"
 #include "cli/output_files.h"
+#include "cli/whole_model.h"
 #include "emit/reflection.h"
 
 namespace sg {
@@ -111,36 +113,29 @@ struct GenerateCommand {
   bool capture = false;
   bool stats = false;
 
-  int run() {
-    GenerateOptions o = args.resolve();
-    o.optimize = optimize;
-    o.capture = capture;
-    std::set<std::string> kinds(emit.begin(), emit.end());
-    if (kinds.empty()) throw CLI::ValidationError("--emit", "nothing to emit");
-    if (optimize && !kinds.count("spv") && !kinds.count("header"))
-      throw CLI::ValidationError("-O", "does not apply: it optimises the SPIR-V, and --emit writes none (add spv or header)");
-    // With one --emit kind, -o names that file exactly (like glslc -o). Otherwise -o is a
-    // stem: known suffixes are stripped and each kind gets its own (.vert .spv .spv.h .json).
-    bool single = kinds.size() == 1 && !output.empty();
-    std::string stem = output.empty() ? std::filesystem::path(o.fragmentPath).stem().string() : output;
+  // The outputs of one generation: with one --emit kind and `exact`, `path` is that file
+  // (like glslc -o); otherwise it is a stem and known suffixes are stripped, each kind getting
+  // its own (.vert .spv .spv.h .json).
+  static std::string stemOf(std::string path) {
     for (const char* suffix : {".spv.h", ".vert", ".spv", ".json", ".h"}) {
       std::string sfx(suffix);
-      if (stem.size() > sfx.size() && stem.compare(stem.size() - sfx.size(), sfx.size(), sfx) == 0) {
-        stem.resize(stem.size() - sfx.size());
+      if (path.size() > sfx.size() && path.compare(path.size() - sfx.size(), sfx.size(), sfx) == 0) {
+        path.resize(path.size() - sfx.size());
         break;
       }
     }
+    return path;
+  }
+  std::vector<PendingFile> outputsOf(const GenerateResult& r, const std::set<std::string>& kinds, const std::string& path,
+                                     bool exact) const {
+    const std::string stem = stemOf(path);
     auto pathFor = [&](const std::string& kind) {
-      if (single) return output;
+      if (exact) return path;
       if (kind == "glsl") return stem + ".vert";
       if (kind == "spv") return stem + ".spv";
       if (kind == "header") return stem + ".spv.h";
       return stem + ".json";
     };
-    o.outputName = single && kinds.count("glsl") ? output : stem + ".vert";
-
-    GenerateResult r = generate(o);
-
     std::vector<PendingFile> files;
     if (kinds.count("glsl")) files.push_back({pathFor("glsl"), r.glsl.text});
     if (kinds.count("spv")) {
@@ -156,25 +151,99 @@ struct GenerateCommand {
       files.push_back({pathFor("header"), spirvHeader(r.spirv.words, sym + "_spv") + buffersHeader(r.glsl, sym)});
     }
     if (kinds.count("reflection")) files.push_back({pathFor("reflection"), reflectionOf(r)});
-    if (depfile || !depfilePath.empty()) {
-      // Every output is a target of the depfile (first = the first output, as Ninja wants).
-      std::vector<std::string> targets;
-      for (const auto& f : files) targets.push_back(f.path);
-      std::string dpath = depfilePath.empty() ? files.front().path + ".d" : depfilePath;
-      files.push_back({dpath, makeDepfile(targets, r.inputsRead)});
-    }
+    return files;
+  }
+
+  // Every output is a target of the depfile (first = the first output, as Ninja wants).
+  void addDepfile(std::vector<PendingFile>& files, const std::vector<std::string>& inputsRead) const {
+    if (!depfile && depfilePath.empty()) return;
+    std::vector<std::string> targets;
+    for (const auto& f : files) targets.push_back(f.path);
+    std::string dpath = depfilePath.empty() ? files.front().path + ".d" : depfilePath;
+    files.push_back({dpath, makeDepfile(targets, inputsRead)});
+  }
+
+  void printPlan(const GenerateResult& r, const GenerateOptions& o) const {
+    std::cout << fmt::format("plan for rig '{}' ({} rules, {} expanded, {} heuristic):\n", r.in.rig.name,
+                             r.plan.actions.size(), r.stats.expanded, o.heuristic);
+    std::cout << describePlan(r.in.problem, r.plan);
+    if (r.in.profile) std::cout << describePlanCost(r.plan, r.in.problem, *r.in.profile);
+  }
+
+  int run() {
+    GenerateOptions o = args.resolve();
+    o.optimize = optimize;
+    o.capture = capture;
+    std::set<std::string> kinds(emit.begin(), emit.end());
+    if (kinds.empty()) throw CLI::ValidationError("--emit", "nothing to emit");
+    if (optimize && !kinds.count("spv") && !kinds.count("header"))
+      throw CLI::ValidationError("-O", "does not apply: it optimises the SPIR-V, and --emit writes none (add spv or header)");
+    if (auto parts = wholeModelParts(o.rigPath)) return runModel(o, kinds, *parts);
+    bool single = kinds.size() == 1 && !output.empty();
+    std::string path = output.empty() ? std::filesystem::path(o.fragmentPath).stem().string() : output;
+    o.outputName = single && kinds.count("glsl") ? output : stemOf(path) + ".vert";
+
+    GenerateResult r = generate(o);
+
+    std::vector<PendingFile> files = outputsOf(r, kinds, path, single);
+    addDepfile(files, r.inputsRead);
     std::vector<std::string> outPaths;
     for (const auto& f : files) outPaths.push_back(f.path);
     refuseClobbering(outPaths, inputFiles(r.in, r.inputsRead));
     writeFilesAtomically(files);
     if (stats) std::cout << describeStats(r.stats);
     if (!quiet) {
-      std::cout << fmt::format("plan for rig '{}' ({} rules, {} expanded, {} heuristic):\n", r.in.rig.name,
-                               r.plan.actions.size(), r.stats.expanded, o.heuristic);
-      std::cout << describePlan(r.in.problem, r.plan);
-      if (r.in.profile) std::cout << describePlanCost(r.plan, r.in.problem, *r.in.profile);
+      printPlan(r, o);
       for (const auto& f : files) std::cout << "wrote " << f.path << "\n";
     }
+    return 0;
+  }
+
+  // MODEL.glb#*: -o is a directory; one set of outputs per primitive (named by
+  // gltfPartName) and index.json. Every primitive is generated before anything is written.
+  int runModel(const GenerateOptions& base, const std::set<std::string>& kinds, const std::vector<GltfPart>& parts) {
+    if (output.empty())
+      throw CLI::ValidationError("-o", "is required with a whole model (" + base.rigPath +
+                                           "): it names the directory that gets one set of outputs per primitive");
+    std::vector<PendingFile> files;
+    std::vector<InputFile> inputs;
+    std::vector<std::string> inputsRead;
+    std::vector<nlohmann::ordered_json> entries(parts.size());
+    std::vector<std::string> failed = forEachPart(parts, [&](const GltfPart& part) {
+      GenerateOptions o = base;
+      o.rigPath = part.ref;
+      std::string stem = (std::filesystem::path(output) / part.name).string();
+      o.outputName = stem + ".vert";
+      GenerateResult r = generate(o);
+      std::vector<PendingFile> out = outputsOf(r, kinds, stem, false);
+      nlohmann::ordered_json& e = entries[static_cast<size_t>(&part - parts.data())];
+      e["rig_name"] = r.in.rig.name;
+      e["plan_cost"] = r.plan.cost;
+      nlohmann::ordered_json names = nlohmann::ordered_json::array();
+      for (const auto& f : out) names.push_back(std::filesystem::path(f.path).filename().string());
+      e["files"] = names;
+      for (const auto& f : inputFiles(r.in, r.inputsRead)) inputs.push_back(f);
+      inputsRead.insert(inputsRead.end(), r.inputsRead.begin(), r.inputsRead.end());
+      if (stats) std::cout << part.name << ": " << describeStats(r.stats);
+      if (!quiet) {
+        std::cout << part.name << ": ";
+        printPlan(r, o);
+      }
+      files.insert(files.end(), out.begin(), out.end());
+    });
+    failIfPartsFailed(base.rigPath, parts.size(), failed);
+    files.push_back({(std::filesystem::path(output) / "index.json").string(),
+                     wholeModelIndex("generate", base.rigPath, parts, entries)});
+    std::sort(inputsRead.begin(), inputsRead.end());
+    inputsRead.erase(std::unique(inputsRead.begin(), inputsRead.end()), inputsRead.end());
+    if (depfile && depfilePath.empty()) depfilePath = files.back().path + ".d";
+    addDepfile(files, inputsRead);
+    std::vector<std::string> outPaths;
+    for (const auto& f : files) outPaths.push_back(f.path);
+    refuseClobbering(outPaths, inputs);
+    writeFilesAtomically(files);
+    if (!quiet) std::cout << fmt::format("{}: {} primitive(s), {} files written to {}\n", base.rigPath, parts.size(),
+                                         files.size(), output);
     return 0;
   }
 };

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "cli/commands.h"
+#include "cli/whole_model.h"
 #include "render/gpu_bench.h"
 #include "render/render.h"
 
@@ -42,10 +43,27 @@ struct RenderCommand {
   std::string size = "512x512";
   std::string light, rim;
   bool noLayers = false;
+  std::optional<double> morphWeight;
+
+  // MODEL.glb#*: every primitive generated and posed first (a failure names its primitive
+  // and nothing is drawn or written), then drawn under one camera.
+  RenderResult renderModel(RenderSession& session, const std::vector<GltfPart>& parts) {
+    std::vector<ModelPart> programs;
+    std::vector<std::string> failed =
+        forEachPart(parts, [&](const GltfPart& part) { programs.push_back(modelPart(ro, part)); });
+    failIfPartsFailed(ro.gen.rigPath, parts.size(), failed);
+    frameModel(programs, ro.camera, float(ro.width) / float(ro.height));
+    FragmentProgram frag = compileFragmentFile(ro.gen.fragmentPath, ro.gen.targetEnv);
+    return session.renderModel(programs, frag, texturesFor(frag, ro.lighting), ro);
+  }
 
   int run() {
     ro.gen = args.resolve();
     ro.validationLayers = !noLayers;
+    if (morphWeight) {
+      ro.morphWeight = static_cast<float>(*morphWeight);
+      ro.gltfMorphWeight = morphWeight;
+    }
     unsigned w = 0, h = 0;
     char tail = 0;
     if (std::sscanf(size.c_str(), "%ux%u%c", &w, &h, &tail) != 2 || w == 0 || h == 0 || w > 8192 || h > 8192)
@@ -57,12 +75,14 @@ struct RenderCommand {
     if (glm::length(ro.lighting.keyDirection) == 0.0f || glm::length(ro.lighting.rimDirection) == 0.0f)
       throw CLI::ValidationError("--light", "a light direction must not be zero");
 
-    std::vector<InputFile> inputs{{ro.gen.rigPath, "the rig"}, {ro.gen.fragmentPath, "the fragment shader"}};
+    auto parts = wholeModelParts(ro.gen.rigPath);
+    std::vector<InputFile> inputs{{parts ? parseGltfRef(ro.gen.rigPath, true).file : ro.gen.rigPath, "the rig"},
+                                  {ro.gen.fragmentPath, "the fragment shader"}};
     for (const auto& r : ro.gen.rulesPaths) inputs.push_back({r, "a rules file"});
     refuseClobbering({output}, inputs);
 
     RenderSession session(ro.device, ro.validationLayers);
-    RenderResult r = session.render(ro);
+    RenderResult r = parts ? renderModel(session, *parts) : session.render(ro);
     std::string png = encodePng(r.image);
     writeFilesAtomically({{output, png}});
     size_t covered = 0;
@@ -119,11 +139,13 @@ void registerRender(CLI::App& app, CliState& state) {
   sub->add_option("--size", cmd->size, "Image size WIDTHxHEIGHT (default 512x512)");
   sub->add_option("--device", cmd->ro.device, "Vulkan device name (substring); default lavapipe");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer");
-  sub->add_option("--time", cmd->ro.time, "glTF rig (MODEL.glb#m/p): animation time in seconds (default 0)")
+  sub->add_option("--time", cmd->ro.time, "glTF rig (MODEL.glb#m/p, or MODEL.glb#* for the whole model): animation time in seconds (default 0)")
       ->check(finiteNumber(false));
   sub->add_option("--animation", cmd->ro.animation, "glTF rig: animation name or index (default: the first)");
   sub->add_option("--pose-seed", cmd->ro.poseSeed, "0 (default): rest pose; N: the random pose of seed N");
-  sub->add_option("--morph-weight", cmd->ro.morphWeight, "Rest pose: weight of every morph target (default 0.5)")
+  sub->add_option("--morph-weight", cmd->morphWeight,
+                  "Weight of every morph target: in the rest pose (default 0.5), or for a glTF rig in place of the "
+                  "animation's (default: the animation's)")
       ->check(finiteNumber(false));
   sub->add_option("--yaw", cmd->ro.camera.yawDegrees, "Camera yaw in degrees around +Y (0: the face)")
       ->check(CLI::Range(-360.0f, 360.0f));

@@ -7,6 +7,7 @@
 #include "validate/gltf_scene.h"
 #include "validate/poses.h"
 #include "cli/output_files.h"
+#include "cli/whole_model.h"
 #include "validate/validate.h"
 
 namespace sg {
@@ -26,6 +27,7 @@ struct ValidateCommand {
   Tolerance tol;
   std::vector<double> times;  // glTF rigs: animation times
   std::string animation;
+  std::optional<double> morphWeight;  // glTF rigs: every target's weight instead of the animation's
 
   int run() {
     ValidateOptions vo;
@@ -42,12 +44,14 @@ struct ValidateCommand {
       for (const char* o : {"--mesh", "--seed", "--poses"})
         refuseOption(*cmd, o, "to a glTF rig: the model's own mesh is posed by its animation (use --time, --animation)");
     if (!gltf)
-      for (const char* o : {"--time", "--animation"})
+      for (const char* o : {"--time", "--animation", "--morph-weight"})
         refuseOption(*cmd, o, "to a YAML rig: it is validated on a procedural mesh in random poses (--mesh, --seed, --poses)");
+    if (auto parts = wholeModelParts(vo.gen.rigPath)) return runModel(vo, *parts);
     if (gltf) {  // a real model: its own mesh, posed by its animation
       GltfSceneOptions so;
       so.times = times;
       so.animation = animation;
+      so.morphWeight = morphWeight;
       GltfSceneInfo info;
       scene = gltfScene(vo.gen.rigPath, so, &info);
       std::string ts;
@@ -82,6 +86,62 @@ struct ValidateCommand {
     std::cout << formatReport(report);
     return report.pass ? 0 : 1;
   }
+
+  // MODEL.glb#*: every primitive at every --time on one device, one report; a line per
+  // primitive at the end. Fails if any primitive fails (or cannot be generated).
+  int runModel(const ValidateOptions& vo, const std::vector<GltfPart>& parts) {
+    if (!savePoses.empty())
+      throw CLI::ValidationError("--save-poses", "does not apply to a whole model (" + vo.gen.rigPath + ")");
+    GltfSceneOptions so;
+    so.times = times;
+    so.animation = animation;
+    so.morphWeight = morphWeight;
+    Validator v(vo);
+    std::vector<std::string> lines(parts.size());
+    std::string header;
+    size_t passed = 0;
+    std::vector<std::string> failed = forEachPart(parts, [&](const GltfPart& part) {
+      size_t i = static_cast<size_t>(&part - parts.data());
+      lines[i] = fmt::format("  FAIL  {}  ({}): not run, see the error above", part.name, part.ref);
+      GltfImportOptions io;
+      io.mesh = part.mesh;
+      io.primitive = part.primitive;
+      GltfImport model = importGltf(parseGltfRef(part.ref).file, io);
+      GltfSceneInfo info;
+      ValidationScene scene = gltfScene(model, so, &info);
+      if (header.empty()) {
+        std::string ts;
+        for (double t : info.times) ts += fmt::format("{}{:g}", ts.empty() ? "" : ", ", t);
+        header = fmt::format("model '{}' ({} primitives), {}, t = {}\n", model.data.file, parts.size(),
+                             info.animation.empty() ? std::string("no animation (rest pose)")
+                                                    : fmt::format("animation '{}' [{:g}, {:g}] s", info.animation,
+                                                                  info.start, info.end),
+                             ts);
+        std::cout << header;
+      }
+      GenerateOptions gen = vo.gen;
+      gen.rigPath = part.ref;
+      ValidateReport report = v.run(scene, gen);
+      std::string kind = model.joints > 0 ? fmt::format("skinned ({} joints)", model.joints) : "rigid";
+      if (model.morphTargets > 0) kind += fmt::format(", {} morph target(s)", model.morphTargets);
+      std::cout << fmt::format("== {} ({}): {} vertices, {}\n", part.name, part.ref, scene.mesh.vertexCount, kind);
+      bool weighted = false;
+      for (const auto& pose : scene.poses)
+        for (float w : pose.morphWeights) weighted = weighted || w != 0.0f;
+      if (model.morphTargets > 0 && !weighted)
+        std::cout << "note: every morph weight is 0 at these times, so the targets are not exercised (--morph-weight W "
+                     "sets them)\n";
+      std::cout << formatReport(report);
+      lines[i] = fmt::format("  {}  {}  ({}): {} vertices, {}, plan cost {}", report.pass ? "PASS" : "FAIL", part.name,
+                             part.ref, scene.mesh.vertexCount, kind, report.runs.front().planCost);
+      if (!report.pass) throw InputError(SourceLoc{part.ref, 0, 0}, "outputs differ from their definitions (report above)");
+      ++passed;
+    });
+    std::cout << fmt::format("{} of {} primitive(s) pass:\n", passed, parts.size());
+    for (const auto& l : lines) std::cout << l << "\n";
+    failIfPartsFailed(vo.gen.rigPath, parts.size(), failed, "the model does not validate");
+    return 0;
+  }
 };
 
 }  // namespace
@@ -103,9 +163,13 @@ void registerValidate(CLI::App& app, CliState& state) {
   sub->add_option("--save-poses", cmd->savePoses, "Write the poses run (with drawn uniforms) to FILE, for --poses FILE");
   sub->add_flag("--strict", cmd->strict, "Fail outputs whose semantic has no definition (unchecked)");
   CLI::Validator finiteNonNegative = finiteNumber(false);  // no nan, inf or negative times and tolerances
-  sub->add_option("--time", cmd->times, "glTF rig (MODEL.glb#m/p): animation time in seconds (repeatable)")
+  sub->add_option("--time", cmd->times, "glTF rig (MODEL.glb#m/p or MODEL.glb#*): animation time in seconds (repeatable)")
       ->check(finiteNonNegative);
   sub->add_option("--animation", cmd->animation, "glTF rig: animation name or index (default: the first)");
+  sub->add_option("--morph-weight", cmd->morphWeight,
+                  "glTF rig: every morph target at this weight in place of the animation's (an expression held "
+                  "through the motion)")
+      ->check(finiteNumber(false));
   sub->add_flag("--cross-check", cmd->crossCheck, "Also force and check every alternative derivation");
   sub->add_option("--device", cmd->device, "Vulkan device name (substring); default lavapipe");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer");

@@ -69,13 +69,21 @@ void writeFilesAtomically(const std::vector<PendingFile>& files) {
   namespace fs = std::filesystem;
   const int pid = static_cast<int>(getpid());
   std::vector<std::string> temps;
+  std::vector<fs::path> createdDirs;  // parents first; removed again (when empty) on failure
   auto removeTemps = [&] {
     for (const auto& t : temps) std::remove(t.c_str());
+    for (auto d = createdDirs.rbegin(); d != createdDirs.rend(); ++d) {
+      std::error_code ec;
+      fs::remove(*d, ec);  // only an empty directory: one this run created
+    }
   };
   // 1. Every new file goes to "<path>.tmp.<pid>" next to its destination.
   for (const auto& f : files) {
     fs::path p(f.path);
     std::error_code ec;
+    std::vector<fs::path> missing;
+    for (fs::path d = p.parent_path(); !d.empty() && !fs::exists(d, ec); d = d.parent_path()) missing.push_back(d);
+    createdDirs.insert(createdDirs.end(), missing.rbegin(), missing.rend());
     if (p.has_parent_path()) fs::create_directories(p.parent_path(), ec);
     std::string tmp = fmt::format("{}.tmp.{}", f.path, pid);
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);

@@ -14,7 +14,8 @@ struct PendingFile {
 
 // Writes every file to "<path>.tmp.<pid>" first, then renames them all into place. If any
 // write or rename fails, existing outputs are left (or put back) as they were, new ones are
-// removed, and no temporary is left behind. Throws std::runtime_error naming the file.
+// removed, and no temporary (nor a directory this call created) is left behind. Throws
+// std::runtime_error naming the file.
 void writeFilesAtomically(const std::vector<PendingFile>& files);
 
 // Refuses (throws InputError) before anything is written: an output that resolves to one

@@ -31,15 +31,20 @@ std::vector<uint32_t> gridIndices(int rings, int segments) {
 
 void frameCamera(const rt::Mesh& mesh, const rt::RigShape& shape, const RenderCamera& cam, float aspect, rt::Pose& pose) {
   // The bounding sphere of the posed mesh (world positions from the reference).
-  std::vector<glm::vec4> world = rt::referenceValues("world.position", mesh, pose, shape);
+  std::vector<glm::vec3> world;
+  for (const auto& p : rt::referenceValues("world.position", mesh, pose, shape)) world.emplace_back(p);
+  frameCameraOn(world, cam, aspect, pose);
+}
+
+void frameCameraOn(const std::vector<glm::vec3>& world, const RenderCamera& cam, float aspect, rt::Pose& pose) {
   glm::vec3 lo(INFINITY), hi(-INFINITY);
   for (const auto& p : world) {
-    lo = glm::min(lo, glm::vec3(p));
-    hi = glm::max(hi, glm::vec3(p));
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
   }
   const glm::vec3 centre = 0.5f * (lo + hi);
   float radius = 0;
-  for (const auto& p : world) radius = std::max(radius, glm::length(glm::vec3(p) - centre));
+  for (const auto& p : world) radius = std::max(radius, glm::length(p - centre));
   radius = std::max(radius, 1e-3f);
   const float fovY = glm::radians(std::clamp(cam.fovYDegrees, 5.0f, 150.0f));
   const float fitFov = aspect < 1.0f ? 2.0f * std::atan(std::tan(0.5f * fovY) * aspect) : fovY;
@@ -51,6 +56,41 @@ void frameCamera(const rt::Mesh& mesh, const rt::RigShape& shape, const RenderCa
   const float nearZ = std::max(0.01f, distance - 2.0f * radius), farZ = distance + 2.0f * radius;
   pose.projection = glm::perspectiveRH_ZO(fovY, aspect, nearZ, farZ);
   pose.projection[1][1] *= -1.0f;  // Vulkan's clip-space Y points down
+}
+
+ModelPart modelPart(const RenderOptions& opts, const GltfPart& part) {
+  RenderOptions o = opts;
+  o.gen.rigPath = part.ref;
+  o.gen.capture = false;
+  ModelPart p;
+  p.name = part.name;
+  p.gen = generate(o.gen);
+  p.scene = renderScene(p.gen.in.rig, o);
+  return p;
+}
+
+void frameModel(std::vector<ModelPart>& parts, const RenderCamera& cam, float aspect) {
+  std::vector<glm::vec3> world;
+  for (const auto& p : parts)
+    for (const auto& w : rt::referenceValues("world.position", p.scene.mesh, p.scene.pose, p.scene.shape))
+      world.emplace_back(w);
+  for (auto& p : parts) frameCameraOn(world, cam, aspect, p.scene.pose);
+}
+
+rt::Image mergeByDepth(const std::vector<rt::Image>& images) {
+  if (images.empty()) throw std::logic_error("mergeByDepth: no images");
+  rt::Image out = images.front();
+  for (size_t i = 1; i < images.size(); ++i) {
+    const rt::Image& im = images[i];
+    if (im.width != out.width || im.height != out.height || im.depth.size() != out.depth.size())
+      throw std::logic_error("mergeByDepth: images of different sizes");
+    for (size_t px = 0; px < out.depth.size(); ++px)
+      if (im.depth[px] < out.depth[px]) {
+        out.depth[px] = im.depth[px];
+        std::memcpy(&out.rgba[px * 4], &im.rgba[px * 4], 4);
+      }
+  }
+  return out;
 }
 
 std::vector<uint32_t> triangleList(const std::vector<uint32_t>& indices, int mode, size_t vertexCount,
@@ -85,6 +125,7 @@ RenderScene renderScene(const Rig& rig, const RenderOptions& opts) {
     GltfSceneOptions so;
     so.times = {opts.time};
     so.animation = opts.animation;
+    so.morphWeight = opts.gltfMorphWeight;
     if (!model.data.indicesError.empty()) throw InputError(SourceLoc{ref.file, 0, 0}, model.data.indicesError);
     ValidationScene vs = gltfScene(model, so);
     RenderScene s;
@@ -200,6 +241,23 @@ RenderResult RenderSession::render(const GenerateResult& gen, const FragmentProg
   for (int a : gen.plan.actions) r.rules.push_back(gen.in.problem.actions[a].name);
   const auto& msgs = harness_->validationMessages();
   r.validationMessages.assign(msgs.begin() + static_cast<long>(before), msgs.end());
+  return r;
+}
+
+RenderResult RenderSession::renderModel(const std::vector<ModelPart>& parts, const FragmentProgram& fragment,
+                                        const std::vector<rt::Texture>& textures, const RenderOptions& opts,
+                                        std::vector<rt::Image>* partImages) {
+  std::vector<rt::Image> images;
+  RenderResult r;
+  for (const auto& p : parts) {
+    RenderResult one = render(p.gen, fragment, textures, p.scene, opts);
+    images.push_back(std::move(one.image));
+    r.planCost += one.planCost;
+    r.device = one.device;
+    r.validationMessages.insert(r.validationMessages.end(), one.validationMessages.begin(), one.validationMessages.end());
+  }
+  r.image = mergeByDepth(images);
+  if (partImages) *partImages = std::move(images);
   return r;
 }
 

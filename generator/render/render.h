@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,7 @@ struct RenderOptions {
   std::string animation;          // glTF rigs: animation name or index ("" = the first)
   uint32_t poseSeed = 0;          // 0 = rest pose (identity bones), else makeRandomPose(seed)
   float morphWeight = 0.5f;       // rest pose: every morph target's weight
+  std::optional<double> gltfMorphWeight;  // glTF rigs: every target's weight instead of the animation's
   RenderCamera camera;
   DawnLighting lighting;
   std::array<float, 4> background{0.06f, 0.06f, 0.08f, 1.0f};
@@ -62,6 +64,23 @@ std::vector<uint32_t> triangleList(const std::vector<uint32_t>& indices, int mod
 // Sets pose.cameraPosition/view/projection so the posed mesh (its reference world
 // positions) fills the image.
 void frameCamera(const rt::Mesh& mesh, const rt::RigShape& shape, const RenderCamera& cam, float aspect, rt::Pose& pose);
+// Same for any set of world-space points (a whole model's primitives together).
+void frameCameraOn(const std::vector<glm::vec3>& world, const RenderCamera& cam, float aspect, rt::Pose& pose);
+
+// One primitive of a whole model (MODEL.glb#*): its own generated program (no capture) and
+// its scene at opts.time, posed at its node (skinned: by its joints) as validation poses it.
+struct ModelPart {
+  std::string name;  // gltfPartName
+  GenerateResult gen;
+  RenderScene scene;
+};
+ModelPart modelPart(const RenderOptions& opts, const GltfPart& part);
+// One camera framing every part's posed world positions, set on every part's pose.
+void frameModel(std::vector<ModelPart>& parts, const RenderCamera& cam, float aspect);
+// Per pixel, the colour of the nearest surface among `images` (smallest depth; ties go to
+// the earlier image), which is what drawing them all in one depth-tested pass writes for
+// opaque surfaces. Every image has the same size; empty pixels keep the first's colour.
+rt::Image mergeByDepth(const std::vector<rt::Image>& images);
 
 // A fragment shader compiled from a file, with the descriptors it uses (glslang's reflection).
 struct FragmentProgram {
@@ -92,6 +111,12 @@ class RenderSession {
   // Draws an already generated program over a scene.
   RenderResult render(const GenerateResult& gen, const FragmentProgram& fragment, const std::vector<rt::Texture>& textures,
                       const RenderScene& scene, const RenderOptions& opts);
+  // A whole model: every part drawn with its own program under the parts' shared camera
+  // (frameModel), merged by depth. `partImages`, when given, receives each part's own image.
+  // planCost is the sum of the parts' costs.
+  RenderResult renderModel(const std::vector<ModelPart>& parts, const FragmentProgram& fragment,
+                           const std::vector<rt::Texture>& textures, const RenderOptions& opts,
+                           std::vector<rt::Image>* partImages = nullptr);
 
  private:
   std::unique_ptr<rt::Harness> harness_;

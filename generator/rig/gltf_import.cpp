@@ -624,20 +624,64 @@ bool isGltfPath(const std::string& path) {
   return ext == ".gltf" || ext == ".glb";
 }
 
-GltfRef parseGltfRef(const std::string& path) {
+bool isWholeModelRef(const std::string& path) { return path.size() >= 2 && path.compare(path.size() - 2, 2, "#*") == 0; }
+
+GltfRef parseGltfRef(const std::string& path, bool allowWholeModel) {
   GltfRef r;
   auto hash = path.rfind('#');
   std::string base = hash == std::string::npos ? path : path.substr(0, hash);
   std::string ext = lower(std::filesystem::path(base).extension().string());
   if (hash != std::string::npos && (ext == ".gltf" || ext == ".glb")) {
     r.file = base;
-    if (!parseSelection(path.substr(hash + 1), r.mesh, r.primitive))
-      fail(base, fmt::format("'{}' does not select a primitive: expected MODEL{}#MESH/PRIMITIVE, e.g. '{}#0/0'",
-                             path.substr(hash), ext, base));
+    if (path.substr(hash) == "#*") {
+      if (!allowWholeModel)
+        fail(base, fmt::format("'{}' names every primitive of the model; this command takes one: {}#MESH/PRIMITIVE, "
+                               "e.g. '{}#0/0' (validate, generate, render, rig import and build take the whole model)",
+                               path, base, base));
+      r.wholeModel = true;
+    } else if (!parseSelection(path.substr(hash + 1), r.mesh, r.primitive)) {
+      fail(base, fmt::format("'{}' does not select a primitive: expected MODEL{}#MESH/PRIMITIVE (e.g. '{}#0/0') or "
+                             "MODEL{}#* (every primitive)",
+                             path.substr(hash), ext, base, ext));
+    }
   } else {
     r.file = path;
   }
   return r;
+}
+
+std::string gltfPartName(int mesh, int primitive, const std::string& meshName) {
+  std::string name = fmt::format("m{}p{}", mesh, primitive);
+  if (meshName.empty()) return name;
+  std::string safe = meshName.substr(0, 48);
+  for (char& c : safe)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') c = '_';
+  return name + "-" + safe;
+}
+
+std::vector<GltfPart> gltfParts(const std::string& file) {
+  tinygltf::Model model;
+  loadChecked(file, nullptr, "", model);
+  std::vector<GltfPart> parts;
+  size_t total = 0;
+  for (const auto& m : model.meshes) total += m.primitives.size();
+  if (total == 0)
+    fail(file, fmt::format("'{}#*' names every mesh primitive of the model, and it has none ({} mesh(es))", file,
+                           model.meshes.size()));
+  if (total > kMaxGltfParts)
+    fail(file, fmt::format("the model has {} mesh primitives; a whole model (#*) takes at most {} (kMaxGltfParts)",
+                           total, kMaxGltfParts));
+  for (size_t m = 0; m < model.meshes.size(); ++m)
+    for (size_t p = 0; p < model.meshes[m].primitives.size(); ++p) {
+      GltfPart part;
+      part.mesh = static_cast<int>(m);
+      part.primitive = static_cast<int>(p);
+      part.meshName = model.meshes[m].name;
+      part.name = gltfPartName(part.mesh, part.primitive, part.meshName);
+      part.ref = fmt::format("{}#{}/{}", file, m, p);
+      parts.push_back(std::move(part));
+    }
+  return parts;
 }
 
 size_t loadGltfModel(const std::string& file, tinygltf::Model& model) { return loadChecked(file, nullptr, "", model); }

@@ -41,17 +41,41 @@ constexpr size_t kMaxGltfDecodedBytes = size_t{1} << 30;
 constexpr size_t kMinGltfDecodedBudget = size_t{64} << 20;
 constexpr size_t kGltfDecodedPerInputByte = 256;
 
-// "model.glb", "model.gltf", "model.glb#1/0" (mesh 1, primitive 0).
+// "model.glb", "model.gltf", "model.glb#1/0" (mesh 1, primitive 0), "model.glb#*" (every
+// primitive of every mesh: the model as a whole).
 struct GltfRef {
   std::string file;
   int mesh = 0;
   int primitive = 0;
+  bool wholeModel = false;
 };
 // True if the path names a glTF model (extension .gltf/.glb, case-insensitive, optionally
-// followed by "#mesh/primitive").
+// followed by "#mesh/primitive" or "#*").
 bool isGltfPath(const std::string& path);
-// Splits the optional "#m/p" suffix. Throws InputError on a malformed suffix.
-GltfRef parseGltfRef(const std::string& path);
+// True if the path ends in "#*" (any file: a YAML rig with "#*" is refused by the callers
+// that take whole models, with the reason).
+bool isWholeModelRef(const std::string& path);
+// Splits the optional "#m/p" or "#*" suffix. Throws InputError on a malformed suffix, and on
+// "#*" unless `allowWholeModel` (the command takes one primitive).
+GltfRef parseGltfRef(const std::string& path, bool allowWholeModel = false);
+
+// Primitives of a whole model (MODEL.glb#*), at most kMaxGltfParts.
+constexpr size_t kMaxGltfParts = 1024;
+// One primitive of a whole model and its name: "m<mesh>p<primitive>" plus "-<mesh name>"
+// when the mesh is named, the name's characters outside [A-Za-z0-9._-] replaced by '_' and
+// cut to 48 bytes ("m2p1-Head", "m0p0-fox1", "m3p0"). The index prefix keeps names unique,
+// stable across runs and in the file's order; they are safe file stems.
+struct GltfPart {
+  int mesh = 0, primitive = 0;
+  std::string meshName;  // as in the file ("" when unnamed)
+  std::string name;      // "m2p1-Head"
+  std::string ref;       // "MODEL.glb#2/1", for every command that takes one primitive
+};
+std::string gltfPartName(int mesh, int primitive, const std::string& meshName);
+// Every primitive of every mesh of the model, in the file's order (meshes, then primitives).
+// Reads the model with every check of importGltf. Throws InputError for a model without
+// mesh primitives and for more than kMaxGltfParts.
+std::vector<GltfPart> gltfParts(const std::string& file);
 
 struct GltfImportOptions {
   int mesh = 0;

@@ -263,7 +263,11 @@ ValidationScene gltfScene(const GltfImport& model, const GltfSceneOptions& opts,
   }
   inf.times = opts.times;
   if (inf.times.empty()) inf.times = {inf.start, inf.start + 0.4 * (inf.end - inf.start)};
-  for (double t : inf.times) s.poses.push_back(gltfPose(model, s.mesh, s.shape, anim, t));
+  for (double t : inf.times) {
+    s.poses.push_back(gltfPose(model, s.mesh, s.shape, anim, t));
+    if (opts.morphWeight)
+      std::fill(s.poses.back().morphWeights.begin(), s.poses.back().morphWeights.end(), static_cast<float>(*opts.morphWeight));
+  }
   if (info) *info = inf;
   return s;
 }

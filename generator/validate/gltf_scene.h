@@ -4,6 +4,7 @@
 #pragma once
 #include <glm/glm.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,10 @@ struct GltfSceneOptions {
   // times, the start and 40% into the animation (or 0 and 1 without animations).
   std::vector<double> times;
   std::string animation;  // name or index; "" = the first animation (rest pose if none)
+  // Every morph target at this weight in place of the animation's and the defaults (an
+  // expression held through the motion): models whose animations leave the weights at 0,
+  // such as RobotExpressive's, otherwise never exercise their targets.
+  std::optional<double> morphWeight;
 };
 
 // What was posed, for reports.

@@ -293,11 +293,13 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
   return rep;
 }
 
-ValidateReport Validator::run(const ValidationScene& scene) {
+ValidateReport Validator::run(const ValidationScene& scene) { return run(scene, opts_.gen); }
+
+ValidateReport Validator::run(const ValidationScene& scene, const GenerateOptions& options) {
   ValidateReport report;
   report.device = harness_->deviceName();
   report.validationLayers = harness_->validationEnabled();
-  GenerateOptions gen = opts_.gen;
+  GenerateOptions gen = options;
   gen.capture = true;
   // The buffer forms must fit this mesh (+1: the harness draws an even count).
   if (gen.maxVertices == 0) gen.maxVertices = static_cast<int64_t>(scene.mesh.vertexCount) + 1;

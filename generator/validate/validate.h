@@ -94,6 +94,8 @@ class Validator {
   // Generates (capture build), runs every pose, compares. With crossCheck, repeats for
   // every alternative derivation of each semantic in the plan.
   ValidateReport run(const ValidationScene& scene);
+  // Same with other generation options (another primitive of a whole model, on this device).
+  ValidateReport run(const ValidationScene& scene, const GenerateOptions& gen);
   // One generation result on the scene (no cross-check); exposed for tests and benchmarks.
   RunReport runOne(const GenerateResult& r, const ValidationScene& scene, const std::string& label);
   // The device it runs on (render and bench draw on the same one).

@@ -3,9 +3,11 @@
 #include <fmt/format.h>
 
 #include <filesystem>
+#include <map>
 #include <set>
 
 #include "common/yaml_util.h"
+#include "rig/gltf_import.h"
 
 namespace sg {
 namespace {
@@ -74,6 +76,7 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
     if (m.emit.empty()) y.fail(root["emit"], "'emit' is empty: nothing to write");
   }
 
+  std::map<std::string, std::vector<std::string>> wholeModels;  // rig name -> its primitives' rig names
   if (!root["rigs"]) y.fail(root, "the manifest needs 'rigs' (name: rig file)");
   y.expectMap(root["rigs"], "'rigs'");
   for (const auto& kv : root["rigs"]) {
@@ -82,7 +85,28 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
     r.loc = locOf(kv.first, file);
     r.path = resolvePath(file, y.scalar(kv.second, "a rig file"));
     if (!safeStem(r.name)) y.fail(kv.first, fmt::format("rig name '{}' must be letters, digits, '-', '_' or '.'", r.name));
-    m.rigs.push_back(r);
+    if (!isWholeModelRef(r.path)) {
+      m.rigs.push_back(r);
+      continue;
+    }
+    // A whole model (MODEL.glb#*): one rig per primitive, "<name>.<part name>".
+    if (!isGltfPath(r.path))
+      y.fail(kv.second, fmt::format("'#*' selects every primitive of a glTF model (.gltf, .glb); '{}' is not one",
+                                    r.path.substr(0, r.path.size() - 2)));
+    std::vector<GltfPart> parts;
+    try {
+      parts = gltfParts(parseGltfRef(r.path, true).file);
+    } catch (const InputError& e) {
+      y.fail(kv.second, fmt::format("rig '{}': {}: {}", r.name, e.diagnostic().loc.file, e.diagnostic().message));
+    }
+    std::vector<std::string>& members = wholeModels[r.name];
+    for (const auto& part : parts) {
+      ManifestRig pr = r;
+      pr.name = r.name + "." + part.name;
+      pr.path = part.ref;
+      members.push_back(pr.name);
+      m.rigs.push_back(pr);
+    }
   }
   if (!root["passes"]) y.fail(root, "the manifest needs 'passes' (name: fragment shader)");
   y.expectMap(root["passes"], "'passes'");
@@ -121,6 +145,17 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
       a.name = y.scalar(kv.first, "an axis name");
       a.loc = locOf(kv.first, file);
       a.values = scalarOrList(y, kv.second, "axis values");
+      if (a.name == "rig") {  // a whole model's name stands for each of its primitives
+        std::vector<std::string> values;
+        for (const auto& v : a.values) {
+          auto whole = wholeModels.find(v);
+          if (whole == wholeModels.end())
+            values.push_back(v);
+          else
+            values.insert(values.end(), whole->second.begin(), whole->second.end());
+        }
+        a.values = values;
+      }
       if (a.values.empty()) y.fail(kv.second, fmt::format("axis '{}' has no values", a.name));
       std::set<std::string> seen;
       for (size_t i = 0; i < a.values.size(); ++i)

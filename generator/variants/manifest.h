@@ -22,6 +22,9 @@ struct ManifestPass {
 };
 
 struct ManifestRig {
+  // A whole model (`name: MODEL.glb#*`) becomes one rig per primitive, named
+  // "<name>.<part name>" (rig/gltf_import.h gltfPartName: "robot.m2p1-Head"); a rig axis value
+  // that names the model stands for all of them.
   std::string name;
   std::string path;  // YAML rig or MODEL.glb#m/p
   SourceLoc loc;

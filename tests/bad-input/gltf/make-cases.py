@@ -207,6 +207,34 @@ case("generate-with-hostile-rig", {"m.gltf": text(model([pos(byteOffset=18446744
      "generate --rig @D/m.gltf#0/0 -f examples/dawn/face.frag -r rules/standard.yaml -o @O/face", 1,
      "@D/m.gltf: error:", "reads bytes 18446744073709551600")
 
+# Whole models (MODEL.glb#*, docs/gltf.md#whole-models).
+two_meshes = model([POS, pos(byteOffset=18446744073709551600)], extra={
+    "meshes": [{"name": "good", "primitives": [{"attributes": {"POSITION": 0}}]},
+               {"name": "bad", "primitives": [{"attributes": {"POSITION": 1}}]}],
+    "nodes": [{"mesh": 0}, {"mesh": 1}], "scenes": [{"nodes": [0, 1]}]})
+case("whole-generate-hostile-primitive", {"m.gltf": text(two_meshes)},
+     "generate --rig @D/m.gltf#* -f tests/gltf/data/minimal.frag -r rules/standard.yaml -o @O/shaders", 1,
+     "@D/m.gltf#1/0: error: primitive m1p0-bad failed:", "reads bytes 18446744073709551600",
+     "@D/m.gltf#*: error: 1 of 2 primitive(s) failed (m1p0-bad); nothing was written")
+case("whole-rig-import-hostile-primitive", {"m.gltf": text(two_meshes)}, "rig import @D/m.gltf#* -o @O/rigs", 1,
+     "primitive m1p0-bad failed", "1 of 2 primitive(s) failed (m1p0-bad); nothing was written")
+no_meshes = {"asset": {"version": "2.0"}, "nodes": [{"name": "empty"}], "scenes": [{"nodes": [0]}]}
+case("whole-no-meshes", {"m.gltf": text(no_meshes)},
+     "validate --rig @D/m.gltf#* -f tests/gltf/data/minimal.frag -r rules/standard.yaml --time 0", 1,
+     "@D/m.gltf: error: '@D/m.gltf#*' names every mesh primitive of the model, and it has none (0 mesh(es))")
+case("whole-yaml-rig", {},
+     "generate --rig examples/dawn/face.rig.yaml#* -f examples/dawn/face.frag -r rules/standard.yaml -o @O/shaders", 1,
+     "error: '#*' selects every primitive of a glTF model (.gltf, .glb)")
+case("whole-explain-takes-one", {"m.gltf": text(model([POS]))},
+     "explain --rig @D/m.gltf#* -f tests/gltf/data/minimal.frag -r rules/standard.yaml", 1,
+     "names every primitive of the model; this command takes one")
+case("whole-rig-import-needs-output", {"m.gltf": text(model([POS]))}, "rig import @D/m.gltf#*", 2,
+     "-o: is required with a whole model")
+case("whole-rig-import-mesh-option", {"m.gltf": text(model([POS]))}, "rig import @D/m.gltf#* --mesh 0 -o @O/rigs", 2,
+     "--mesh: does not apply")
+case("whole-selection-malformed", {"m.gltf": text(model([POS]))}, "rig import @D/m.gltf#** -o @O/rigs", 1,
+     "'#**' does not select a primitive", "or MODEL.gltf#* (every primitive)")
+
 
 def main():
     for name in sorted(os.listdir(HERE)):

@@ -1,0 +1,308 @@
+// Whole models (MODEL.glb#*, docs/gltf.md#whole-models): part names, and every command over
+// the shared Fox and three.js's RobotExpressive (rigid meshes on animated nodes, a morphed
+// head, skinned hands; tests/gltf/data/RobotExpressive).
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "gltf_test_util.h"
+#include "render/render.h"
+#include "rig/gltf_import.h"
+#include "variants/manifest.h"
+
+namespace sg {
+namespace {
+
+namespace fs = std::filesystem;
+using test::dataPath;
+using test::modelPath;
+using test::sourcePath;
+
+std::string robot() { return dataPath("RobotExpressive/RobotExpressive.glb"); }
+
+struct CliRun {
+  int status = -1;
+  std::string out;  // standard output and error together
+};
+
+CliRun cli(const std::string& args) {
+  std::string cmd = fmt::format("XDG_RUNTIME_DIR=/tmp \"{}\" {} 2>&1", SG_CLI, args);
+  CliRun r;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  std::array<char, 4096> buf{};
+  size_t n = 0;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
+  int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+fs::path scratch(const std::string& name) {
+  fs::path d = fs::temp_directory_path() / ("sg_whole_" + name);
+  fs::remove_all(d);
+  return d;
+}
+
+// The 19 primitives of RobotExpressive, named from its JSON (mesh names, primitive counts).
+const std::vector<std::string> kRobotParts = {
+    "m0p0-Foot.L",     "m1p0-Torso", "m1p1-Torso",  "m2p0-Head",       "m2p1-Head",       "m2p2-Head",
+    "m3p0-Foot.R",     "m4p0-Shoulder.L", "m5p0-Arm.L", "m6p0-Shoulder.R", "m7p0-Arm.R",  "m8p0-Leg.L",
+    "m9p0-LowerLeg.L", "m10p0-Leg.R", "m11p0-LowerLeg.R", "m12p0-Hand.R", "m12p1-Hand.R", "m13p0-Hand.L",
+    "m13p1-Hand.L"};
+
+TEST(WholeModel, PartNamesAreIndexedSanitizedAndUnique) {
+  EXPECT_EQ(gltfPartName(2, 1, "Head"), "m2p1-Head");
+  EXPECT_EQ(gltfPartName(3, 0, ""), "m3p0");
+  EXPECT_EQ(gltfPartName(0, 0, "../a b/\xc3\xa9"), "m0p0-.._a_b___");
+  EXPECT_EQ(gltfPartName(1, 2, std::string(100, 'x')), "m1p2-" + std::string(48, 'x'));
+  // Two meshes of one name still differ (the index prefix).
+  EXPECT_NE(gltfPartName(0, 0, "Cube"), gltfPartName(1, 0, "Cube"));
+
+  std::vector<GltfPart> parts = gltfParts(robot());
+  std::vector<std::string> names;
+  for (const auto& p : parts) names.push_back(p.name);
+  EXPECT_EQ(names, kRobotParts);
+  EXPECT_EQ(parts[4].ref, robot() + "#2/1");
+  EXPECT_EQ(parts[4].meshName, "Head");
+  EXPECT_EQ(parseGltfRef(robot() + "#*", true).wholeModel, true);
+  EXPECT_THROW(parseGltfRef(robot() + "#*"), InputError);  // commands that take one primitive
+}
+
+// The model's kinds of primitive, as the import sees them: what "rigid, skinned and morphed
+// parts together" means for this model.
+TEST(WholeModel, RobotHasRigidSkinnedAndMorphedParts) {
+  int rigid = 0, skinned = 0, morphed = 0;
+  for (const auto& p : gltfParts(robot())) {
+    GltfImportOptions o;
+    o.mesh = p.mesh;
+    o.primitive = p.primitive;
+    GltfImport imp = importGltf(robot(), o);
+    if (imp.joints > 0) ++skinned;
+    if (imp.morphTargets > 0) ++morphed;
+    if (imp.joints == 0 && imp.morphTargets == 0) ++rigid;
+  }
+  EXPECT_EQ(rigid, 12);
+  EXPECT_EQ(skinned, 4);  // the hands, 43 joints each
+  EXPECT_EQ(morphed, 3);  // the head's primitives: Angry, Surprised, Sad
+}
+
+// Done-when of issue 24: one command validates every primitive, at two times, for the Fox
+// and for the robot (with an expression held, so the head's targets are exercised).
+TEST(WholeModel, ValidateEveryPrimitiveOfFoxAndRobotAtTwoTimes) {
+  CliRun fox = cli(fmt::format("validate --rig \"{}#*\" -f \"{}\" -r \"{}\" --animation Run --time 0.25 --time 0.8",
+                            modelPath("Fox/Fox.glb"), dataPath("uv.frag"), sourcePath("rules/standard.yaml")));
+  EXPECT_EQ(fox.status, 0) << fox.out;
+  EXPECT_NE(fox.out.find("1 of 1 primitive(s) pass"), std::string::npos) << fox.out;
+  EXPECT_NE(fox.out.find("PASS  m0p0-fox1"), std::string::npos) << fox.out;
+
+  CliRun r = cli(fmt::format("validate --rig \"{}#*\" -f \"{}\" -r \"{}\" --animation Dance --time 0.6 --time 2.1 "
+                          "--morph-weight 0.6",
+                          robot(), dataPath("lit.frag"), sourcePath("rules/standard.yaml")));
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("19 of 19 primitive(s) pass"), std::string::npos) << r.out;
+  for (const auto& name : kRobotParts)
+    EXPECT_NE(r.out.find("PASS  " + name + "  "), std::string::npos) << name << "\n" << r.out;
+  EXPECT_NE(r.out.find("m12p0-Hand.R  (" + robot() + "#12/0): "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("skinned (43 joints)"), std::string::npos);
+  EXPECT_NE(r.out.find("rigid, 3 morph target(s)"), std::string::npos);
+  EXPECT_EQ(r.out.find("not exercised"), std::string::npos) << "--morph-weight must reach the head";
+}
+
+// A broken rule that only the morphed primitives use (the position deltas counted twice):
+// the command fails and names exactly the primitive it breaks, m2p2-Head, the eyebrows:
+// the head's other two primitives have targets whose position deltas are all zero (their
+// accessors' min and max are 0), so doubling them changes nothing. The others still pass.
+TEST(WholeModel, PlantedRuleFailureNamesTheMorphedPrimitives) {
+  fs::path d = scratch("broken_rule");
+  fs::create_directories(d);
+  std::ofstream(d / "broken.yaml") << "include: [" << sourcePath("rules/standard.yaml") << "]\n"
+                                   << R"(rules:
+  - name: object_position_morphed
+    override: true
+    produces: object.position
+    needs: [vertex.position, "morph.position[*]", morph.weights]
+    when: has(morph.position)
+    cost: morph_targets
+    glsl: |
+      ${out} = ${vertex.position};
+      @for i in morph_targets
+      ${out} += 2.0 * ${morph.weights}[${i}] * ${morph.position[i]};
+      @end
+)";
+  CliRun r = cli(fmt::format("validate --rig \"{}#*\" -f \"{}\" -r \"{}\" --animation Wave --time 0.5 --morph-weight 0.8",
+                          robot(), dataPath("lit.frag"), (d / "broken.yaml").string()));
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("18 of 19 primitive(s) pass"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("RobotExpressive.glb#*: error: 1 of 19 primitive(s) failed (m2p2-Head); the model does not validate"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("FAIL  m2p2-Head  "), std::string::npos);
+  EXPECT_NE(r.out.find("RobotExpressive.glb#2/2: error: primitive m2p2-Head failed"), std::string::npos);
+  EXPECT_NE(r.out.find("PASS  m2p1-Head  "), std::string::npos);
+  EXPECT_NE(r.out.find("PASS  m12p0-Hand.R  "), std::string::npos);
+  EXPECT_NE(r.out.find("PASS  m1p0-Torso  "), std::string::npos);
+  fs::remove_all(d);
+}
+
+// generate and rig import write one set of outputs per primitive and an index; a hostile
+// primitive makes them fail naming it, with nothing written (not even the directory).
+TEST(WholeModel, GenerateAndImportWriteEveryPrimitiveOrNothing) {
+  fs::path out = scratch("generate");
+  CliRun g = cli(fmt::format("generate -q --rig \"{}#*\" -f \"{}\" -r \"{}\" -o \"{}\" --emit glsl,spv,reflection", robot(),
+                          dataPath("lit.frag"), sourcePath("rules/standard.yaml"), out.string()));
+  ASSERT_EQ(g.status, 0) << g.out;
+  std::ifstream in(out / "index.json");
+  nlohmann::json index = nlohmann::json::parse(in);
+  ASSERT_EQ(index["primitives"].size(), kRobotParts.size());
+  for (size_t i = 0; i < kRobotParts.size(); ++i) {
+    const auto& e = index["primitives"][i];
+    EXPECT_EQ(e["name"], kRobotParts[i]);
+    EXPECT_EQ(e["rig"], fmt::format("{}#{}/{}", robot(), e["mesh"].get<int>(), e["primitive"].get<int>()));
+    ASSERT_EQ(e["files"].size(), 3u);
+    for (const auto& f : e["files"]) EXPECT_TRUE(fs::is_regular_file(out / f.get<std::string>())) << f;
+  }
+  // Each primitive's program is the one `generate --rig MODEL#m/p` makes.
+  fs::path one = scratch("generate_one.vert");
+  CliRun single = cli(fmt::format("generate -q --rig \"{}#12/1\" -f \"{}\" -r \"{}\" -o \"{}\" --emit glsl", robot(),
+                               dataPath("lit.frag"), sourcePath("rules/standard.yaml"), one.string()));
+  ASSERT_EQ(single.status, 0) << single.out;
+  auto slurp = [](const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+  };
+  std::string a = slurp(out / "m12p1-Hand.R.vert"), b = slurp(one);
+  // The GLSL names its own output file in a comment; the program is otherwise identical.
+  auto strip = [](std::string s, const std::string& name) {
+    for (size_t p; (p = s.find(name)) != std::string::npos;) s.erase(p, name.size());
+    return s;
+  };
+  EXPECT_EQ(strip(a, (out / "m12p1-Hand.R.vert").string()), strip(b, one.string()));
+  EXPECT_NE(a.find("bones"), std::string::npos);  // the hand is skinned
+
+  fs::path rigs = scratch("rigs");
+  CliRun imp = cli(fmt::format("rig import -q \"{}#*\" -o \"{}\"", robot(), rigs.string()));
+  ASSERT_EQ(imp.status, 0) << imp.out;
+  for (const auto& name : kRobotParts) EXPECT_TRUE(fs::is_regular_file(rigs / (name + ".yaml"))) << name;
+  Rig head = loadRigFile((rigs / "m2p1-Head.yaml").string());
+  EXPECT_EQ(head.name, "RobotExpressive/Head/1");
+  EXPECT_EQ(head.morphTargets(), 3);
+
+  // A model whose second mesh is hostile: nothing is written, the primitive is named.
+  fs::path bad = scratch("hostile");
+  fs::create_directories(bad);
+  std::ofstream(bad / "m.gltf")
+      << R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}],)"
+         R"("bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"},)"
+         R"({"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","byteOffset":400}],)"
+         R"("meshes":[{"name":"good","primitives":[{"attributes":{"POSITION":0}}]},{"name":"bad","primitives":[{"attributes":{"POSITION":1}}]}],)"
+         R"("nodes":[{"mesh":0},{"mesh":1}],"scenes":[{"nodes":[0,1]}]})";
+  fs::path none = bad / "out" / "shaders";
+  CliRun fail = cli(fmt::format("generate -q --rig \"{}#*\" -f \"{}\" -r \"{}\" -o \"{}\"", (bad / "m.gltf").string(),
+                             dataPath("minimal.frag"), sourcePath("rules/standard.yaml"), none.string()));
+  EXPECT_EQ(fail.status, 1) << fail.out;
+  EXPECT_NE(fail.out.find("error: primitive m1p0-bad failed"), std::string::npos) << fail.out;
+  EXPECT_NE(fail.out.find("1 of 2 primitive(s) failed (m1p0-bad); nothing was written"), std::string::npos) << fail.out;
+  EXPECT_FALSE(fs::exists(bad / "out")) << "a failed whole-model generate left a directory";
+  fs::remove_all(out);
+  fs::remove_all(one);
+  fs::remove_all(rigs);
+  fs::remove_all(bad);
+}
+
+// A manifest's whole-model rig is one rig per primitive; a rig axis value naming the model
+// stands for all of them, and exclusions name the parts.
+TEST(WholeModel, ManifestExpandsAWholeModelIntoOneRigPerPrimitive) {
+  std::string text = fmt::format(R"(rules: {}
+rigs:
+  robot: {}#*
+  face: {}
+passes:
+  lit: {}
+axes:
+  rig: [face, robot]
+exclude:
+  - {{ rig: robot.m2p1-Head }}
+)",
+                                 sourcePath("rules/standard.yaml"), robot(), sourcePath("examples/dawn/face.rig.yaml"),
+                                 dataPath("lit.frag"));
+  Manifest m = loadManifestText(text, "m.yaml");
+  ASSERT_EQ(m.rigs.size(), 1 + kRobotParts.size());
+  EXPECT_EQ(m.rigs[0].name, "robot.m0p0-Foot.L");
+  EXPECT_EQ(m.rigs[0].path, robot() + "#0/0");
+  EXPECT_EQ(m.rigs.back().name, "face");
+  std::vector<Variant> vs = expandVariants(m);
+  ASSERT_EQ(vs.size(), 1 + kRobotParts.size() - 1);
+  EXPECT_EQ(vs[0].name, "face-lit");
+  EXPECT_EQ(vs[1].name, "robot.m0p0-Foot.L-lit");
+  for (const auto& v : vs) EXPECT_NE(v.name, "robot.m2p1-Head-lit");
+
+  EXPECT_THROW(loadManifestText("rules: r.yaml\nrigs:\n  r: face.rig.yaml#*\npasses:\n  p: x.frag\n", "m.yaml"),
+               InputError);
+}
+
+// The whole model drawn: the picture covers exactly the union of the primitives' own
+// silhouettes under the same camera, each pixel shows the nearest primitive, and the
+// rigid parts are drawn at their animated nodes (the union is larger than any one part).
+TEST(WholeModel, RenderCoversTheUnionOfThePrimitivesSilhouettes) {
+  fs::path png = scratch("robot.png");
+  const std::string frag = dataPath("lit.frag");
+  CliRun r = cli(fmt::format("render --rig \"{}#*\" -f \"{}\" -r \"{}\" --animation Wave --time 0.9 --size 160x200 -o \"{}\"",
+                          robot(), frag, sourcePath("rules/standard.yaml"), png.string()));
+  ASSERT_EQ(r.status, 0) << r.out;
+  rt::Image whole = readPng(png.string());
+
+  RenderOptions ro;
+  ro.gen.rigPath = robot() + "#*";
+  ro.gen.fragmentPath = frag;
+  ro.gen.rulesPaths = {sourcePath("rules/standard.yaml")};
+  ro.animation = "Wave";
+  ro.time = 0.9;
+  ro.width = 160;
+  ro.height = 200;
+  std::vector<ModelPart> parts;
+  for (const auto& p : gltfParts(robot())) parts.push_back(modelPart(ro, p));
+  frameModel(parts, ro.camera, 160.0f / 200.0f);
+  RenderSession session("", false);
+  FragmentProgram fp = compileFragmentFile(frag, ro.gen.targetEnv);
+  std::vector<rt::Texture> textures = texturesFor(fp, ro.lighting);
+  std::vector<rt::Image> own;
+  for (const auto& p : parts) own.push_back(session.render(p.gen, fp, textures, p.scene, ro).image);
+
+  size_t unionCovered = 0, largest = 0, mismatched = 0;
+  for (const auto& im : own) {
+    size_t c = 0;
+    for (float d : im.depth) c += d < 1.0f;
+    EXPECT_GT(c, 0u) << "a primitive is not in the picture";
+    largest = std::max(largest, c);
+  }
+  for (size_t px = 0; px < whole.rgba.size() / 4; ++px) {
+    size_t nearest = SIZE_MAX;
+    for (size_t i = 0; i < own.size(); ++i)
+      if (own[i].depth[px] < 1.0f && (nearest == SIZE_MAX || own[i].depth[px] < own[nearest].depth[px])) nearest = i;
+    const uint8_t* w = &whole.rgba[px * 4];
+    // lit.frag never writes the background's colour (its grey is at least 0.2).
+    bool covered = !(w[0] == 15 && w[1] == 15 && w[2] == 20);
+    if (nearest != SIZE_MAX) ++unionCovered;
+    if (covered != (nearest != SIZE_MAX)) {
+      ++mismatched;
+      continue;
+    }
+    if (nearest != SIZE_MAX && std::memcmp(w, &own[nearest].rgba[px * 4], 3) != 0) ++mismatched;
+  }
+  EXPECT_EQ(mismatched, 0u);
+  EXPECT_GT(unionCovered, largest + largest / 2) << "the parts do not add up to a character";
+  fs::remove(png);
+}
+
+}  // namespace
+}  // namespace sg
