@@ -224,7 +224,7 @@ ImageObj& ProgramObjects::image(VkFormat format, uint32_t w, uint32_t h, uint32_
 // A texture with its full mip chain, made shader-readable in this command buffer: level 0
 // is copied from a staging buffer, each further level is a linear blit of the one above
 // (half the size, so each texel averages a 2x2 block of its parent). Without the chain a
-// minified map aliases: the procedural skin maps shimmered into blocky highlights.
+// minified map aliases: each pixel shows whichever texels its centre happens to hit.
 void ProgramObjects::uploadTexture(const Texture& t) {
   const uint32_t faces = t.cube ? 6 : 1;
   uint32_t mips = 1;

@@ -41,6 +41,7 @@ TangentResult bakeTangents(const std::vector<Vec3>& positions, const std::vector
     dPdv /= lv;
     for (int k = 0; k < 3; ++k) {
       double a = cornerAngle(p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
+      if (!(a > 0)) continue;  // a degenerate corner (or NaN positions) adds nothing
       sumU[t[k]] += a * dPdu;
       sumV[t[k]] += a * dPdv;
     }
