@@ -27,7 +27,8 @@ struct StorageBufferData {
   std::vector<uint8_t> data;  // non-empty
 };
 
-// A sampled texture at set 1, `binding` (combined image sampler, linear filtering).
+// A sampled texture at set 1, `binding` (combined image sampler, trilinear filtering: the
+// runtime makes the full mip chain from `data`, each level a linear blit of the one above).
 struct Texture {
   uint32_t binding = 0;
   bool cube = false;  // 6 faces in Vulkan order +X, -X, +Y, -Y, +Z, -Z

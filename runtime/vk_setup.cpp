@@ -51,9 +51,10 @@ const char* kindName(DescriptorKind k) {
   return "descriptor";
 }
 
+// Moves mip levels [baseMip, baseMip + mips) of every layer from one layout to another.
 void imageBarrier(VkCommandBuffer cmd, VkImage image, uint32_t layers, VkImageLayout from, VkImageLayout to,
                   VkAccessFlags srcAccess, VkAccessFlags dstAccess, VkPipelineStageFlags srcStage,
-                  VkPipelineStageFlags dstStage) {
+                  VkPipelineStageFlags dstStage, uint32_t baseMip = 0, uint32_t mips = 1) {
   VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
   b.srcAccessMask = srcAccess;
   b.dstAccessMask = dstAccess;
@@ -61,7 +62,7 @@ void imageBarrier(VkCommandBuffer cmd, VkImage image, uint32_t layers, VkImageLa
   b.newLayout = to;
   b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.image = image;
-  b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, layers};
+  b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, baseMip, mips, 0, layers};
   vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr, 1, &b);
 }
 
@@ -193,14 +194,14 @@ Buffer& ProgramObjects::buffer(VkDeviceSize size, VkBufferUsageFlags usage, Memo
 }
 
 ImageObj& ProgramObjects::image(VkFormat format, uint32_t w, uint32_t h, uint32_t layers, bool cube, VkImageUsageFlags usage,
-                                VkImageAspectFlags aspect) {
+                                VkImageAspectFlags aspect, uint32_t mipLevels) {
   ImageObj& img = images_.emplace_back();
   VkImageCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
   ci.flags = cube ? VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT : 0;
   ci.imageType = VK_IMAGE_TYPE_2D;
   ci.format = format;
   ci.extent = {w, h, 1};
-  ci.mipLevels = 1;
+  ci.mipLevels = mipLevels;
   ci.arrayLayers = layers;
   ci.samples = VK_SAMPLE_COUNT_1_BIT;
   ci.tiling = VK_IMAGE_TILING_OPTIMAL;
@@ -215,9 +216,59 @@ ImageObj& ProgramObjects::image(VkFormat format, uint32_t w, uint32_t h, uint32_
   vci.image = img.image;
   vci.viewType = cube ? VK_IMAGE_VIEW_TYPE_CUBE : VK_IMAGE_VIEW_TYPE_2D;
   vci.format = format;
-  vci.subresourceRange = {aspect, 0, 1, 0, layers};
+  vci.subresourceRange = {aspect, 0, mipLevels, 0, layers};
   check(vkCreateImageView(d_.h.device, &vci, nullptr, &img.view), "vkCreateImageView");
   return img;
+}
+
+// A texture with its full mip chain, made shader-readable in this command buffer: level 0
+// is copied from a staging buffer, each further level is a linear blit of the one above
+// (half the size, so each texel averages a 2x2 block of its parent). Without the chain a
+// minified map aliases: each pixel shows whichever texels its centre happens to hit.
+void ProgramObjects::uploadTexture(const Texture& t) {
+  const uint32_t faces = t.cube ? 6 : 1;
+  uint32_t mips = 1;
+  while ((t.size >> mips) > 0) ++mips;  // floor(log2(size)) + 1
+  VkFormatProperties fp{};
+  vkGetPhysicalDeviceFormatProperties(d_.h.physicalDevice, t.format, &fp);
+  const VkFormatFeatureFlags need =
+      VK_FORMAT_FEATURE_BLIT_SRC_BIT | VK_FORMAT_FEATURE_BLIT_DST_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT;
+  if ((fp.optimalTilingFeatures & need) != need)  // required for both formats by the Vulkan spec
+    throw std::runtime_error(fmt::format("vulkan: texture format {} cannot be blitted and filtered linearly on this device",
+                                         static_cast<int>(t.format)));
+  ImageObj& img = image(t.format, t.size, t.size, faces, t.cube,
+                        VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+                        VK_IMAGE_ASPECT_COLOR_BIT, mips);
+  Buffer& staging = buffer(t.data.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, Memory::Upload);
+  std::memcpy(staging.mapped, t.data.data(), t.data.size());
+  imageBarrier(cmd_, img.image, faces, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
+               VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, mips);
+  VkBufferImageCopy copy{};
+  copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, faces};
+  copy.imageExtent = {t.size, t.size, 1};
+  vkCmdCopyBufferToImage(cmd_, staging.buffer, img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
+  for (uint32_t m = 1; m < mips; ++m) {
+    imageBarrier(cmd_, img.image, faces, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                 VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                 VK_PIPELINE_STAGE_TRANSFER_BIT, m - 1, 1);
+    const int32_t from = static_cast<int32_t>(t.size >> (m - 1)), to = static_cast<int32_t>(t.size >> m);
+    VkImageBlit blit{};
+    blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, m - 1, 0, faces};
+    blit.srcOffsets[1] = {from, from, 1};
+    blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, m, 0, faces};
+    blit.dstOffsets[1] = {to, to, 1};
+    vkCmdBlitImage(cmd_, img.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                   &blit, VK_FILTER_LINEAR);
+  }
+  // Levels above the last were blit sources; the last is still a copy/blit destination.
+  if (mips > 1)
+    imageBarrier(cmd_, img.image, faces, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                 VK_ACCESS_TRANSFER_READ_BIT, VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                 VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, mips - 1);
+  imageBarrier(cmd_, img.image, faces, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+               VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+               VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, mips - 1, 1);
+  textures_.push_back(&img);
 }
 
 ProgramObjects::ProgramObjects(const Device& device, const ProgramInputs& inputs, const PassDesc& pass)
@@ -251,24 +302,7 @@ ProgramObjects::ProgramObjects(const Device& device, const ProgramInputs& inputs
     if (rasterize_) {
       index_ = &buffer(pass_.indices->size() * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, Memory::Upload);
       std::memcpy(index_->mapped, pass_.indices->data(), pass_.indices->size() * 4);
-      // Textures: staged, copied, made shader-readable in this command buffer.
-      for (const Texture& t : in_.textures) {
-        const uint32_t faces = t.cube ? 6 : 1;
-        ImageObj& img = image(t.format, t.size, t.size, faces, t.cube, VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
-                              VK_IMAGE_ASPECT_COLOR_BIT);
-        Buffer& staging = buffer(t.data.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, Memory::Upload);
-        std::memcpy(staging.mapped, t.data.data(), t.data.size());
-        imageBarrier(cmd_, img.image, faces, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
-                     VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
-        VkBufferImageCopy copy{};
-        copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, faces};
-        copy.imageExtent = {t.size, t.size, 1};
-        vkCmdCopyBufferToImage(cmd_, staging.buffer, img.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
-        imageBarrier(cmd_, img.image, faces, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                     VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                     VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT);
-        textures_.push_back(&img);
-      }
+      for (const Texture& t : in_.textures) uploadTexture(t);
     }
     createDescriptors();
     createTargets();
@@ -355,9 +389,9 @@ void ProgramObjects::createDescriptors() {
   if (rasterize_) {
     VkSamplerCreateInfo sci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
     sci.magFilter = sci.minFilter = VK_FILTER_LINEAR;
-    sci.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
+    sci.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;  // trilinear over the chain uploadTexture makes
     sci.addressModeU = sci.addressModeV = sci.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT;
-    sci.maxLod = 0;
+    sci.maxLod = VK_LOD_CLAMP_NONE;
     check(vkCreateSampler(dev, &sci, nullptr, &samplerRepeat_), "vkCreateSampler");
     sci.addressModeU = sci.addressModeV = sci.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
     check(vkCreateSampler(dev, &sci, nullptr, &samplerClamp_), "vkCreateSampler");

@@ -94,7 +94,8 @@ class ProgramObjects {
 
  private:
   ImageObj& image(VkFormat format, uint32_t w, uint32_t h, uint32_t layers, bool cube, VkImageUsageFlags usage,
-                  VkImageAspectFlags aspect);
+                  VkImageAspectFlags aspect, uint32_t mipLevels = 1);
+  void uploadTexture(const Texture& t);
   void checkInputs() const;
   void release();
   void createDescriptors();

@@ -1,4 +1,4 @@
-// glTF side of the occlusion baker. tinygltf's implementation is compiled once, in
+// glTF side of the bakers (occlusion, tangents). tinygltf's implementation is compiled once, in
 // rig/gltf_load.cpp; vertex data is decoded by the rig import (sparse accessors,
 // normalized formats) so the baker sees exactly what `rig import` and validation see.
 // The same configuration as the implementation (the class's defaults depend on it).
@@ -17,9 +17,11 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <sstream>
 
+#include "bake/tangents.h"
 #include "common/diagnostics.h"
 #include "rig/gltf_import.h"
 #include "validate/gltf_scene.h"
@@ -212,8 +214,9 @@ uint64_t streamOf(int mesh, int primitive, int target, size_t vertex) {
              vertex);
 }
 
-// Appends `values` as a float SCALAR accessor (in buffer 0) and returns its index.
-int appendScalarAccessor(tinygltf::Model& m, const std::vector<float>& values) {
+// Appends `values` (`components` floats per element: SCALAR, VEC3 or VEC4) as an accessor in
+// buffer 0 and returns its index.
+int appendFloatAccessor(tinygltf::Model& m, const std::vector<float>& values, int components) {
   if (m.buffers.empty()) m.buffers.emplace_back();
   auto& buf = m.buffers[0].data;
   while (buf.size() % 4) buf.push_back(0);
@@ -228,28 +231,25 @@ int appendScalarAccessor(tinygltf::Model& m, const std::vector<float>& values) {
   tinygltf::Accessor a;
   a.bufferView = static_cast<int>(m.bufferViews.size()) - 1;
   a.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
-  a.type = TINYGLTF_TYPE_SCALAR;
-  a.count = values.size();
-  if (!values.empty()) {
-    auto [lo, hi] = std::minmax_element(values.begin(), values.end());
-    a.minValues = {*lo};
-    a.maxValues = {*hi};
+  a.type = components == 1 ? TINYGLTF_TYPE_SCALAR : components == 3 ? TINYGLTF_TYPE_VEC3 : TINYGLTF_TYPE_VEC4;
+  const size_t c = static_cast<size_t>(components);
+  a.count = values.size() / c;
+  if (a.count > 0) {  // min and max per component (required for morph target POSITION only; kept for all)
+    a.minValues.assign(c, std::numeric_limits<double>::infinity());
+    a.maxValues.assign(c, -std::numeric_limits<double>::infinity());
+    for (size_t i = 0; i < values.size(); ++i) {
+      a.minValues[i % c] = std::min<double>(a.minValues[i % c], values[i]);
+      a.maxValues[i % c] = std::max<double>(a.maxValues[i % c], values[i]);
+    }
   }
   m.accessors.push_back(a);
   return static_cast<int>(m.accessors.size()) - 1;
 }
 
-}  // namespace
-
-GltfBakeResult bakeGltfOcclusion(const std::string& file, const GltfBakeOptions& opts) {
-  tinygltf::Model model;
-  size_t inputBytes = loadGltfModel(file, model);  // the rig import's checked loader (docs/limits.md)
+// Every primitive of the model decoded as the rig import decodes it, with its triangles.
+std::vector<PrimitiveData> decodePrimitives(const tinygltf::Model& model, size_t inputBytes, const std::string& file) {
   if (model.meshes.empty()) fail(file, "the model has no meshes: nothing to bake");
-  GltfBakeResult result;
-
-  // Decode every primitive as the rig import does.
   std::vector<PrimitiveData> prims;
-  std::map<std::pair<int, int>, size_t> primIndex;
   for (size_t m = 0; m < model.meshes.size(); ++m)
     for (size_t p = 0; p < model.meshes[m].primitives.size(); ++p) {
       PrimitiveData d;
@@ -261,10 +261,47 @@ GltfBakeResult bakeGltfOcclusion(const std::string& file, const GltfBakeOptions&
       d.imp = importGltfModel(model, inputBytes, file, io);  // parsed once, not per primitive
       d.triangles = primitiveTriangles(model, model.meshes[m].primitives[p], d.imp.data.vertexCount, file,
                                        fmt::format("mesh '{}' primitive {}", d.imp.data.meshName, p));
-      primIndex[{d.mesh, d.primitive}] = prims.size();
       prims.push_back(std::move(d));
     }
   if (prims.empty()) fail(file, "the model's meshes have no primitives: nothing to bake");
+  return prims;
+}
+
+// The output file: every buffer embedded (buffer 0 in the GLB binary chunk, the others as
+// data URIs); `inputs` gets the model and its buffer files, `notes` the images left external.
+std::string serialise(tinygltf::Model& model, const std::string& file, bool binary, std::vector<std::string>& inputs,
+                      std::vector<std::string>& notes) {
+  for (const auto& img : model.images)
+    if (!img.uri.empty() && img.uri.rfind("data:", 0) != 0)
+      notes.push_back(fmt::format("image '{}' stays an external reference ('{}'), relative to the output file",
+                                  img.name, img.uri));
+  inputs.push_back(file);
+  for (const auto& b : model.buffers)
+    if (!b.uri.empty() && b.uri.rfind("data:", 0) != 0)
+      inputs.push_back((std::filesystem::path(file).parent_path() / b.uri).string());
+  for (auto& b : model.buffers) b.uri.clear();
+  tinygltf::TinyGLTF writer;
+  std::ostringstream os;
+  if (!writer.WriteGltfSceneToStream(&model, os, !binary, binary)) fail(file, "cannot serialise the baked model");
+  return os.str();
+}
+
+std::vector<Vec3> vec3Stream(const GltfModelData& d, const std::string& name) {
+  std::vector<Vec3> out;
+  for (const auto& v : d.streams.at(name)) out.push_back({v[0], v[1], v[2]});
+  return out;
+}
+
+}  // namespace
+
+GltfBakeResult bakeGltfOcclusion(const std::string& file, const GltfBakeOptions& opts) {
+  tinygltf::Model model;
+  size_t inputBytes = loadGltfModel(file, model);  // the rig import's checked loader (docs/limits.md)
+  GltfBakeResult result;
+
+  std::vector<PrimitiveData> prims = decodePrimitives(model, inputBytes, file);
+  std::map<std::pair<int, int>, size_t> primIndex;
+  for (size_t i = 0; i < prims.size(); ++i) primIndex[{prims[i].mesh, prims[i].primitive}] = i;
   const GltfModelData& sceneData = prims[0].imp.data;  // nodes, skins, animations: the same for all
 
   int anim = -1;
@@ -388,7 +425,7 @@ GltfBakeResult bakeGltfOcclusion(const std::string& file, const GltfBakeOptions&
                               baseOcc.begin() + static_cast<long>(firstPoint[i] + n));
     auto& prim = model.meshes[static_cast<size_t>(p.mesh)].primitives[static_cast<size_t>(p.primitive)];
     replaced |= prim.attributes.count("_OCCLUSION") != 0;
-    prim.attributes["_OCCLUSION"] = appendScalarAccessor(model, values);
+    prim.attributes["_OCCLUSION"] = appendFloatAccessor(model, values, 1);
     BakedPrimitive bp;
     bp.mesh = p.mesh;
     bp.primitive = p.primitive;
@@ -400,7 +437,7 @@ GltfBakeResult bakeGltfOcclusion(const std::string& file, const GltfBakeOptions&
     bp.meanOcclusion = n ? sum / static_cast<double>(n) : 0;
     for (int tgt = 0; tgt < p.imp.morphTargets; ++tgt) {
       const auto& d = deltas[i][static_cast<size_t>(tgt)];
-      prim.targets[static_cast<size_t>(tgt)]["_OCCLUSION"] = appendScalarAccessor(model, d);
+      prim.targets[static_cast<size_t>(tgt)]["_OCCLUSION"] = appendFloatAccessor(model, d, 1);
       double s = 0;
       for (float v : d) s += std::fabs(v);
       bp.meanAbsTargetDelta.push_back(n ? s / static_cast<double>(n) : 0);
@@ -408,23 +445,59 @@ GltfBakeResult bakeGltfOcclusion(const std::string& file, const GltfBakeOptions&
     result.primitives.push_back(std::move(bp));
   }
   if (replaced) result.notes.push_back("the model already had _OCCLUSION attributes: they are replaced");
-  for (const auto& img : model.images)
-    if (!img.uri.empty() && img.uri.rfind("data:", 0) != 0)
-      result.notes.push_back(fmt::format("image '{}' stays an external reference ('{}'), relative to the output file",
-                                         img.name, img.uri));
+  result.bytes = serialise(model, file, opts.binary, result.inputs, result.notes);
+  return result;
+}
 
-  result.inputs.push_back(file);
-  for (const auto& b : model.buffers)
-    if (!b.uri.empty() && b.uri.rfind("data:", 0) != 0)
-      result.inputs.push_back((std::filesystem::path(file).parent_path() / b.uri).string());
 
-  // Every buffer is embedded: buffer 0 in the GLB binary chunk, the others as data URIs.
-  for (auto& b : model.buffers) b.uri.clear();
-  tinygltf::TinyGLTF writer;
-  std::ostringstream os;
-  if (!writer.WriteGltfSceneToStream(&model, os, !opts.binary, opts.binary))
-    fail(file, "cannot serialise the baked model");
-  result.bytes = os.str();
+GltfTangentResult bakeGltfTangents(const std::string& file, bool binary) {
+  tinygltf::Model model;
+  size_t inputBytes = loadGltfModel(file, model);
+  GltfTangentResult result;
+  for (const PrimitiveData& p : decodePrimitives(model, inputBytes, file)) {
+    const GltfModelData& d = p.imp.data;
+    const std::string where = fmt::format("mesh '{}' primitive {}", d.meshName, p.primitive);
+    auto& prim = model.meshes[static_cast<size_t>(p.mesh)].primitives[static_cast<size_t>(p.primitive)];
+    if (prim.attributes.count("TANGENT")) {
+      result.notes.push_back(where + " keeps its own TANGENT");
+      continue;
+    }
+    if (!d.streams.count("vertex.normal") || !d.streams.count("vertex.texcoord0")) {
+      result.notes.push_back(where + " has no NORMAL or no TEXCOORD_0: no tangents");
+      continue;
+    }
+    if (p.triangles.empty()) {
+      result.notes.push_back(where + " has no triangles: no tangents");
+      continue;
+    }
+    std::vector<Vec2> uvs;
+    for (const auto& v : d.streams.at("vertex.texcoord0")) uvs.push_back({v[0], v[1]});
+    std::vector<Vec3> pos = vec3Stream(d, "vertex.position"), nrm = vec3Stream(d, "vertex.normal");
+    TangentResult base = bakeTangents(pos, nrm, uvs, p.triangles);
+    std::vector<float> flat;
+    for (const Vec4& t : base.tangents) flat.insert(flat.end(), t.begin(), t.end());
+    prim.attributes["TANGENT"] = appendFloatAccessor(model, flat, 4);
+    // Each target's shape gets its own frames; its TANGENT delta is the difference of xyz
+    // (glTF morphs no handedness).
+    for (int tgt = 0; tgt < p.imp.morphTargets; ++tgt) {
+      std::vector<Vec3> tp = pos, tn = nrm;
+      auto add = [&](std::vector<Vec3>& to, const std::string& name) {
+        auto it = d.streams.find(fmt::format("{}[{}]", name, tgt));
+        if (it == d.streams.end()) return;
+        for (size_t v = 0; v < to.size(); ++v)
+          for (int c = 0; c < 3; ++c) to[v][static_cast<size_t>(c)] += it->second[v][static_cast<size_t>(c)];
+      };
+      add(tp, "morph.position");
+      add(tn, "morph.normal");
+      TangentResult shape = bakeTangents(tp, tn, uvs, p.triangles);
+      std::vector<float> delta;
+      for (size_t v = 0; v < pos.size(); ++v)
+        for (size_t c = 0; c < 3; ++c) delta.push_back(shape.tangents[v][c] - base.tangents[v][c]);
+      prim.targets[static_cast<size_t>(tgt)]["TANGENT"] = appendFloatAccessor(model, delta, 3);
+    }
+    result.primitives.push_back({p.mesh, p.primitive, d.meshName, d.vertexCount, p.imp.morphTargets, base.fallbacks});
+  }
+  result.bytes = serialise(model, file, binary, result.inputs, result.notes);
   return result;
 }
 

@@ -45,4 +45,25 @@ struct GltfBakeResult {
 // import cannot decode.
 GltfBakeResult bakeGltfOcclusion(const std::string& file, const GltfBakeOptions& opts);
 
+// `shadergen bake tangents`: a TANGENT (VEC4 float, bake/tangents.h) on every primitive that
+// has NORMAL and TEXCOORD_0 but no TANGENT, and on each of its morph targets a TANGENT delta
+// (the target shape's frames minus the base's). Primitives that have tangents keep them.
+struct TangentPrimitive {
+  int mesh = 0, primitive = 0;
+  std::string meshName;
+  size_t vertices = 0;
+  int targets = 0;
+  size_t fallbacks = 0;  // vertices without a texture direction (orthonormal basis of the normal)
+};
+
+struct GltfTangentResult {
+  std::string bytes;                      // the output file
+  std::vector<TangentPrimitive> primitives;  // the primitives that got tangents
+  std::vector<std::string> notes;         // primitives left as they were, external images
+  std::vector<std::string> inputs;        // the model and its buffer files
+};
+
+// Throws InputError as bakeGltfOcclusion does. `binary`: .glb, else .gltf with embedded buffers.
+GltfTangentResult bakeGltfTangents(const std::string& file, bool binary);
+
 }  // namespace sg::bake

@@ -146,9 +146,11 @@ class BruteForceCaster final : public RayCaster {
   std::vector<Tri> tris_;
 };
 
+}  // namespace
+
 // Orthonormal basis around a unit normal (Duff et al. 2017, "Building an orthonormal basis,
 // revisited"): continuous everywhere but the sign flip at z = 0, no normalisation needed.
-void basis(const Vec3& n, Vec3& t, Vec3& b) {
+void orthonormalBasis(const Vec3& n, Vec3& t, Vec3& b) {
   float sign = std::copysign(1.0f, n[2]);
   float a = -1.0f / (sign + n[2]);
   float c = n[0] * n[1] * a;
@@ -156,7 +158,6 @@ void basis(const Vec3& n, Vec3& t, Vec3& b) {
   b = {c, sign + n[1] * n[1] * a, -n[1]};
 }
 
-}  // namespace
 
 int RayCaster::countOccluded(const Vec3& origin, const std::vector<Vec3>& dirs, float tnear, float tfar) const {
   int hits = 0;
@@ -199,7 +200,7 @@ Vec3 hemisphereDirection(const Vec3& n, Distribution dist, uint64_t seed, uint64
   double phi = kTwoPi * u2;
   double x = sinT * std::cos(phi), y = sinT * std::sin(phi);
   Vec3 t, b;
-  basis(n, t, b);
+  orthonormalBasis(n, t, b);
   Vec3 d;
   for (size_t c = 0; c < 3; ++c) d[c] = static_cast<float>(x * t[c] + y * b[c] + cosT * n[c]);
   return d;

@@ -74,6 +74,10 @@ std::vector<float> bakeOcclusion(const RayCaster& caster, const std::vector<Bake
 std::vector<float> bakeOcclusion(const TriangleSoup& scene, const std::vector<BakePoint>& points,
                                  const OcclusionOptions& opts);
 
+// Orthonormal basis (t, b) around a unit normal (Duff et al. 2017, "Building an orthonormal
+// basis, revisited"): continuous everywhere but the sign flip at z = 0.
+void orthonormalBasis(const Vec3& unitNormal, Vec3& t, Vec3& b);
+
 // The i-th direction of a point's hemisphere (exposed for tests): unit length, dot(d, n) >= 0.
 Vec3 hemisphereDirection(const Vec3& unitNormal, Distribution d, uint64_t seed, uint64_t stream, int i);
 

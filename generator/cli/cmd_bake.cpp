@@ -1,5 +1,6 @@
 // `shadergen bake occlusion MODEL.glb -o OUT.glb [options]`: per-vertex occlusion of a glTF
-// model, base shape and morph targets, stored as _OCCLUSION attributes (docs/bake.md).
+// model, base shape and morph targets, stored as _OCCLUSION attributes; `shadergen bake
+// tangents MODEL.glb -o OUT.glb`: TANGENT frames from normals and UVs (docs/bake.md).
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -21,6 +22,25 @@ std::string lowerExtension(const std::string& path) {
   return e;
 }
 
+// True for a .glb output, false for .gltf; anything else is a usage error. Refuses an output
+// that names the model (before baking; its buffer files are known after: writeBaked).
+bool binaryOutput(const std::string& model, const std::string& output) {
+  std::string ext = lowerExtension(output);
+  if (ext != ".glb" && ext != ".gltf")
+    throw CLI::ValidationError("--output", fmt::format("'{}' must end in .glb or .gltf", output));
+  refuseClobbering({output}, {{model, "the glTF model"}});
+  return ext == ".glb";
+}
+
+// Writes the baked model unless `output` is the model or one of its buffer files (`inputs`).
+void writeBaked(const std::string& model, const std::string& output, const std::string& bytes,
+                const std::vector<std::string>& inputs) {
+  std::vector<InputFile> files;
+  for (const auto& in : inputs) files.push_back({in, in == model ? "the glTF model" : "a buffer file of the model"});
+  refuseClobbering({output}, files);
+  writeFilesAtomically({PendingFile{output, bytes}});
+}
+
 struct BakeOcclusionCommand {
   std::string model;
   std::string output;
@@ -35,11 +55,8 @@ struct BakeOcclusionCommand {
   bool quiet = false;
 
   int run() {
-    std::string ext = lowerExtension(output);
-    if (ext != ".glb" && ext != ".gltf")
-      throw CLI::ValidationError("--output", fmt::format("'{}' must end in .glb or .gltf", output));
     if (!animation.empty() && !time) throw CLI::ValidationError("--animation", "needs --time");
-    refuseClobbering({output}, {{model, "the glTF model"}});  // before the (long) bake; buffer files after
+    const bool binary = binaryOutput(model, output);  // before the (long) bake
     bake::GltfBakeOptions o;
     o.occlusion.rays = rays;
     o.occlusion.distribution = distribution == "cosine" ? bake::Distribution::Cosine : bake::Distribution::Uniform;
@@ -49,7 +66,7 @@ struct BakeOcclusionCommand {
     o.occlusion.threads = threads;
     o.time = time;
     o.animation = animation;
-    o.binary = ext == ".glb";
+    o.binary = binary;
     bool tty = !quiet && isatty(STDERR_FILENO);
     if (tty)
       o.progress = [](int pass, int passes, const std::string& what, size_t done, size_t total) {
@@ -60,10 +77,7 @@ struct BakeOcclusionCommand {
     bake::GltfBakeResult r = bake::bakeGltfOcclusion(model, o);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (tty) std::cerr << "\r\033[K" << std::flush;
-    std::vector<InputFile> inputs;
-    for (const auto& in : r.inputs) inputs.push_back({in, in == model ? "the glTF model" : "a buffer file of the model"});
-    refuseClobbering({output}, inputs);
-    writeFilesAtomically({PendingFile{output, r.bytes}});
+    writeBaked(model, output, r.bytes, r.inputs);
     if (!quiet) {
       for (const auto& n : r.notes) std::cerr << fmt::format("{}: warning: {}\n", model, n);
       size_t vertices = 0;
@@ -79,6 +93,25 @@ struct BakeOcclusionCommand {
                                "({:.1f} Mrays/s); wrote {}\n",
                                model, vertices, r.triangles, r.passes, r.rays, rays, distribution, seconds,
                                seconds > 0 ? static_cast<double>(r.rays) / seconds * 1e-6 : 0.0, output);
+    }
+    return 0;
+  }
+};
+
+struct BakeTangentsCommand {
+  std::string model;
+  std::string output;
+  bool quiet = false;
+
+  int run() {
+    bake::GltfTangentResult r = bake::bakeGltfTangents(model, binaryOutput(model, output));
+    writeBaked(model, output, r.bytes, r.inputs);
+    if (!quiet) {
+      for (const auto& n : r.notes) std::cerr << fmt::format("{}: warning: {}\n", model, n);
+      for (const auto& p : r.primitives)
+        std::cout << fmt::format("mesh {} '{}' primitive {}: {} vertices, {} target(s), {} without a texture direction\n",
+                                 p.mesh, p.meshName, p.primitive, p.vertices, p.targets, p.fallbacks);
+      std::cout << fmt::format("{}: tangents for {} primitive(s); wrote {}\n", model, r.primitives.size(), output);
     }
     return 0;
   }
@@ -111,6 +144,14 @@ void registerBake(CLI::App& app, CliState& state) {
   occ->add_option("--animation", cmd->animation, "With --time: animation name or index (default: the first)");
   occ->add_flag("-q,--quiet", cmd->quiet, "No progress, summary or warnings");
   occ->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
+
+  auto tan = std::make_shared<BakeTangentsCommand>();
+  CLI::App* tc = bake->add_subcommand(
+      "tangents", "TANGENT frames from normals and TEXCOORD_0 for primitives without them, morph targets included");
+  tc->add_option("model", tan->model, "glTF model (.gltf or .glb)")->required();
+  tc->add_option("-o,--output", tan->output, "Output model (.glb, or .gltf with embedded buffers)")->required();
+  tc->add_flag("-q,--quiet", tan->quiet, "No summary or warnings");
+  tc->callback([tan, &state] { state.run = [tan] { return tan->run(); }; });
 }
 
 }  // namespace sg

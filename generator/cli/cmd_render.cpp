@@ -154,6 +154,9 @@ void registerRender(CLI::App& app, CliState& state) {
       ->check(CLI::Range(0.1f, 10.0f));
   sub->add_option("--light", cmd->light, "Direction towards the key light, x,y,z (world space)");
   sub->add_option("--rim-light", cmd->rim, "Direction of the hilight cube map's rim light, x,y,z");
+  sub->add_option("--texture-size", cmd->ro.lighting.textureSize,
+                  "Side of listing 3-4's procedural 2D maps in texels (default 1024; mipmapped)")
+      ->check(CLI::Range(1, 4096));
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 
   auto bench = std::make_shared<BenchCommand>();

@@ -69,7 +69,7 @@ glm::vec4 normalSideSpec(float u, float v) {
   };
   float dx = (height(u + e, v) - height(u - e, v)) / (2.0f * e);
   float dy = (height(u, v + e) - height(u, v - e)) / (2.0f * e);
-  glm::vec3 n = glm::normalize(glm::vec3(-0.0012f * dx, -0.0012f * dy, 1.0f));
+  glm::vec3 n = glm::normalize(glm::vec3(-0.0006f * dx, -0.0006f * dy, 1.0f));
   return glm::vec4(n, 0.25f + 0.2f * valueNoise(u, v, 16, 5));
 }
 
@@ -90,9 +90,12 @@ glm::vec4 diffuseEnv(const glm::vec3& d, const DawnLighting& l) {
   return glm::vec4(l.ambient * (0.6f + 0.8f * sky) + l.keyColor * key, 1.0f);
 }
 glm::vec4 specularEnv(const glm::vec3& d, const DawnLighting& l) {
-  float key = std::pow(std::max(0.0f, glm::dot(d, unit(l.keyDirection))), 24.0f);
+  float cosKey = std::max(0.0f, glm::dot(d, unit(l.keyDirection)));
+  float key = std::pow(cosKey, 24.0f), sheen = cosKey * cosKey * cosKey;
   float sky = 0.5f + 0.5f * d.y;
-  return glm::vec4(l.ambient * 0.5f * sky + l.keyColor * 2.0f * key, 0.2f + 0.6f * key);
+  // The broad lobe is warm: light that skin scatters back is reddened (section 3.2's look).
+  glm::vec3 warm(1.0f, 0.74f, 0.62f);
+  return glm::vec4(l.ambient * 0.6f * sky + l.keyColor * (0.9f * sheen * warm + 1.5f * key), 0.2f + 0.6f * key);
 }
 glm::vec4 hilightEnv(const glm::vec3& d, const DawnLighting& l) {
   float rim = std::pow(std::max(0.0f, glm::dot(d, unit(l.rimDirection))), 4.0f);

@@ -17,8 +17,8 @@ struct DawnLighting {
   glm::vec3 keyColor{3.2f, 2.9f, 2.6f};      // HDR: above 1 where the light is
   glm::vec3 rimDirection{-0.6f, 0.3f, -0.7f}; // the hilight cube's back/rim light
   glm::vec3 ambient{0.35f, 0.36f, 0.42f};
-  uint32_t textureSize = 256;  // 2D maps (size x size)
-  uint32_t cubeSize = 32;      // each cube face
+  uint32_t textureSize = 1024;  // 2D maps (size x size); fine enough that a close-up does not magnify them
+  uint32_t cubeSize = 64;      // each cube face: 1.4-degree texels, small beside the cos^24 lobe (~14 degrees)
 };
 
 // One texture per sampler of listing 3-4, by the sampler's name:
