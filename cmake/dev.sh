@@ -22,6 +22,7 @@ packages=(
   libglpk-dev
   libembree-dev
   libpng-dev
+  spirv-cross libspirv-cross-c-shared-dev
 )
 missing=()
 for p in "${packages[@]}"; do
