@@ -146,38 +146,37 @@ INSTANTIATE_TEST_SUITE_P(Passes, DawnHlsl, ::testing::ValuesIn(kPasses),
 // A planted error in the HLSL path fails validation: two output semantics swapped (the
 // pixel shader would read each value in the other's place), or two vertex input semantics
 // swapped (the input layout would feed each stream to the other).
-TEST(HlslPlantedErrors, SwappedOutputSemanticsFailExactlyThoseOutputs) {
+// The face through HLSL, one run at a time (runOne), for planting errors in its text.
+struct FaceViaHlsl {
   GenerateOptions gen = dawnOptions("face.rig.yaml", "face.frag");
-  ValidateOptions vo;
-  vo.gen = gen;
-  vo.via = ValidateVia::Hlsl;
-  Validator v(vo);
+  Validator validator{ValidateOptions{gen, ValidateVia::Hlsl}};
   ValidationScene scene = proceduralScene(loadRigFile(gen.rigPath), "head", 7, 2);
   GenerateResult r = generate(gen);
-  ASSERT_TRUE(v.runOne(r, scene, "as emitted").pass);
+  RunReport run(const std::string& label) { return validator.runOne(r, scene, label); }
+};
+
+TEST(HlslPlantedErrors, SwappedOutputSemanticsFailExactlyThoseOutputs) {
+  FaceViaHlsl face;
+  GenerateResult& r = face.r;
+  ASSERT_TRUE(face.run("as emitted").pass);
   // WorldTanMatrixX (TEXCOORD0) and WorldEyeDir (TEXCOORD3) are both float3.
   ASSERT_NE(r.hlsl->text.find("float3 WorldTanMatrixX : TEXCOORD0;"), std::string::npos) << r.hlsl->text;
   ASSERT_NE(r.hlsl->text.find("float3 WorldEyeDir : TEXCOORD3;"), std::string::npos);
   r.hlsl->text = swapped(r.hlsl->text, "TEXCOORD0;", "TEXCOORD3;", "struct SPIRV_Cross_Output");
-  RunReport bad = v.runOne(r, scene, "semantics swapped");
+  RunReport bad = face.run("semantics swapped");
   EXPECT_FALSE(bad.pass);
   for (const auto& o : bad.outputs)
     EXPECT_EQ(o.pass, o.name != "WorldTanMatrixX" && o.name != "WorldEyeDir") << o.name;
 }
 
 TEST(HlslPlantedErrors, SwappedInputSemanticsFail) {
-  GenerateOptions gen = dawnOptions("face.rig.yaml", "face.frag");
-  ValidateOptions vo;
-  vo.gen = gen;
-  vo.via = ValidateVia::Hlsl;
-  Validator v(vo);
-  ValidationScene scene = proceduralScene(loadRigFile(gen.rigPath), "head", 7, 2);
-  GenerateResult r = generate(gen);
+  FaceViaHlsl face;
+  GenerateResult& r = face.r;
   // a_normal and a_tangent are both float4: swapping their semantics type-checks everywhere.
   ASSERT_NE(r.hlsl->text.find("float4 a_normal : TEXCOORD1;"), std::string::npos) << r.hlsl->text;
   ASSERT_NE(r.hlsl->text.find("float4 a_tangent : TEXCOORD2;"), std::string::npos);
   r.hlsl->text = swapped(r.hlsl->text, "TEXCOORD1;", "TEXCOORD2;", "struct SPIRV_Cross_Input");
-  RunReport bad = v.runOne(r, scene, "input semantics swapped");
+  RunReport bad = face.run("input semantics swapped");
   EXPECT_FALSE(bad.pass);
   for (const auto& o : bad.outputs)
     if (o.name == "gl_Position" || o.name == "SkinUVST") EXPECT_TRUE(o.pass) << o.name;  // read neither
