@@ -7,6 +7,11 @@
 #     [OUTPUT_NAME <name>]      # default: the fragment shader's name without extension
 #     [OPTIMIZE]                # -O (spirv-opt)
 #     [EMBED]                   # also <name>.spv.h (uint32_t <name>_spv[]), #include-able
+#     [HLSL]                    # also <name>.hlsl (Direct3D), translated from the SPIR-V (docs/hlsl-msl.md)
+#     [HLSL_SHADER_MODEL <sm>]  # 5.0 (default), 5.1, 6.0 .. 6.7 (needs HLSL)
+#     [MSL]                     # also <name>.metal (Metal)
+#     [MSL_VERSION <v>]         # 2.0 (default), 1.2, 2.1 .. 2.4, 3.0 (needs MSL)
+#     [MSL_PLATFORM <p>]        # macos (default), ios (needs MSL)
 #     [TARGET_ENV <env>]        # vulkan1.0 (default) .. vulkan1.3
 #     [CAPTURE]                 # transform-feedback build (to read outputs back with sg::rt::Harness)
 #     [MAP <Name=sem[,sem...]>...]  # --map overrides of fragment inputs
@@ -19,13 +24,14 @@
 # template), so editing any of them regenerates this shader and nothing else.
 #
 # Outputs go to ${CMAKE_CURRENT_BINARY_DIR}/shadergen/<target>/<name>.{vert,spv,json}
-# (+ .spv.h with EMBED) and are added to the target's sources. The target gets:
+# (+ .spv.h with EMBED, .hlsl with HLSL, .metal with MSL; their bindings are in the .json)
+# and are added to the target's sources. The target gets:
 #   - compile definitions SHADERGEN_<NAME>_SPV="<abs path of .spv>" and
 #     SHADERGEN_<NAME>_REFLECTION="<abs path of .json>" (NAME: OUTPUT_NAME upper-cased,
-#     non-alphanumerics replaced by '_'),
+#     non-alphanumerics replaced by '_'), and SHADERGEN_<NAME>_HLSL / _MSL with HLSL / MSL,
 #   - with EMBED, that directory as a PRIVATE include directory, so `#include "<name>.spv.h"`
 #     works.
-# The same paths are set in the caller's scope as SHADERGEN_<NAME>_{GLSL,SPV,REFLECTION,HEADER}.
+# The same paths are set in the caller's scope as SHADERGEN_<NAME>_{GLSL,SPV,REFLECTION,HEADER,HLSL,MSL}.
 
 if(CMAKE_VERSION VERSION_LESS 3.20)
   message(FATAL_ERROR "shadergen_add_vertex_shader() needs CMake 3.20 or newer (DEPFILE support for all generators)")
@@ -51,8 +57,8 @@ function(_shadergen_executable caller out_var)
 endfunction()
 
 function(shadergen_add_vertex_shader target)
-  set(options OPTIMIZE EMBED CAPTURE)
-  set(one RIG FRAGMENT OUTPUT_NAME TARGET_ENV TEMPLATES DEVICE_PROFILE)
+  set(options OPTIMIZE EMBED CAPTURE HLSL MSL)
+  set(one RIG FRAGMENT OUTPUT_NAME TARGET_ENV TEMPLATES DEVICE_PROFILE HLSL_SHADER_MODEL MSL_VERSION MSL_PLATFORM)
   set(multi RULES MAP DEPENDS)
   cmake_parse_arguments(PARSE_ARGV 1 SG "${options}" "${one}" "${multi}")
 
@@ -70,6 +76,15 @@ function(shadergen_add_vertex_shader target)
   if(SG_TARGET_ENV AND NOT SG_TARGET_ENV MATCHES "^vulkan(1\\.[0-3])?$")
     message(FATAL_ERROR "shadergen_add_vertex_shader(${target}): TARGET_ENV must be vulkan1.0, vulkan1.1, vulkan1.2 or vulkan1.3, not '${SG_TARGET_ENV}'")
   endif()
+
+  if(SG_HLSL_SHADER_MODEL AND NOT SG_HLSL)
+    message(FATAL_ERROR "shadergen_add_vertex_shader(${target}): HLSL_SHADER_MODEL needs HLSL")
+  endif()
+  foreach(o MSL_VERSION MSL_PLATFORM)
+    if(SG_${o} AND NOT SG_MSL)
+      message(FATAL_ERROR "shadergen_add_vertex_shader(${target}): ${o} needs MSL")
+    endif()
+  endforeach()
 
   _shadergen_executable(shadergen_add_vertex_shader _sg_exe)
 
@@ -101,14 +116,34 @@ function(shadergen_add_vertex_shader target)
   set(_depfile "${_stem}.d")
   # Same order as the generator writes them (its depfile names the first one first).
   set(_outputs "${_stem}.vert" "${_stem}.spv")
-  set(_emit glsl,spv,reflection)
+  set(_emit glsl,spv)
   if(SG_EMBED)
     list(APPEND _outputs "${_stem}.spv.h")
-    set(_emit glsl,spv,header,reflection)
+    string(APPEND _emit ",header")
+  endif()
+  set(_translate "")
+  if(SG_HLSL)
+    list(APPEND _outputs "${_stem}.hlsl")
+    string(APPEND _emit ",hlsl")
+    if(SG_HLSL_SHADER_MODEL)
+      list(APPEND _translate "--hlsl-shader-model=${SG_HLSL_SHADER_MODEL}")
+    endif()
+  endif()
+  if(SG_MSL)
+    list(APPEND _outputs "${_stem}.metal")
+    string(APPEND _emit ",msl")
+    if(SG_MSL_VERSION)
+      list(APPEND _translate "--msl-version=${SG_MSL_VERSION}")
+    endif()
+    if(SG_MSL_PLATFORM)
+      list(APPEND _translate "--msl-platform=${SG_MSL_PLATFORM}")
+    endif()
   endif()
   list(APPEND _outputs "${_stem}.json")
+  string(APPEND _emit ",reflection")
 
-  set(_args generate --rig "${_rig}" -f "${_frag}" ${_rule_args} -o "${_stem}" --emit ${_emit} -MF "${_depfile}" -q)
+  set(_args generate --rig "${_rig}" -f "${_frag}" ${_rule_args} -o "${_stem}" --emit ${_emit} ${_translate}
+      -MF "${_depfile}" -q)
   if(SG_OPTIMIZE)
     list(APPEND _args -O)
   endif()
@@ -144,6 +179,13 @@ function(shadergen_add_vertex_shader target)
 
   target_sources(${target} PRIVATE ${_outputs})
   set_source_files_properties(${_outputs} PROPERTIES GENERATED TRUE)
+  # Sources to hand to the engine, not to this build: the Visual Studio generator would run
+  # FXC on .hlsl and Xcode the Metal compiler on .metal with their default settings.
+  foreach(_translated IN ITEMS "${_stem}.hlsl" "${_stem}.metal")
+    if(_translated IN_LIST _outputs)
+      set_source_files_properties("${_translated}" PROPERTIES HEADER_FILE_ONLY TRUE)
+    endif()
+  endforeach()
   target_compile_definitions(${target} PRIVATE
     "SHADERGEN_${_NAME}_SPV=\"${_stem}.spv\""
     "SHADERGEN_${_NAME}_REFLECTION=\"${_stem}.json\"")
@@ -154,6 +196,14 @@ function(shadergen_add_vertex_shader target)
   set(SHADERGEN_${_NAME}_GLSL "${_stem}.vert" PARENT_SCOPE)
   set(SHADERGEN_${_NAME}_SPV "${_stem}.spv" PARENT_SCOPE)
   set(SHADERGEN_${_NAME}_REFLECTION "${_stem}.json" PARENT_SCOPE)
+  if(SG_HLSL)
+    target_compile_definitions(${target} PRIVATE "SHADERGEN_${_NAME}_HLSL=\"${_stem}.hlsl\"")
+    set(SHADERGEN_${_NAME}_HLSL "${_stem}.hlsl" PARENT_SCOPE)
+  endif()
+  if(SG_MSL)
+    target_compile_definitions(${target} PRIVATE "SHADERGEN_${_NAME}_MSL=\"${_stem}.metal\"")
+    set(SHADERGEN_${_NAME}_MSL "${_stem}.metal" PARENT_SCOPE)
+  endif()
 endfunction()
 
 # shadergen_add_shader_variants(): every variant of a manifest (docs/variants.md) built at

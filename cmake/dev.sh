@@ -21,6 +21,7 @@ packages=(
   libglpk-dev
   libembree-dev
   libpng-dev
+  spirv-cross libspirv-cross-c-shared-dev
 )
 test_packages=(libgtest-dev libgmock-dev libbenchmark-dev graphviz)
 sanitize_packages=(clang-14 libclang-rt-14-dev)

@@ -92,6 +92,36 @@ GenerateOptions GenerateArgs::resolve() const {
   return o;
 }
 
+void CrossArgs::add(CLI::App& cmd, bool msl) {
+  cmd.add_option("--hlsl-shader-model", shaderModel,
+                 fmt::format("HLSL shader model: {} (default 5.0: compiles with FXC for Direct3D 11 and 12 and "
+                             "with DXC as vs_6_x)",
+                             kShaderModels));
+  if (!msl) return;
+  cmd.add_option("--msl-version", mslVersion, fmt::format("Metal Shading Language version: {} (default 2.0)", kMslVersions));
+  cmd.add_option("--msl-platform", mslPlatform, "Metal platform: macos (default), ios");
+}
+
+void CrossArgs::resolve(bool hlsl, bool msl, GenerateOptions& o) const {
+  if (!shaderModel.empty() && !hlsl) throw CLI::ValidationError("--hlsl-shader-model", "does not apply: nothing is translated to HLSL (generate: --emit hlsl; validate: --via hlsl)");
+  if (!mslVersion.empty() && !msl) throw CLI::ValidationError("--msl-version", "does not apply: no MSL is made (add msl to --emit)");
+  if (!mslPlatform.empty() && !msl) throw CLI::ValidationError("--msl-platform", "does not apply: no MSL is made (add msl to --emit)");
+  if (hlsl) {
+    o.hlsl = HlslOptions{};
+    if (!shaderModel.empty() && !parseShaderModel(shaderModel, o.hlsl->shaderModel))
+      throw CLI::ValidationError("--hlsl-shader-model",
+                                 fmt::format("unsupported shader model '{}' (supported: {})", shaderModel, kShaderModels));
+  }
+  if (msl) {
+    o.msl = MslOptions{};
+    if (!mslVersion.empty() && !parseMslVersion(mslVersion, *o.msl))
+      throw CLI::ValidationError("--msl-version",
+                                 fmt::format("unsupported Metal Shading Language version '{}' (supported: {})", mslVersion, kMslVersions));
+    if (!mslPlatform.empty() && !parseMslPlatform(mslPlatform, o.msl->platform))
+      throw CLI::ValidationError("--msl-platform", fmt::format("unknown Metal platform '{}' (macos, ios)", mslPlatform));
+  }
+}
+
 std::vector<InputFile> inputFiles(const LoadedInputs& in, const std::vector<std::string>& extra) {
   std::vector<InputFile> files{{in.fragment.file, "the fragment shader"}};
   for (const auto& f : in.rig.sourceFiles) files.push_back({f, "the rig"});
@@ -112,12 +142,13 @@ struct GenerateCommand {
   bool quiet = false;
   bool capture = false;
   bool stats = false;
+  CrossArgs cross;
 
   // The outputs of one generation: with one --emit kind and `exact`, `path` is that file
   // (like glslc -o); otherwise it is a stem and known suffixes are stripped, each kind getting
   // its own (.vert .spv .spv.h .json).
   static std::string stemOf(std::string path) {
-    for (const char* suffix : {".spv.h", ".vert", ".spv", ".json", ".h"}) {
+    for (const char* suffix : {".spv.h", ".vert", ".spv", ".json", ".h", ".hlsl", ".metal"}) {
       std::string sfx(suffix);
       if (path.size() > sfx.size() && path.compare(path.size() - sfx.size(), sfx.size(), sfx) == 0) {
         path.resize(path.size() - sfx.size());
@@ -134,6 +165,8 @@ struct GenerateCommand {
       if (kind == "glsl") return stem + ".vert";
       if (kind == "spv") return stem + ".spv";
       if (kind == "header") return stem + ".spv.h";
+      if (kind == "hlsl") return stem + ".hlsl";
+      if (kind == "msl") return stem + ".metal";
       return stem + ".json";
     };
     std::vector<PendingFile> files;
@@ -150,6 +183,8 @@ struct GenerateCommand {
       if (sym.empty() || std::isdigit(static_cast<unsigned char>(sym[0]))) sym = "sg_" + sym;
       files.push_back({pathFor("header"), spirvHeader(r.spirv.words, sym + "_spv") + buffersHeader(r.glsl, sym)});
     }
+    if (kinds.count("hlsl")) files.push_back({pathFor("hlsl"), r.hlsl->text});
+    if (kinds.count("msl")) files.push_back({pathFor("msl"), r.msl->text});
     if (kinds.count("reflection")) files.push_back({pathFor("reflection"), reflectionOf(r)});
     return files;
   }
@@ -176,8 +211,9 @@ struct GenerateCommand {
     o.capture = capture;
     std::set<std::string> kinds(emit.begin(), emit.end());
     if (kinds.empty()) throw CLI::ValidationError("--emit", "nothing to emit");
-    if (optimize && !kinds.count("spv") && !kinds.count("header"))
+    if (optimize && !kinds.count("spv") && !kinds.count("header") && !kinds.count("hlsl") && !kinds.count("msl"))
       throw CLI::ValidationError("-O", "does not apply: it optimises the SPIR-V, and --emit writes none (add spv or header)");
+    cross.resolve(kinds.count("hlsl") > 0, kinds.count("msl") > 0, o);
     if (auto parts = wholeModelParts(o.rigPath)) return runModel(o, kinds, *parts);
     bool single = kinds.size() == 1 && !output.empty();
     std::string path = output.empty() ? std::filesystem::path(o.fragmentPath).stem().string() : output;
@@ -255,9 +291,13 @@ void registerGenerate(CLI::App& app, CliState& state) {
   CLI::App* sub = app.add_subcommand("generate", "Generate the cheapest vertex shader (GLSL + SPIR-V)");
   cmd->args.add(*sub);
   sub->add_option("-o", cmd->output, "Output path (a file if one --emit kind, else the stem for all)");
-  sub->add_option("--emit", cmd->emit, "What to write: glsl, spv, header, reflection (comma-separated)")
+  sub->add_option("--emit", cmd->emit,
+                   "What to write: glsl, spv, header, reflection, hlsl (Direct3D), msl (Metal) (comma-separated). "
+                   "HLSL and MSL are translated from the SPIR-V by SPIRV-Cross; their bindings go into the "
+                   "reflection (docs/hlsl-msl.md)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"glsl", "spv", "header", "reflection"}));
+      ->check(CLI::IsMember({"glsl", "spv", "header", "reflection", "hlsl", "msl"}));
+  cmd->cross.add(*sub, true);
   sub->add_flag("-O", cmd->optimize, "Optimise the SPIR-V (spirv-opt -O)");
   sub->add_flag("--MD", cmd->depfile,
                 "-MD: write a Make/Ninja depfile (<first output>.d) listing every input read "

@@ -28,10 +28,16 @@ struct ValidateCommand {
   std::vector<double> times;  // glTF rigs: animation times
   std::string animation;
   std::optional<double> morphWeight;  // glTF rigs: every target's weight instead of the animation's
+  std::string via = "spirv";
+  bool optimize = false;
+  CrossArgs cross;
 
   int run() {
     ValidateOptions vo;
     vo.gen = args.resolve();
+    vo.gen.optimize = optimize;
+    vo.via = via == "hlsl" ? ValidateVia::Hlsl : ValidateVia::Spirv;
+    cross.resolve(vo.via == ValidateVia::Hlsl, false, vo.gen);
     vo.crossCheck = crossCheck;
     vo.device = device;
     vo.validationLayers = !noLayers;
@@ -171,6 +177,12 @@ void registerValidate(CLI::App& app, CliState& state) {
                   "through the motion)")
       ->check(finiteNumber(false));
   sub->add_flag("--cross-check", cmd->crossCheck, "Also force and check every alternative derivation");
+  sub->add_option("--via", cmd->via,
+                  "What runs: spirv (default: the GLSL's SPIR-V), or hlsl (the HLSL `generate --emit hlsl` writes, "
+                  "compiled back to SPIR-V by glslang's HLSL front end and bound by its semantics)")
+      ->check(CLI::IsMember({"spirv", "hlsl"}));
+  sub->add_flag("-O", cmd->optimize, "Validate the optimised SPIR-V (spirv-opt -O), as `generate -O` writes it");
+  cmd->cross.add(*sub, false);
   sub->add_option("--device", cmd->device, "Vulkan device name (substring); default lavapipe");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer");
   sub->add_option("--tolerance-abs", cmd->tol.abs, "Absolute tolerance (see docs/validation.md)")

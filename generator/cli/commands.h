@@ -27,6 +27,16 @@ struct GenerateArgs {
   GenerateOptions resolve() const;  // parses --map and --target-env (throws CLI::ValidationError)
 };
 
+// --hlsl-shader-model, --msl-version, --msl-platform (generate; validate --via hlsl takes
+// the shader model). Empty = not given (the defaults of emit/cross_compile.h).
+struct CrossArgs {
+  std::string shaderModel, mslVersion, mslPlatform;
+  void add(CLI::App& cmd, bool msl);
+  // Sets o.hlsl / o.msl for the languages asked for. A value no translation supports, or an
+  // option for a language not asked for, throws CLI::ValidationError.
+  void resolve(bool hlsl, bool msl, GenerateOptions& o) const;
+};
+
 // Every file `in` was loaded from (plus `extra`), named for refuseClobbering (output_files.h).
 std::vector<InputFile> inputFiles(const LoadedInputs& in, const std::vector<std::string>& extra = {});
 

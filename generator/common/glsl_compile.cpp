@@ -6,10 +6,13 @@
 #include <glslang/Public/ResourceLimits.h>
 #include <glslang/Public/ShaderLang.h>
 #include <glslang/SPIRV/GlslangToSpv.h>
+#include <glslang/SPIRV/spirv.hpp>
 #include <spirv-tools/libspirv.hpp>
 #include <spirv-tools/optimizer.hpp>
 
 #include <algorithm>
+#include <cctype>
+#include <tuple>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -135,15 +138,25 @@ GlslShader::GlslShader(const GlslUnit& unit, TargetEnv env) : impl_(std::make_un
   const char* src = m.unit.text.c_str();
   m.shader->setStrings(&src, 1);
   EnvVersions v = versionsOf(env);
-  m.shader->setEnvInput(glslang::EShSourceGlsl, m.lang, glslang::EShClientVulkan, 100);
+  const bool hlsl = unit.language == SourceLanguage::Hlsl;
+  m.shader->setEnvInput(hlsl ? glslang::EShSourceHlsl : glslang::EShSourceGlsl, m.lang, glslang::EShClientVulkan, 100);
   m.shader->setEnvClient(glslang::EShClientVulkan, v.client);
   m.shader->setEnvTarget(glslang::EShTargetSpv, v.spirv);
-  bool parsed = m.shader->parse(GetDefaultResources(), 450, ECoreProfile, false, false, kMessages);
+  EShMessages messages = kMessages;
+  if (hlsl) {
+    messages = static_cast<EShMessages>(messages | EShMsgReadHlsl);
+    m.shader->setEntryPoint("main");
+    m.shader->setHlslIoMapping(true);  // registers give bindings
+    m.shader->setShiftBinding(glslang::EResTexture, unit.hlslTextureBindingShift);
+    m.shader->setAutoMapLocations(true);  // bindSemantics sets the real ones
+    m.shader->setEnvTargetHlslFunctionality1();
+  }
+  bool parsed = m.shader->parse(GetDefaultResources(), hlsl ? 500 : 450, ECoreProfile, false, false, messages);
   m.diagnostics = parseGlslangLog(m.shader->getInfoLog(), m.unit);
   if (!parsed) return;
   m.program = std::make_unique<glslang::TProgram>();
   m.program->addShader(m.shader.get());
-  if (!m.program->link(kMessages)) {
+  if (!m.program->link(messages) || (hlsl && !m.program->mapIO())) {
     auto more = parseGlslangLog(m.program->getInfoLog(), m.unit);
     m.diagnostics.insert(m.diagnostics.end(), more.begin(), more.end());
     return;
@@ -388,6 +401,144 @@ std::vector<uint32_t> optimizeSpirv(const std::vector<uint32_t>& words, TargetEn
   std::vector<uint32_t> out;
   if (!opt.Run(in.data(), in.size(), &out)) throw std::runtime_error("spirv-opt failed: " + messages);
   return out;
+}
+
+namespace {
+
+// A module as its instructions (each with its opcode word), for the rewrites below.
+struct SpirvInstructions {
+  std::vector<uint32_t> header;
+  std::vector<std::vector<uint32_t>> ops;
+
+  explicit SpirvInstructions(const std::vector<uint32_t>& words) {
+    if (words.size() < 5) throw std::invalid_argument("not a SPIR-V module");
+    header.assign(words.begin(), words.begin() + 5);
+    for (size_t i = 5; i < words.size();) {
+      const uint32_t len = words[i] >> 16;
+      if (len == 0 || i + len > words.size()) throw std::invalid_argument("truncated SPIR-V instruction");
+      ops.emplace_back(words.begin() + static_cast<long>(i), words.begin() + static_cast<long>(i + len));
+      i += len;
+    }
+  }
+  std::vector<uint32_t> words() const {
+    std::vector<uint32_t> out = header;
+    for (const auto& op : ops) out.insert(out.end(), op.begin(), op.end());
+    return out;
+  }
+  static uint32_t opcode(const std::vector<uint32_t>& op) { return op[0] & 0xffffu; }
+  static std::vector<uint32_t> make(spv::Op code, std::vector<uint32_t> operands) {
+    operands.insert(operands.begin(), (static_cast<uint32_t>(operands.size() + 1) << 16) | code);
+    return operands;
+  }
+  // A literal string operand starting at word `at`.
+  static std::string string(const std::vector<uint32_t>& op, size_t at) {
+    std::string s;
+    for (size_t w = at; w < op.size(); ++w)
+      for (int b = 0; b < 4; ++b) {
+        char c = static_cast<char>((op[w] >> (8 * b)) & 0xffu);
+        if (c == 0) return s;
+        s += c;
+      }
+    return s;
+  }
+  // Interface variables of a storage class.
+  std::vector<uint32_t> variables(spv::StorageClass sc) const {
+    std::vector<uint32_t> ids;
+    for (const auto& op : ops)
+      if (opcode(op) == spv::OpVariable && op.size() >= 4 && op[3] == static_cast<uint32_t>(sc)) ids.push_back(op[2]);
+    return ids;
+  }
+  // The operand of `OpDecorate id decoration operand`, or -1.
+  int64_t decoration(uint32_t id, spv::Decoration d) const {
+    for (const auto& op : ops)
+      if (opcode(op) == spv::OpDecorate && op.size() >= 4 && op[1] == id && op[2] == static_cast<uint32_t>(d)) return op[3];
+    return -1;
+  }
+  void setDecoration(uint32_t id, spv::Decoration d, uint32_t value) {
+    size_t firstAnnotation = ops.size();
+    for (size_t i = 0; i < ops.size(); ++i) {
+      const uint32_t code = opcode(ops[i]);
+      if (code == spv::OpDecorate && ops[i].size() >= 4 && ops[i][1] == id && ops[i][2] == static_cast<uint32_t>(d)) {
+        ops[i][3] = value;
+        return;
+      }
+      if (firstAnnotation == ops.size() && (code == spv::OpDecorate || code == spv::OpMemberDecorate ||
+                                            code == spv::OpDecorateString || code == spv::OpMemberDecorateString))
+        firstAnnotation = i;
+    }
+    ops.insert(ops.begin() + static_cast<long>(firstAnnotation), make(spv::OpDecorate, {id, static_cast<uint32_t>(d), value}));
+  }
+};
+
+std::string upper(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+}  // namespace
+
+std::vector<uint32_t> bindSemantics(const std::vector<uint32_t>& words, const std::map<std::string, int>& inputs,
+                                    const std::map<std::string, int>& outputs, const std::string& name) {
+  SpirvInstructions m(words);
+  constexpr auto kSemantic = static_cast<uint32_t>(spv::DecorationHlslSemanticGOOGLE);
+  std::map<uint32_t, std::string> semantics;  // variable id -> semantic
+  for (const auto& op : m.ops)
+    if (SpirvInstructions::opcode(op) == spv::OpDecorateString && op.size() >= 4 && op[2] == kSemantic)
+      semantics[op[1]] = upper(SpirvInstructions::string(op, 3));
+  for (auto [sc, table, what] : {std::tuple{spv::StorageClassInput, &inputs, "input"},
+                                 std::tuple{spv::StorageClassOutput, &outputs, "output"}}) {
+    std::map<std::string, int> byName;
+    for (const auto& [k, loc] : *table) byName[upper(k)] = loc;
+    for (uint32_t id : m.variables(sc)) {
+      if (m.decoration(id, spv::DecorationBuiltIn) >= 0) continue;  // SV_Position and other system values
+      auto s = semantics.find(id);
+      auto to = s == semantics.end() ? byName.end() : byName.find(s->second);
+      if (to == byName.end())
+        throw InputError(SourceLoc{name, 0, 0},
+                         fmt::format("HLSL vertex {} with semantic '{}' is not in the reflection", what,
+                                     s == semantics.end() ? std::string("(none)") : s->second));
+      m.setDecoration(id, spv::DecorationLocation, static_cast<uint32_t>(to->second));
+    }
+  }
+  // Drop the semantic strings and the extensions that declare them.
+  std::vector<std::vector<uint32_t>> kept;
+  for (auto& op : m.ops) {
+    const uint32_t code = SpirvInstructions::opcode(op);
+    if ((code == spv::OpDecorateString || code == spv::OpMemberDecorateString) && op.size() >= 3 &&
+        (op[2] == kSemantic || op[2] == static_cast<uint32_t>(spv::DecorationUserTypeGOOGLE) ||
+         (code == spv::OpMemberDecorateString && op.size() >= 4 &&
+          (op[3] == kSemantic || op[3] == static_cast<uint32_t>(spv::DecorationUserTypeGOOGLE)))))
+      continue;
+    if (code == spv::OpExtension && SpirvInstructions::string(op, 1).rfind("SPV_GOOGLE_", 0) == 0) continue;
+    kept.push_back(std::move(op));
+  }
+  m.ops = std::move(kept);
+  return m.words();
+}
+
+std::vector<uint32_t> withCapture(const std::vector<uint32_t>& words, uint32_t stride,
+                                  const std::map<int, uint32_t>& offsets) {
+  SpirvInstructions m(words);
+  for (uint32_t id : m.variables(spv::StorageClassOutput)) {
+    const int64_t builtIn = m.decoration(id, spv::DecorationBuiltIn), location = m.decoration(id, spv::DecorationLocation);
+    if (builtIn >= 0 ? builtIn != spv::BuiltInPosition : location < 0) continue;  // not captured
+    auto at = offsets.find(builtIn >= 0 ? -1 : static_cast<int>(location));
+    if (at == offsets.end()) continue;
+    m.setDecoration(id, spv::DecorationXfbBuffer, 0);
+    m.setDecoration(id, spv::DecorationXfbStride, stride);
+    m.setDecoration(id, spv::DecorationOffset, at->second);
+  }
+  size_t lastCapability = 0, entry = 0;
+  for (size_t i = 0; i < m.ops.size(); ++i) {
+    if (SpirvInstructions::opcode(m.ops[i]) == spv::OpCapability) lastCapability = i;
+    if (SpirvInstructions::opcode(m.ops[i]) == spv::OpEntryPoint) entry = i;
+  }
+  const uint32_t entryId = m.ops.at(entry).at(2);
+  m.ops.insert(m.ops.begin() + static_cast<long>(entry) + 1,
+               SpirvInstructions::make(spv::OpExecutionMode, {entryId, static_cast<uint32_t>(spv::ExecutionModeXfb)}));
+  m.ops.insert(m.ops.begin() + static_cast<long>(lastCapability) + 1,
+               SpirvInstructions::make(spv::OpCapability, {static_cast<uint32_t>(spv::CapabilityTransformFeedback)}));
+  return m.words();
 }
 
 size_t countInstructions(const std::vector<uint32_t>& words) {

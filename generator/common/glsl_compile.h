@@ -4,10 +4,13 @@
 // A shader is parsed once (GlslShader); that parse serves code generation, reflection
 // and cross-stage linking. The target environment sets both
 // the Vulkan client version and the SPIR-V version (vulkan1.1 → SPIR-V 1.3, ...).
+// HLSL (SPIRV-Cross's output, entry point "main") goes through glslang's HLSL front end the
+// same way, so a translated program can be run where the GLSL runs (validate --via hlsl).
 // Messages become located diagnostics: `#line L S` directives in the source map
 // locations back to sourceFiles[S - 1] (S = 0 is the GLSL file itself).
 #pragma once
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -24,11 +27,18 @@ enum class TargetEnv { Vulkan1_0, Vulkan1_1, Vulkan1_2, Vulkan1_3 };
 bool parseTargetEnv(const std::string& s, TargetEnv& out);  // "vulkan1.0".."vulkan1.3"
 const char* targetEnvName(TargetEnv e);
 
+enum class SourceLanguage { Glsl, Hlsl };
+
 struct GlslUnit {
   Stage stage = Stage::Vertex;
   std::string text;
   std::string fileName;                 // reported for source string 0
   std::vector<std::string> sourceFiles;  // reported for source string S >= 1
+  SourceLanguage language = SourceLanguage::Glsl;
+  // HLSL: register bN is binding N, tN is binding N + this (the storage buffers follow the
+  // uniform block); set = space. The SPIR-V keeps each input's and output's semantic
+  // (SPV_GOOGLE_hlsl_functionality1) for bindSemantics.
+  uint32_t hlslTextureBindingShift = 0;
 };
 
 // A user input or output of one stage, as reflected from the parse.
@@ -119,6 +129,20 @@ std::string validateSpirv(const std::vector<uint32_t>& words, TargetEnv env);
 // unrollLoops: also unroll every loop with a constant trip count, then -O again (how the
 // cost model counts the loads a rule's loop makes, analysis/cost.h).
 std::vector<uint32_t> optimizeSpirv(const std::vector<uint32_t>& words, TargetEnv env, bool unrollLoops = false);
+
+// A vertex module compiled from HLSL, bound the way a Direct3D host binds it, by semantic:
+// each user input and output takes the location its semantic has in `inputs` / `outputs`
+// (semantics compare case-insensitively), then the semantic decorations and their
+// extensions are removed (Vulkan drivers need not know them). Throws InputError (at
+// `name`) for a semantic the tables do not list.
+std::vector<uint32_t> bindSemantics(const std::vector<uint32_t>& words, const std::map<std::string, int>& inputs,
+                                    const std::map<std::string, int>& outputs, const std::string& name);
+
+// The module with transform feedback capture (xfb buffer 0, `stride` bytes a vertex): the
+// output at each location of `offsets`, and the position (key -1), at its byte offset.
+// What the GLSL capture build declares in its source, added to a module compiled without it.
+std::vector<uint32_t> withCapture(const std::vector<uint32_t>& words, uint32_t stride,
+                                  const std::map<int, uint32_t>& offsets);
 
 // Number of instructions in a module (header excluded).
 size_t countInstructions(const std::vector<uint32_t>& words);

@@ -43,6 +43,38 @@ std::string buffersJson(const EmittedGlsl& glsl) {
   return j;
 }
 
+// A translation's interface: semantics or attribute indices by variable, registers or
+// buffer indices by resource.
+std::string crossJson(const CrossShader& c) {
+  const bool hlsl = c.hlsl;
+  std::string j = fmt::format("  {}: {{\n    {}: {}, {}: {}, \"entry_point\": {},\n    \"inputs\": [", quote(hlsl ? "hlsl" : "msl"),
+                              quote(hlsl ? "shader_model" : "version"), quote(c.version),
+                              quote(hlsl ? "profile" : "platform"), quote(c.profile), quote(c.entryPoint));
+  auto variables = [&](const std::vector<CrossVariable>& vars) {
+    std::string v;
+    for (size_t i = 0; i < vars.size(); ++i) {
+      const CrossVariable& x = vars[i];
+      std::string slots = x.slots > 1 ? fmt::format(", \"{}\": {}", hlsl ? "semantic_count" : "locations", x.slots) : "";
+      v += fmt::format("{}\n      {{\"name\": {}, \"location\": {}, {}: {}{}}}", i ? "," : "", quote(x.name), x.location,
+                       quote(hlsl ? "semantic" : "attribute"), quote(x.binding), slots);
+    }
+    return v + (vars.empty() ? "]" : "\n    ]");
+  };
+  j += variables(c.inputs) + ",\n    \"outputs\": [" + variables(c.outputs) + ",\n    \"resources\": [";
+  for (size_t i = 0; i < c.resources.size(); ++i) {
+    const CrossResource& r = c.resources[i];
+    std::string where = hlsl ? fmt::format("\"register\": {}, \"space\": 0", quote(r.slot))
+                             : fmt::format("\"buffer\": {}", r.index);
+    j += fmt::format("{}\n      {{\"name\": {}, \"variable\": {}, \"kind\": {}, {}, \"set\": {}, \"binding\": {}}}",
+                     i ? "," : "", quote(r.name), quote(r.variable),
+                     quote(r.uniformBlock ? (hlsl ? "cbuffer" : "constant") : (hlsl ? "ByteAddressBuffer" : "device const")),
+                     where, r.set, r.binding);
+  }
+  j += c.resources.empty() ? "]" : "\n    ]";
+  if (!hlsl) j += fmt::format(",\n    \"first_vertex_buffer\": {}", c.firstVertexBuffer);
+  return j + "\n  },\n";
+}
+
 }  // namespace
 
 std::string buffersHeader(const EmittedGlsl& glsl, const std::string& symbol) {
@@ -63,7 +95,8 @@ std::string buffersHeader(const EmittedGlsl& glsl, const std::string& symbol) {
 }
 
 std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spirv,
-                           const DeviceProfile* profile, const PlanCostPrediction* predicted) {
+                           const DeviceProfile* profile, const PlanCostPrediction* predicted, const CrossShader* hlsl,
+                           const CrossShader* msl) {
   std::string j = "{\n  \"rig\": " + quote(rig.name) + ",\n  \"inputs\": [";
   for (size_t i = 0; i < glsl.inputs.size(); ++i) {
     const auto& in = glsl.inputs[i];
@@ -104,6 +137,8 @@ std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvM
                        predicted->amounts[t], predicted->nanoseconds[t]);
     j += "\n  }},\n";
   }
+  if (hlsl) j += crossJson(*hlsl);
+  if (msl) j += crossJson(*msl);
   j += "  \"outputs\": [";
   for (size_t i = 0; i < glsl.outputs.size(); ++i) {
     const auto& o = glsl.outputs[i];

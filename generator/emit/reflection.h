@@ -3,6 +3,7 @@
 #pragma once
 #include <string>
 
+#include "emit/cross_compile.h"
 #include "emit/glsl_emitter.h"
 #include "emit/spirv.h"
 #include "rig/rig.h"
@@ -10,9 +11,11 @@
 
 namespace sg {
 
-// With a device profile, also the plan's predicted cost per term ("predicted_cost").
+// With a device profile, also the plan's predicted cost per term ("predicted_cost"); with
+// translations, how a Direct3D ("hlsl") or Metal ("msl") host binds them (docs/hlsl-msl.md).
 std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spirv,
-                           const DeviceProfile* profile = nullptr, const PlanCostPrediction* predicted = nullptr);
+                           const DeviceProfile* profile = nullptr, const PlanCostPrediction* predicted = nullptr,
+                           const CrossShader* hlsl = nullptr, const CrossShader* msl = nullptr);
 
 // A C/C++ header defining `static const uint32_t <symbol>[]` with the SPIR-V words.
 std::string spirvHeader(const std::vector<uint32_t>& words, const std::string& symbol);

@@ -237,9 +237,11 @@ LoadedInputs loadInputs(const GenerateOptions& opts) {
 }
 
 std::string reflectionOf(const GenerateResult& r) {
-  if (!r.in.profile) return reflectionJson(r.in.rig, r.glsl, r.spirv);
+  const CrossShader* hlsl = r.hlsl ? &*r.hlsl : nullptr;
+  const CrossShader* msl = r.msl ? &*r.msl : nullptr;
+  if (!r.in.profile) return reflectionJson(r.in.rig, r.glsl, r.spirv, nullptr, nullptr, hlsl, msl);
   const PlanCostPrediction c = predictPlanCost(r.plan, r.in.problem, *r.in.profile);
-  return reflectionJson(r.in.rig, r.glsl, r.spirv, &*r.in.profile, &c);
+  return reflectionJson(r.in.rig, r.glsl, r.spirv, &*r.in.profile, &c, hlsl, msl);
 }
 
 std::string explainUnreachable(const Problem& p, const RuleSet& rules) {
@@ -268,6 +270,8 @@ GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const
   res.spirv = compiled.module;
   res.spirv.words =
       checkStage(in, res.glsl, compiled, ShaderCheckOptions{opts.outputName, opts.targetEnv, opts.optimize, opts.maxUniformBlockBytes});
+  if (opts.hlsl) res.hlsl = translateToHlsl(res.spirv.words, res.glsl, *opts.hlsl, opts.outputName);
+  if (opts.msl) res.msl = translateToMsl(res.spirv.words, res.glsl, *opts.msl, opts.outputName);
   res.inputsRead = inputsRead(in, templates);
   res.in = std::move(in);
   return res;

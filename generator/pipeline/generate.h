@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "common/glsl_compile.h"
+#include "emit/cross_compile.h"
 #include "emit/glsl_emitter.h"
 #include "emit/spirv.h"
 #include "interface/fragment_interface.h"
@@ -54,6 +55,9 @@ struct GenerateOptions {
   // A device profile (docs/device-profiles.md): the plan is the cheapest in predicted time
   // on that device. "" = the instruction-slot model.
   std::string deviceProfilePath;
+  // Also translate the checked SPIR-V to HLSL / MSL (emit/cross_compile.h, docs/hlsl-msl.md).
+  std::optional<HlslOptions> hlsl;
+  std::optional<MslOptions> msl;
 };
 
 struct GenerateResult {
@@ -62,6 +66,7 @@ struct GenerateResult {
   SearchStats stats;
   EmittedGlsl glsl;
   SpirvModule spirv;
+  std::optional<CrossShader> hlsl, msl;  // translated from spirv.words when asked for
   std::vector<std::string> inputsRead;  // every file read (for depfiles)
 };
 

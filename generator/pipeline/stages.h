@@ -1,6 +1,6 @@
 // The generator as named stages, each taking and returning plain data:
 //
-//   load ─► instantiate ─► search ─► emit ─► compile ─► check
+//   load ─► instantiate ─► search ─► emit ─► compile ─► check ─► translate
 //
 // load reads files (rig, rules, fragment shader, templates); nothing after it reads a
 // file. instantiate binds the fragment inputs to semantics, measures `cost: auto` for
@@ -78,6 +78,10 @@ struct ShaderCheckOptions {
 // + spirv-val again. Returns the final SPIR-V words.
 std::vector<uint32_t> checkStage(const LoadedInputs& in, const EmittedGlsl& glsl, const CompiledVertexShader& vertex,
                                  const ShaderCheckOptions& opts);
+
+// ---- translate (when HLSL or MSL is asked for) -------------------------------------------
+// The checked SPIR-V (what `--emit spv` writes) through SPIRV-Cross, with the bindings the
+// reflection records: emit/cross_compile.h.
 
 // Every file the stages read for this context (rig, fragment shader, rules files and their
 // includes, templates): the depfile's prerequisites.

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -39,6 +40,69 @@ std::string nonFiniteReport(Interpreter& reference, const EmittedOutput& o, size
 }
 
 }  // namespace
+
+std::string withoutIntegerMatrices(const std::string& hlsl) {
+  // asfloat(uintRxC(a, b, ...)) -> floatRxC(asfloat(a), asfloat(b), ...): both reinterpret
+  // each component, and the constructors place the components alike.
+  std::string out;
+  size_t from = 0;
+  for (size_t at; (at = hlsl.find("asfloat(uint", from)) != std::string::npos;) {
+    size_t p = at + 12;
+    const bool matrix = p + 4 <= hlsl.size() && std::isdigit(static_cast<unsigned char>(hlsl[p])) && hlsl[p + 1] == 'x' &&
+                        std::isdigit(static_cast<unsigned char>(hlsl[p + 2])) && hlsl[p + 3] == '(';
+    if (!matrix) {
+      out.append(hlsl, from, p - from);
+      from = p;
+      continue;
+    }
+    std::vector<std::string> args(1);
+    int depth = 0;
+    size_t q = p + 4;
+    for (; q < hlsl.size(); ++q) {
+      const char c = hlsl[q];
+      if (depth == 0 && c == ')') break;
+      if (depth == 0 && c == ',') {
+        args.emplace_back();
+        continue;
+      }
+      depth += c == '(' ? 1 : c == ')' ? -1 : 0;
+      args.back() += c;
+    }
+    if (q + 1 >= hlsl.size() || hlsl[q + 1] != ')') {  // not the whole argument of asfloat: keep it
+      out.append(hlsl, from, p - from);
+      from = p;
+      continue;
+    }
+    out.append(hlsl, from, at - from);
+    out += "float" + hlsl.substr(p, 3) + "(";
+    for (size_t i = 0; i < args.size(); ++i) out += (i ? ", asfloat(" : "asfloat(") + args[i].substr(args[i].find_first_not_of(' ')) + ")";
+    out += ")";
+    from = q + 2;
+  }
+  return out + hlsl.substr(from);
+}
+
+std::vector<uint32_t> hlslCaptureModule(const GenerateResult& r, TargetEnv env) {
+  if (!r.hlsl) throw std::logic_error("hlslCaptureModule: the result has no HLSL");
+  const std::string name = r.hlsl->entryPoint + " (HLSL of " + r.in.fragment.file + ")";
+  // Storage buffers are registers t0, t1, ... for bindings 1, 2, ... (emit/cross_compile.h).
+  // glslang's HLSL front end turns integer matrices (valid HLSL, which SPIRV-Cross writes
+  // to load a matrix from a ByteAddressBuffer) into SPIR-V that Vulkan forbids: that one
+  // form is rewritten to its equivalent first (docs/hlsl-msl.md).
+  GlslUnit unit{Stage::Vertex, withoutIntegerMatrices(r.hlsl->text), name, {}, SourceLanguage::Hlsl, 1};
+  CompileResult c = compileGlsl(unit, env);
+  if (!c.ok) throwDiagnostics(c.diagnostics, name, "the HLSL does not compile");
+  std::map<std::string, int> inputs, outputs;
+  for (const auto& v : r.hlsl->inputs) inputs[v.binding] = v.location;
+  for (const auto& v : r.hlsl->outputs)
+    if (v.location >= 0) outputs[v.binding] = v.location;
+  std::map<int, uint32_t> offsets;
+  for (const auto& o : r.glsl.outputs) offsets[o.location] = o.captureOffset;
+  std::vector<uint32_t> words = withCapture(bindSemantics(c.spirv, inputs, outputs, name), r.glsl.captureStride, offsets);
+  if (std::string err = validateSpirv(words, env); !err.empty())
+    throw InputError(SourceLoc{name, 0, 0}, "the SPIR-V compiled from the HLSL fails validation: " + err);
+  return words;
+}
 
 void limitActiveTargets(const Rig& rig, std::vector<rt::Pose>& poses, uint32_t seed) {
   for (const auto& u : rig.uniforms) {
@@ -143,7 +207,7 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
   rep.vertices = mesh.vertexCount;
 
   rt::RunRequest req;
-  req.spirv = r.spirv.words;
+  req.spirv = opts_.via == ValidateVia::Hlsl ? hlslCaptureModule(r, opts_.gen.targetEnv) : r.spirv.words;
   req.capture.strideBytes = r.glsl.captureStride;
   if (!poses.empty()) static_cast<rt::ProgramInputs&>(req) = programInputs(r, mesh, poses.front());
 
@@ -300,7 +364,12 @@ ValidateReport Validator::run(const ValidationScene& scene, const GenerateOption
   report.device = harness_->deviceName();
   report.validationLayers = harness_->validationEnabled();
   GenerateOptions gen = options;
-  gen.capture = true;
+  // Through HLSL: the shipped build is translated (its text is what `generate --emit hlsl`
+  // writes) and the capture is added to the module compiled back from it.
+  gen.capture = opts_.via == ValidateVia::Spirv;
+  if (opts_.via == ValidateVia::Hlsl && !gen.hlsl) gen.hlsl = HlslOptions{};
+  if (opts_.via == ValidateVia::Hlsl)
+    report.via = fmt::format("HLSL {} (compiled back by glslang)", shaderModelName(gen.hlsl->shaderModel));
   // The buffer forms must fit this mesh (+1: the harness draws an even count).
   if (gen.maxVertices == 0) gen.maxVertices = static_cast<int64_t>(scene.mesh.vertexCount) + 1;
   LoadedInputs in = loadInputs(gen);
@@ -356,8 +425,8 @@ ValidateReport Validator::run(const ValidationScene& scene, const GenerateOption
 }
 
 std::string formatReport(const ValidateReport& report) {
-  std::string s = fmt::format("device: {} (validation layers {})\n", report.device,
-                              report.validationLayers ? "on" : "not available");
+  std::string s = fmt::format("device: {} (validation layers {}), running {}\n", report.device,
+                              report.validationLayers ? "on" : "not available", report.via);
   for (const auto& run : report.runs) {
     s += fmt::format("{}: plan cost {}, {} vertices: {}\n", run.label, run.planCost, run.vertices,
                      run.pass ? "PASS" : "FAIL");

@@ -57,6 +57,7 @@ struct RunReport {
 
 struct ValidateReport {
   std::string device;
+  std::string via = "SPIR-V";  // what ran: "SPIR-V", or "HLSL 5.0 (compiled back by glslang)"
   bool validationLayers = false;
   std::vector<RunReport> runs;
   bool pass = true;
@@ -78,8 +79,13 @@ ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_
 // pose, a seeded choice of as many non-zero morph weights as the list holds.
 void limitActiveTargets(const Rig& rig, std::vector<rt::Pose>& poses, uint32_t seed);
 
+// What runs on the device: the SPIR-V (its GLSL's capture build), or the HLSL translated
+// from the shipped SPIR-V, compiled back by glslang's HLSL front end (docs/hlsl-msl.md).
+enum class ValidateVia { Spirv, Hlsl };
+
 struct ValidateOptions {
   GenerateOptions gen;
+  ValidateVia via = ValidateVia::Spirv;
   bool crossCheck = false;  // also force each alternative derivation and check it
   Tolerance tolerance;
   std::string device;       // "" = lavapipe
@@ -114,5 +120,15 @@ class Validator {
 };
 
 std::string formatReport(const ValidateReport& report);
+
+// The HLSL of `r` (r.hlsl, as `generate --emit hlsl` writes it) compiled back to SPIR-V by
+// glslang's HLSL front end, its inputs and outputs bound by the semantics r.hlsl's
+// reflection gives them (as a Direct3D input layout and pixel shader bind them), registers
+// to the Vulkan bindings, and captured at the GLSL capture build's offsets. Throws
+// InputError if it does not compile or validate.
+std::vector<uint32_t> hlslCaptureModule(const GenerateResult& r, TargetEnv env);
+// `asfloat(uintRxC(a, ...))` rewritten as `floatRxC(asfloat(a), ...)`, the same value:
+// glslang cannot compile integer matrices to valid Vulkan SPIR-V (hlslCaptureModule).
+std::string withoutIntegerMatrices(const std::string& hlsl);
 
 }  // namespace sg

@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 #include "common/input_file.h"
 #include "emit/depfile.h"
@@ -25,7 +26,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // Bumped whenever the entry layout or what a key covers changes.
-constexpr const char* kCacheFormat = "shadergen-variant-cache 2";  // 2: glTF buffer files keyed
+constexpr const char* kCacheFormat = "shadergen-variant-cache 3";  // 2: glTF buffer files keyed; 3: hlsl, msl
 
 // Every file a build reads, loaded once and shared (read-only) by all workers.
 struct SharedInputs {
@@ -86,6 +87,8 @@ std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v,
   Sha256 h;
   h.field(kCacheFormat).field(shadergenVersion()).field(targetEnvName(m.targetEnv)).field(m.heuristic);
   h.field(m.optimize ? "optimize" : "no-optimize");
+  if (m.emits("hlsl")) h.field("hlsl").field(shaderModelName(m.hlsl.shaderModel));
+  if (m.emits("msl")) h.field("msl").field(mslVersionName(m.msl)).field(mslPlatformName(m.msl.platform));
   h.field(v.rig->path).field(v.pass->fragment);
   for (const auto& [k, val] : v.params) h.field(k).field(std::to_string(val));
   h.field("maps");
@@ -123,7 +126,7 @@ bool readEntry(const std::string& path, BuiltVariant& out) {
   std::istringstream rules(line.substr(5));
   out.rules.clear();
   for (std::string r; rules >> r;) out.rules.push_back(r);
-  for (std::string* blob : {&out.glsl, &out.spirv, &out.reflection}) {
+  for (std::string* blob : {&out.glsl, &out.spirv, &out.reflection, &out.hlsl, &out.msl}) {
     if (!std::getline(in, line)) return false;
     size_t n = 0;
     try {
@@ -141,8 +144,9 @@ bool readEntry(const std::string& path, BuiltVariant& out) {
 void writeEntry(const std::string& path, const BuiltVariant& v) {
   std::string rules;
   for (const auto& r : v.rules) rules += " " + r;
-  std::string text = fmt::format("{}\ncost {}\nrules{}\nglsl {}\n{}spirv {}\n{}reflection {}\n{}", kCacheFormat, v.cost,
-                                 rules, v.glsl.size(), v.glsl, v.spirv.size(), v.spirv, v.reflection.size(), v.reflection);
+  std::string text = fmt::format("{}\ncost {}\nrules{}\nglsl {}\n{}spirv {}\n{}reflection {}\n{}hlsl {}\n{}msl {}\n{}",
+                                 kCacheFormat, v.cost, rules, v.glsl.size(), v.glsl, v.spirv.size(), v.spirv,
+                                 v.reflection.size(), v.reflection, v.hlsl.size(), v.hlsl, v.msl.size(), v.msl);
   static std::atomic<unsigned> counter{0};
   std::error_code ec;
   fs::create_directories(fs::path(path).parent_path(), ec);
@@ -181,12 +185,16 @@ void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v,
   o.targetEnv = m.targetEnv;
   o.optimize = m.optimize;
   o.outputName = (fs::path(m.outputDir) / (v.name + ".vert")).string();
+  if (m.emits("hlsl")) o.hlsl = m.hlsl;
+  if (m.emits("msl")) o.msl = m.msl;
   GenerateResult r = generateWith(std::move(in), s.templates, o);
   out.cost = r.plan.cost;
   for (int a : r.plan.actions) out.rules.push_back(r.in.problem.actions[a].name);
   out.glsl = r.glsl.text;
   out.spirv.assign(reinterpret_cast<const char*>(r.spirv.words.data()), r.spirv.words.size() * 4);
   out.reflection = reflectionOf(r);
+  if (r.hlsl) out.hlsl = r.hlsl->text;
+  if (r.msl) out.msl = r.msl->text;
 }
 
 void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts, BuiltVariant& out) {
@@ -201,6 +209,8 @@ void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts
     out.glsl = std::move(fromCache.glsl);
     out.spirv = std::move(fromCache.spirv);
     out.reflection = std::move(fromCache.reflection);
+    out.hlsl = std::move(fromCache.hlsl);
+    out.msl = std::move(fromCache.msl);
     out.ok = out.cached = true;
   } else {  // a miss, or a damaged entry (read into its own record, so nothing leaks from it)
     try {
@@ -244,6 +254,10 @@ std::string indexJson(const Manifest& m, const BuildReport& r) {
   out += fmt::format("  \"shadergen\": {},\n", jsonString(shadergenVersion()));
   out += fmt::format("  \"target_env\": {},\n", jsonString(targetEnvName(m.targetEnv)));
   out += fmt::format("  \"optimize\": {},\n", m.optimize ? "true" : "false");
+  if (m.emits("hlsl")) out += fmt::format("  \"hlsl_shader_model\": {},\n", jsonString(shaderModelName(m.hlsl.shaderModel)));
+  if (m.emits("msl"))
+    out += fmt::format("  \"msl_version\": {},\n  \"msl_platform\": {},\n", jsonString(mslVersionName(m.msl)),
+                       jsonString(mslPlatformName(m.msl.platform)));
   if (!m.deviceProfile.empty())  // then "cost" is femtoseconds per vertex on that device
     out += fmt::format("  \"device_profile\": {},\n", jsonString(m.deviceProfile));
   std::string rules;
@@ -334,6 +348,12 @@ BuildReport buildVariants(const Manifest& m, const std::vector<Variant>& variant
       b.outputs["reflection"] = (fs::path(m.outputDir) / (v.name + ".json")).string();
       report.files.push_back({b.outputs["reflection"], b.reflection});
       targets.push_back(b.outputs["reflection"]);
+    }
+    for (auto [kind, suffix, text] : {std::tuple{"hlsl", ".hlsl", &b.hlsl}, std::tuple{"msl", ".metal", &b.msl}}) {
+      if (!has(kind)) continue;
+      b.outputs[kind] = (fs::path(m.outputDir) / (v.name + suffix)).string();
+      report.files.push_back({b.outputs[kind], *text});
+      targets.push_back(b.outputs[kind]);
     }
     std::vector<std::string> deps{m.file};
     deps.insert(deps.end(), b.inputs.begin(), b.inputs.end());

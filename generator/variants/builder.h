@@ -31,6 +31,7 @@ struct BuiltVariant {
   int64_t cost = 0;
   std::vector<std::string> rules;      // plan rules in order
   std::string glsl, spirv, reflection; // outputs (spirv: the module's bytes)
+  std::string hlsl, msl;               // when the manifest emits them
   std::string spirvHash;               // SHA-256 of the SPIR-V
   std::vector<std::string> inputs;     // every file it was made from (depfile)
   std::map<std::string, std::string> outputs;  // kind -> path written

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -42,6 +43,8 @@ bool safeStem(const std::string& s) {
 
 }  // namespace
 
+bool Manifest::emits(const std::string& kind) const { return std::find(emit.begin(), emit.end(), kind) != emit.end(); }
+
 Manifest loadManifest(const std::string& path) { return loadManifestText(readInputFile(path), path); }
 
 Manifest loadManifestText(const std::string& text, const std::string& file) {
@@ -51,7 +54,7 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
   YAML::Node root = parseYaml(text, file);
   y.expectMap(root, "a manifest");
   y.checkKeys(root, {"output", "rules", "templates", "target_env", "optimize", "heuristic", "emit", "rigs", "passes",
-                     "axes", "exclude", "name", "device_profile"});
+                     "axes", "exclude", "name", "device_profile", "hlsl_shader_model", "msl_version", "msl_platform"});
   m.outputDir = resolvePath(file, root["output"] ? y.scalar(root["output"], "'output'") : "shaders");
   if (!root["rules"]) y.fail(root, "the manifest needs 'rules' (a rules file or a list of them)");
   for (const auto& r : scalarOrList(y, root["rules"], "'rules'")) m.rules.push_back(resolvePath(file, r));
@@ -70,11 +73,25 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
   }
   if (root["emit"]) {
     m.emit = scalarOrList(y, root["emit"], "'emit'");
-    static const std::set<std::string> kinds{"glsl", "spv", "reflection"};
+    static const std::set<std::string> kinds{"glsl", "spv", "reflection", "hlsl", "msl"};
     for (const auto& k : m.emit)
-      if (!kinds.count(k)) y.fail(root["emit"], fmt::format("unknown emit kind '{}' (glsl, spv, reflection)", k));
+      if (!kinds.count(k)) y.fail(root["emit"], fmt::format("unknown emit kind '{}' (glsl, spv, reflection, hlsl, msl)", k));
     if (m.emit.empty()) y.fail(root["emit"], "'emit' is empty: nothing to write");
   }
+  // Translation options apply only to what is emitted (like generate's flags).
+  auto translation = [&](const char* key, const char* kind) -> std::string {
+    if (!root[key]) return "";
+    const std::string what = fmt::format("'{}'", key);
+    std::string v = y.scalar(root[key], what.c_str());
+    if (!m.emits(kind)) y.fail(root[key], fmt::format("'{}' does not apply: 'emit' has no {}", key, kind));
+    return v;
+  };
+  if (std::string v = translation("hlsl_shader_model", "hlsl"); !v.empty() && !parseShaderModel(v, m.hlsl.shaderModel))
+    y.fail(root["hlsl_shader_model"], fmt::format("unsupported shader model '{}' (supported: {})", v, kShaderModels));
+  if (std::string v = translation("msl_version", "msl"); !v.empty() && !parseMslVersion(v, m.msl))
+    y.fail(root["msl_version"], fmt::format("unsupported Metal Shading Language version '{}' (supported: {})", v, kMslVersions));
+  if (std::string v = translation("msl_platform", "msl"); !v.empty() && !parseMslPlatform(v, m.msl.platform))
+    y.fail(root["msl_platform"], fmt::format("unknown Metal platform '{}' (macos, ios)", v));
 
   std::map<std::string, std::vector<std::string>> wholeModels;  // rig name -> its primitives' rig names
   if (!root["rigs"]) y.fail(root, "the manifest needs 'rigs' (name: rig file)");

@@ -9,6 +9,7 @@
 
 #include "common/diagnostics.h"
 #include "common/glsl_compile.h"
+#include "emit/cross_compile.h"
 #include "interface/fragment_interface.h"
 
 namespace sg {
@@ -58,6 +59,9 @@ struct Manifest {
   bool optimize = false;
   std::string heuristic = "lmcut";
   std::string deviceProfile;  // `device_profile:` (docs/device-profiles.md); "" = instruction slots
+  HlslOptions hlsl;           // `hlsl_shader_model:`, when emit has hlsl (docs/hlsl-msl.md)
+  MslOptions msl;             // `msl_version:`, `msl_platform:`, when emit has msl
+  bool emits(const std::string& kind) const;
 };
 
 // One shader to make.

@@ -210,6 +210,61 @@ TEST(Build, CacheRegeneratesOnlyWhatChanged) {
   EXPECT_EQ(buildVariants(opt, expandVariants(opt), bo).generated, variants.size());
 }
 
+// emit: hlsl, msl (docs/hlsl-msl.md): each variant's .hlsl and .metal are generate()'s text
+// with the manifest's options, cached like the other outputs; the options are in the key.
+TEST(Build, HlslAndMslAreGeneratesTextsAndCached) {
+  auto dir = freshDir("x");
+  Manifest m = loadManifest(
+      smallManifest(dir, "emit: [spv, hlsl, msl, reflection]\nhlsl_shader_model: \"6.0\"\nmsl_platform: ios\n").string());
+  EXPECT_EQ(m.hlsl.shaderModel, 60);
+  EXPECT_EQ(m.msl.platform, MslPlatform::IOS);
+  std::vector<Variant> variants = expandVariants(m);
+  BuildOptions bo;
+  bo.cacheDir = (dir / "cache").string();
+  BuildReport r = buildVariants(m, variants, bo);
+  ASSERT_EQ(r.failed, 0u);
+  auto files = filesOf(r);
+  for (const auto& b : r.variants) {
+    GenerateOptions o;
+    o.rigPath = b.variant->rig->path;
+    o.fragmentPath = b.variant->pass->fragment;
+    o.rulesPaths = m.rules;
+    o.rigParams = b.variant->params;
+    o.outputName = (fs::path(m.outputDir) / (b.variant->name + ".vert")).string();
+    o.hlsl = HlslOptions{60};
+    o.msl = MslOptions{2, 0, MslPlatform::IOS};
+    GenerateResult g = generate(o);
+    EXPECT_EQ(b.outputs.at("hlsl"), (fs::path(m.outputDir) / (b.variant->name + ".hlsl")).string());
+    EXPECT_EQ(files.at(b.outputs.at("hlsl")), g.hlsl->text) << b.variant->name;
+    EXPECT_EQ(files.at(b.outputs.at("msl")), g.msl->text) << b.variant->name;
+    EXPECT_EQ(files.at(b.outputs.at("reflection")), reflectionOf(g)) << b.variant->name;
+    EXPECT_EQ(b.outputs.count("glsl"), 0u);
+  }
+  EXPECT_NE(files.at(r.indexPath).find("\"hlsl_shader_model\": \"6.0\""), std::string::npos);
+  EXPECT_NE(files.at(r.indexPath).find(".metal\""), std::string::npos);
+  BuildReport warm = buildVariants(m, variants, bo);
+  EXPECT_EQ(warm.cached, variants.size());
+  EXPECT_EQ(filesOf(warm), files);
+  Manifest sm51 = m;
+  sm51.hlsl.shaderModel = 51;  // another shader model: another key
+  EXPECT_EQ(buildVariants(sm51, expandVariants(sm51), bo).generated, variants.size());
+}
+
+TEST(Manifest, TranslationOptionsAreChecked) {
+  auto dir = freshDir("xo");
+  auto errorFor = [&](const std::string& extra) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return errorOf([&] { loadManifest(smallManifest(dir, extra).string()); });
+  };
+  EXPECT_NE(errorFor("emit: [hlsl]\nhlsl_shader_model: \"4.0\"\n").message.find("unsupported shader model '4.0'"),
+            std::string::npos);
+  EXPECT_NE(errorFor("emit: [msl]\nmsl_version: \"2.7\"\n").message.find("unsupported Metal Shading Language version"),
+            std::string::npos);
+  EXPECT_NE(errorFor("emit: [spv]\nhlsl_shader_model: \"6.0\"\n").message.find("'emit' has no hlsl"), std::string::npos);
+  EXPECT_NE(errorFor("emit: [hlsl, dxil]\n").message.find("unknown emit kind 'dxil'"), std::string::npos);
+}
+
 TEST(Build, SameBytesWhateverTheThreadCount) {
   auto dir = freshDir("t");
   Manifest m = loadManifest(smallManifest(dir).string());
