@@ -11,6 +11,8 @@
 #include <regex>
 #include <set>
 
+#include <shadergen/shadergen.h>
+
 #include "../gltf/gltf_test_util.h"
 #include "emit/reflection.h"
 #include "pipeline/generate.h"
@@ -264,6 +266,33 @@ TEST(HlslMslReflection, StorageBuffersTakeTRegistersAndRunThroughHlsl) {
   }
   ValidateReport report = validateViaHlsl(o, false);
   EXPECT_TRUE(report.pass) << formatReport(report);
+}
+
+// shadergen::core (api/shadergen.h) makes the same texts from strings, and refuses bad ones.
+TEST(HlslMslLibrary, TheApiReturnsTheTranslationsAndRefusesUnsupportedOptions) {
+  shadergen::Options o;
+  o.rig = kDawn + "face.rig.yaml";
+  o.fragment = kDawn + "depth.frag";
+  o.rules = {kDawn + "rules.yaml"};
+  o.templates = std::string(SG_SOURCE_DIR) + "/templates";
+  o.hlslShaderModel = "5.1";
+  o.mslVersion = "2.2";
+  shadergen::Result r = shadergen::generate(o);
+  ASSERT_TRUE(r.ok);
+  GenerateOptions g = dawnOptions("face.rig.yaml", "depth.frag");
+  g.hlsl->shaderModel = 51;
+  g.msl->minor = 2;
+  GenerateResult expected = generate(g);
+  EXPECT_EQ(r.hlsl, expected.hlsl->text);
+  EXPECT_EQ(r.msl, expected.msl->text);
+  EXPECT_EQ(r.reflection, reflectionOf(expected));
+  o.hlslShaderModel = "4.1";
+  r = shadergen::generate(o);
+  ASSERT_FALSE(r.ok);
+  EXPECT_EQ(r.diagnostics.at(0).message, "unsupported shader model '4.1' (supported: 5.0, 5.1, 6.0 .. 6.7)");
+  o.hlslShaderModel = "";
+  o.mslPlatform = "visionos";
+  EXPECT_FALSE(shadergen::generate(o).ok);
 }
 
 // The shared models (../shared/models) through HLSL, at animation times, as
