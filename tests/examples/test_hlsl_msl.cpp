@@ -270,6 +270,24 @@ TEST(HlslMslReflection, StorageBuffersTakeTRegistersAndRunThroughHlsl) {
   EXPECT_TRUE(report.pass) << formatReport(report);
 }
 
+// A matrix varying (the glTF Sample Viewer's mat3 v_TBN) takes TEXCOORD2..4 and still
+// validates through HLSL: its columns land where the GLSL capture puts them.
+TEST(HlslMslReflection, AMatrixOutputTakesConsecutiveSemanticsAndValidates) {
+  GenerateOptions o = dawnOptions("face.rig.yaml", "face.frag");
+  o.fragmentPath = std::string(SG_SOURCE_DIR) + "/tests/validate/data/conventions/gltf_sample_viewer.frag";
+  o.rulesPaths = {std::string(SG_SOURCE_DIR) + "/rules/standard.yaml"};
+  GenerateResult r = generate(o);
+  std::string j = reflectionOf(r);
+  EXPECT_NE(j.find("{\"name\": \"v_TBN\", \"location\": 2, \"semantic\": \"TEXCOORD2\", \"semantic_count\": 3}"),
+            std::string::npos)
+      << j;
+  EXPECT_NE(j.find("{\"name\": \"v_TBN\", \"location\": 2, \"attribute\": \"user(locn2)\", \"locations\": 3}"),
+            std::string::npos);
+  EXPECT_NE(r.hlsl->text.find("float3x3 v_TBN : TEXCOORD2;"), std::string::npos);
+  ValidateReport report = validateViaHlsl(o, false);
+  EXPECT_TRUE(report.pass) << formatReport(report);
+}
+
 // shadergen::core (api/shadergen.h) makes the same texts from strings, and refuses bad ones.
 TEST(HlslMslLibrary, TheApiReturnsTheTranslationsAndRefusesUnsupportedOptions) {
   shadergen::Options o;
