@@ -43,7 +43,23 @@ Result generate(const Options& options) {
     o.optimize = options.optimize;
     o.templateDir = options.templates;
     o.deviceProfilePath = options.deviceProfile;
+    if (!options.hlslShaderModel.empty()) {
+      o.hlsl = sg::HlslOptions{};
+      if (!sg::parseShaderModel(options.hlslShaderModel, o.hlsl->shaderModel))
+        throw sg::InputError(sg::SourceLoc{}, fmt::format("unsupported shader model '{}' (supported: {})",
+                                                          options.hlslShaderModel, sg::kShaderModels));
+    }
+    if (!options.mslVersion.empty()) {
+      o.msl = sg::MslOptions{};
+      if (!sg::parseMslVersion(options.mslVersion, *o.msl))
+        throw sg::InputError(sg::SourceLoc{}, fmt::format("unsupported Metal Shading Language version '{}' (supported: {})",
+                                                          options.mslVersion, sg::kMslVersions));
+      if (!sg::parseMslPlatform(options.mslPlatform, o.msl->platform))
+        throw sg::InputError(sg::SourceLoc{}, fmt::format("unknown Metal platform '{}' (macos, ios)", options.mslPlatform));
+    }
     sg::GenerateResult g = sg::generate(o);
+    if (g.hlsl) r.hlsl = g.hlsl->text;
+    if (g.msl) r.msl = g.msl->text;
     r.glsl = g.glsl.text;
     r.spirv = g.spirv.words;
     r.reflection = sg::reflectionOf(g);

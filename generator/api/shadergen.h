@@ -26,6 +26,11 @@ struct Options {
   bool optimize = false;             // spirv-opt -O
   std::string templates;             // "" = the templates installed with shadergen
   std::string deviceProfile;         // device profile YAML (docs/device-profiles.md); "" = instruction slots
+  // Also the program for Direct3D / Metal, translated from the SPIR-V (docs/hlsl-msl.md);
+  // their bindings go into `reflection`. "" = not made.
+  std::string hlslShaderModel;       // "5.0", "5.1", "6.0" .. "6.7"
+  std::string mslVersion;            // "1.2", "2.0" .. "2.4", "3.0"
+  std::string mslPlatform = "macos";  // with mslVersion: "macos" or "ios"
 };
 
 struct Diagnostic {
@@ -40,7 +45,8 @@ struct Result {
   bool ok = false;
   std::string glsl;                   // the vertex shader (Vulkan GLSL 450)
   std::vector<uint32_t> spirv;        // validated SPIR-V
-  std::string reflection;             // JSON: vertex inputs, uniform layout, outputs
+  std::string reflection;             // JSON: vertex inputs, uniform layout, outputs (+ HLSL/MSL bindings)
+  std::string hlsl, msl;              // when asked for (Options::hlslShaderModel, mslVersion)
   int64_t cost = 0;                   // plan cost: instruction slots, or femtoseconds per vertex with a profile
   // With a device profile: the plan's amount and predicted nanoseconds per vertex of each
   // cost term ("arithmetic", "locations", ...), and their sum.

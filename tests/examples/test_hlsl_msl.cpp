@@ -11,6 +11,8 @@
 #include <regex>
 #include <set>
 
+#include <shadergen/shadergen.h>
+
 #include "../gltf/gltf_test_util.h"
 #include "emit/reflection.h"
 #include "pipeline/generate.h"
@@ -88,7 +90,8 @@ TEST_P(DawnHlsl, TheHlslRoundTripValidatesOnLavapipe) {
 }
 
 // The HLSL that runs is the text `generate` writes, byte for byte: the validator translates
-// the shipped build, not a capture build.
+// the shipped build. (The GLSL capture build would translate to the same text too: its
+// transform feedback qualifiers have no HLSL form, so SPIRV-Cross drops them.)
 TEST_P(DawnHlsl, TheValidatedHlslIsTheEmittedText) {
   auto [rig, frag] = GetParam();
   GenerateResult shipped = generate(dawnOptions(rig, frag));
@@ -96,7 +99,8 @@ TEST_P(DawnHlsl, TheValidatedHlslIsTheEmittedText) {
   capture.capture = true;
   GenerateResult captured = generate(capture);
   ASSERT_TRUE(shipped.hlsl && captured.hlsl);
-  EXPECT_EQ(shipped.hlsl->text.find("xfb"), std::string::npos);
+  EXPECT_NE(captured.glsl.text, shipped.glsl.text);
+  EXPECT_EQ(captured.hlsl->text, shipped.hlsl->text);
   // The module the harness runs is compiled from shipped.hlsl; the capture is added to it.
   std::vector<uint32_t> words = hlslCaptureModule(shipped, TargetEnv::Vulkan1_0);
   EXPECT_EQ(validateSpirv(words, TargetEnv::Vulkan1_0), "");
@@ -264,6 +268,51 @@ TEST(HlslMslReflection, StorageBuffersTakeTRegistersAndRunThroughHlsl) {
   }
   ValidateReport report = validateViaHlsl(o, false);
   EXPECT_TRUE(report.pass) << formatReport(report);
+}
+
+// A matrix varying (the glTF Sample Viewer's mat3 v_TBN) takes TEXCOORD2..4 and still
+// validates through HLSL: its columns land where the GLSL capture puts them.
+TEST(HlslMslReflection, AMatrixOutputTakesConsecutiveSemanticsAndValidates) {
+  GenerateOptions o = dawnOptions("face.rig.yaml", "face.frag");
+  o.fragmentPath = std::string(SG_SOURCE_DIR) + "/tests/validate/data/conventions/gltf_sample_viewer.frag";
+  o.rulesPaths = {std::string(SG_SOURCE_DIR) + "/rules/standard.yaml"};
+  GenerateResult r = generate(o);
+  std::string j = reflectionOf(r);
+  EXPECT_NE(j.find("{\"name\": \"v_TBN\", \"location\": 2, \"semantic\": \"TEXCOORD2\", \"semantic_count\": 3}"),
+            std::string::npos)
+      << j;
+  EXPECT_NE(j.find("{\"name\": \"v_TBN\", \"location\": 2, \"attribute\": \"user(locn2)\", \"locations\": 3}"),
+            std::string::npos);
+  EXPECT_NE(r.hlsl->text.find("float3x3 v_TBN : TEXCOORD2;"), std::string::npos);
+  ValidateReport report = validateViaHlsl(o, false);
+  EXPECT_TRUE(report.pass) << formatReport(report);
+}
+
+// shadergen::core (api/shadergen.h) makes the same texts from strings, and refuses bad ones.
+TEST(HlslMslLibrary, TheApiReturnsTheTranslationsAndRefusesUnsupportedOptions) {
+  shadergen::Options o;
+  o.rig = kDawn + "face.rig.yaml";
+  o.fragment = kDawn + "depth.frag";
+  o.rules = {kDawn + "rules.yaml"};
+  o.templates = std::string(SG_SOURCE_DIR) + "/templates";
+  o.hlslShaderModel = "5.1";
+  o.mslVersion = "2.2";
+  shadergen::Result r = shadergen::generate(o);
+  ASSERT_TRUE(r.ok);
+  GenerateOptions g = dawnOptions("face.rig.yaml", "depth.frag");
+  g.hlsl->shaderModel = 51;
+  g.msl->minor = 2;
+  GenerateResult expected = generate(g);
+  EXPECT_EQ(r.hlsl, expected.hlsl->text);
+  EXPECT_EQ(r.msl, expected.msl->text);
+  EXPECT_EQ(r.reflection, reflectionOf(expected));
+  o.hlslShaderModel = "4.1";
+  r = shadergen::generate(o);
+  ASSERT_FALSE(r.ok);
+  EXPECT_EQ(r.diagnostics.at(0).message, "unsupported shader model '4.1' (supported: 5.0, 5.1, 6.0 .. 6.7)");
+  o.hlslShaderModel = "";
+  o.mslPlatform = "visionos";
+  EXPECT_FALSE(shadergen::generate(o).ok);
 }
 
 // The shared models (../shared/models) through HLSL, at animation times, as
