@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <map>
+#include <mutex>
+#include <utility>
 
 namespace sg {
 namespace {
@@ -138,13 +141,23 @@ bool dawnTexture(const std::string& sampler, bool cube, const DawnLighting& ligh
     const uint32_t n = std::max<uint32_t>(1, light.textureSize);
     out.size = n;
     out.format = signedData ? VK_FORMAT_R16G16B16A16_SFLOAT : VK_FORMAT_R8G8B8A8_UNORM;
-    out.data.reserve(size_t(n) * n * (signedData ? 8 : 4));
-    for (uint32_t y = 0; y < n; ++y)
-      for (uint32_t x = 0; x < n; ++x) {
-        glm::vec4 c = fn((static_cast<float>(x) + 0.5f) / static_cast<float>(n), (static_cast<float>(y) + 0.5f) / static_cast<float>(n));
-        if (signedData) putHalf4(out.data, c);
-        else putRgba8(out.data, c);
-      }
+    // The 2D maps depend on the sampler and the size only, and a 1024² map takes a good part
+    // of a second to make: made once per process (a session renders many images).
+    static std::mutex mutex;
+    static std::map<std::pair<std::string, uint32_t>, std::vector<uint8_t>> made;
+    std::lock_guard<std::mutex> lock(mutex);
+    auto [it, isNew] = made.try_emplace({sampler, n});
+    if (isNew) {
+      std::vector<uint8_t>& data = it->second;
+      data.reserve(size_t(n) * n * (signedData ? 8 : 4));
+      for (uint32_t y = 0; y < n; ++y)
+        for (uint32_t x = 0; x < n; ++x) {
+          glm::vec4 c = fn((static_cast<float>(x) + 0.5f) / static_cast<float>(n), (static_cast<float>(y) + 0.5f) / static_cast<float>(n));
+          if (signedData) putHalf4(data, c);
+          else putRgba8(data, c);
+        }
+    }
+    out.data = it->second;
     return true;
   }
   glm::vec4 (*fn)(const glm::vec3&, const DawnLighting&) = nullptr;
