@@ -32,6 +32,7 @@ struct ValidateCommand {
     vo.gen = args.resolve();
     vo.crossCheck = crossCheck;
     vo.device = device;
+    vo.limits = {!device.empty(), args.maxAttributes->count() > 0, args.maxUniformBytes->count() > 0};
     vo.validationLayers = !noLayers;
     vo.tolerance = tol;
     vo.strict = strict;
@@ -107,7 +108,10 @@ void registerValidate(CLI::App& app, CliState& state) {
       ->check(finiteNonNegative);
   sub->add_option("--animation", cmd->animation, "glTF rig: animation name or index (default: the first)");
   sub->add_flag("--cross-check", cmd->crossCheck, "Also force and check every alternative derivation");
-  sub->add_option("--device", cmd->device, "Vulkan device name (substring); default lavapipe");
+  sub->add_option("--device", cmd->device,
+                  "Vulkan device name (substring); default lavapipe. A named device's own limits (maxVertexInputAttributes, "
+                  "maxUniformBufferRange, storage buffers) constrain the search; --max-attributes and --max-uniform-bytes "
+                  "lower them (a higher value is clamped to the device's)");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer");
   sub->add_option("--tolerance-abs", cmd->tol.abs, "Absolute tolerance (see docs/validation.md)")
       ->check(finiteNonNegative);

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <type_traits>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -122,6 +124,36 @@ Validator::Validator(const ValidateOptions& opts) : opts_(opts) {
   ho.deviceName = opts.device;
   ho.validation = opts.validationLayers;
   harness_ = std::make_unique<rt::Harness>(ho);
+  limits_ = applyDeviceLimits(opts_.gen, opts.limits, *harness_);
+}
+
+std::string applyDeviceLimits(GenerateOptions& gen, const DeviceLimitsOptions& o, const rt::Harness& device) {
+  if (!o.fromDevice) return "";
+  const VkPhysicalDeviceLimits& lim = device.limits();
+  std::vector<std::string> parts, clamped;
+  // A given limit stays when the device allows it, else the device's; not given: the device's.
+  auto set = [&](auto& value, uint64_t deviceValue, uint64_t cap, bool given, const char* flag, const char* vkName,
+                 const char* what) {
+    using T = std::remove_reference_t<decltype(value)>;
+    const uint64_t dv = std::min(deviceValue, cap);
+    if (!given) {
+      value = static_cast<T>(dv);
+    } else if (static_cast<uint64_t>(value) > dv) {
+      clamped.push_back(fmt::format("{} {} clamped to the device's {} {}", flag, value, vkName, dv));
+      value = static_cast<T>(dv);
+    }
+    parts.push_back(fmt::format("{} {}{}", value, what, given ? " (given)" : ""));
+  };
+  set(gen.maxAttributes, lim.maxVertexInputAttributes, 4096, o.attributesGiven, "--max-attributes",
+      "maxVertexInputAttributes", "vertex attributes");
+  set(gen.maxUniformBlockBytes, lim.maxUniformBufferRange, uint64_t{1} << 30, o.uniformBytesGiven,
+      "--max-uniform-bytes", "maxUniformBufferRange", "uniform bytes");
+  set(gen.maxStorageBuffers, lim.maxPerStageDescriptorStorageBuffers, 4096, false, "", "", "storage buffers");
+  set(gen.maxStorageBufferBytes, lim.maxStorageBufferRange, uint64_t{1} << 40, false, "", "", "bytes per storage buffer");
+  std::string line = "limits of " + device.deviceName() + ": ";
+  for (size_t i = 0; i < parts.size(); ++i) line += (i ? ", " : "") + parts[i];
+  for (const auto& c : clamped) line += "; " + c;
+  return line;
 }
 
 Validator::~Validator() = default;
@@ -296,6 +328,7 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
 ValidateReport Validator::run(const ValidationScene& scene) {
   ValidateReport report;
   report.device = harness_->deviceName();
+  report.limits = limits_;
   report.validationLayers = harness_->validationEnabled();
   GenerateOptions gen = opts_.gen;
   gen.capture = true;
@@ -356,6 +389,7 @@ ValidateReport Validator::run(const ValidationScene& scene) {
 std::string formatReport(const ValidateReport& report) {
   std::string s = fmt::format("device: {} (validation layers {})\n", report.device,
                               report.validationLayers ? "on" : "not available");
+  if (!report.limits.empty()) s += report.limits + "\n";
   for (const auto& run : report.runs) {
     s += fmt::format("{}: plan cost {}, {} vertices: {}\n", run.label, run.planCost, run.vertices,
                      run.pass ? "PASS" : "FAIL");
