@@ -284,6 +284,7 @@ Harness::~Harness() {
 const std::vector<std::string>& Harness::validationMessages() const { return impl_->messages; }
 std::string Harness::deviceName() const { return impl_->dev.props.deviceName; }
 bool Harness::validationEnabled() const { return impl_->validation; }
+const VkPhysicalDeviceLimits& Harness::limits() const { return impl_->dev.props.limits; }
 Harness::Handles Harness::handles() const { return {impl_->dev.pd, impl_->device, impl_->queueFamily, impl_->queue}; }
 
 RunResult Harness::run(const RunRequest& req) {

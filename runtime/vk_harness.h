@@ -56,6 +56,8 @@ class Harness {
   const std::vector<std::string>& validationMessages() const;
   std::string deviceName() const;
   bool validationEnabled() const;  // whether the layer was found and enabled
+  // The physical device's limits (maxVertexInputAttributes, maxUniformBufferRange, ...).
+  const VkPhysicalDeviceLimits& limits() const;
 
   // The device the harness set up, for code that draws with it (runtime/vk_render.h).
   struct Handles {

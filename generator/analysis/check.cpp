@@ -423,7 +423,7 @@ class Checker {
             break;
           }
         } catch (const InputError& e) {
-          add(unknownName, e.diagnostic().loc,
+          add(rule.when.failsForEveryRig() ? Severity::Error : unknownName, e.diagnostic().loc,
               fmt::format("rule '{}': cannot evaluate 'when' for {}: {}", rule.name, p.name, e.diagnostic().message));
           whenFailed = true;
           break;
@@ -445,7 +445,9 @@ class Checker {
                   fmt::format("rule '{}' has cost {} for {}, above the limit of {}", rule.name, *row.stated,
                               chosen->name, kMaxRuleCost));
         } catch (const InputError& e) {
-          add(unknownName, e.diagnostic().loc,
+          // Without a rig a failure may be that rig's (an unknown name); one in a part that
+          // every rig evaluates (a constant that overflows) is an error, as generate says.
+          add(rule.cost.failsForEveryRig() ? Severity::Error : unknownName, e.diagnostic().loc,
               fmt::format("rule '{}': cannot evaluate 'cost' for {}: {}", rule.name, chosen->name,
                           e.diagnostic().message));
         }

@@ -36,11 +36,11 @@ void GenerateArgs::add(CLI::App& cmd) {
   cmd.add_option("--max-expansions", opts.searchLimits.maxExpansions,
                  "Give up (error) after this many A* expansions")
       ->check(CLI::PositiveNumber);
-  cmd.add_option("--max-attributes", opts.maxAttributes,
+  maxAttributes = cmd.add_option("--max-attributes", opts.maxAttributes,
                  "Vertex input attributes the plan may use (the device's maxVertexInputAttributes; default 16, "
                  "what every Vulkan device supports). A constraint of the search, not a cost")
       ->check(CLI::Range(1, 4096));
-  cmd.add_option("--max-uniform-bytes", opts.maxUniformBlockBytes,
+  maxUniformBytes = cmd.add_option("--max-uniform-bytes", opts.maxUniformBlockBytes,
                  "Bytes of the uniform block (the device's maxUniformBufferRange; default 16384)")
       ->check(CLI::Range(16, 1 << 30));
   cmd.add_option("--vertices", opts.maxVertices,

@@ -104,6 +104,7 @@ struct BenchCommand {
 
   int run() {
     bo.render.gen = args.resolve();
+    bo.limits = {!bo.render.device.empty(), args.maxAttributes->count() > 0, args.maxUniformBytes->count() > 0};
     bo.render.validationLayers = !noLayers;
     unsigned w = 0, h = 0;
     char tail = 0;
@@ -179,7 +180,9 @@ void registerRender(CLI::App& app, CliState& state) {
       ->check(CLI::IsMember({"on", "off", "both"}));
   b->add_flag("--no-alternatives", bench->noAlternatives, "Only the generated plan (and the hand port and floor)");
   b->add_flag("--no-floor", bench->noFloor, "Leave out the pass-through floor");
-  b->add_option("--device", bench->bo.render.device, "Vulkan device name (substring); default lavapipe");
+  b->add_option("--device", bench->bo.render.device,
+                "Vulkan device name (substring); default lavapipe. A named device's own limits constrain the search, "
+                "as in validate --device");
   b->add_flag("--no-validation-layers", bench->noLayers, "Run without the Khronos validation layer (use for timings)");
   b->callback([bench, &state] { state.run = [bench] { return bench->run(); }; });
 }

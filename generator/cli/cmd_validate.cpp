@@ -40,6 +40,7 @@ struct ValidateCommand {
     cross.resolve(vo.via == ValidateVia::Hlsl, false, vo.gen);
     vo.crossCheck = crossCheck;
     vo.device = device;
+    vo.limits = {!device.empty(), args.maxAttributes->count() > 0, args.maxUniformBytes->count() > 0};
     vo.validationLayers = !noLayers;
     vo.tolerance = tol;
     vo.strict = strict;
@@ -183,7 +184,10 @@ void registerValidate(CLI::App& app, CliState& state) {
       ->check(CLI::IsMember({"spirv", "hlsl"}));
   sub->add_flag("-O", cmd->optimize, "Validate the optimised SPIR-V (spirv-opt -O), as `generate -O` writes it");
   cmd->cross.add(*sub, false);
-  sub->add_option("--device", cmd->device, "Vulkan device name (substring); default lavapipe");
+  sub->add_option("--device", cmd->device,
+                  "Vulkan device name (substring); default lavapipe. A named device's own limits (maxVertexInputAttributes, "
+                  "maxUniformBufferRange, storage buffers) constrain the search; --max-attributes and --max-uniform-bytes "
+                  "lower them (a higher value is clamped to the device's)");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer");
   sub->add_option("--tolerance-abs", cmd->tol.abs, "Absolute tolerance (see docs/validation.md)")
       ->check(finiteNonNegative);

@@ -23,6 +23,8 @@ struct GenerateArgs {
   std::vector<std::string> maps;  // "Name=sem[,sem...]"
   std::vector<std::string> sets;  // "param=value" (rig deformer parameters)
   std::string targetEnv = "vulkan1.0";
+  CLI::Option* maxAttributes = nullptr;  // whether the device limits were given (applyDeviceLimits)
+  CLI::Option* maxUniformBytes = nullptr;
   void add(CLI::App& cmd);
   GenerateOptions resolve() const;  // parses --map and --target-env (throws CLI::ValidationError)
 };

@@ -206,8 +206,12 @@ std::vector<StageVariable> stageVariables(glslang::TProgram& prog, bool outputs)
       if (q.hasLocation()) v.location = static_cast<int>(q.layoutLocation);
       v.flat = q.flat;
       v.block = t->getBasicType() == glslang::EbtBlock;
+      if (v.block) v.blockName = t->getTypeName().c_str();
     }
-    v.block = v.block || r.name.find('.') != std::string::npos;
+    if (r.name.find('.') != std::string::npos) {  // glslang's "Block.member"
+      v.block = true;
+      v.blockName = r.name.substr(0, r.name.find('.'));
+    }
     out.push_back(std::move(v));
   }
   return out;

@@ -49,7 +49,8 @@ struct StageVariable {
   std::string typeText;      // glslang's spelling of the type (for messages)
   int location = -1;         // -1: no layout(location)
   bool flat = false;
-  bool block = false;        // member of an interface block
+  bool block = false;        // an interface block, or a member of one
+  std::string blockName;     // the block's type name (`in Block { ... } instance;`)
 };
 
 // A member of a uniform block, laid out as the compiler laid it out (std140).

@@ -66,7 +66,8 @@ SourceLoc findDeclaration(const std::string& src, const std::string& file, const
       last = SourceLoc{file, line, static_cast<int>(b - lineStart) + 1};
       continue;
     }
-    if (c == ';' && sawIn && lastName == name) return last;
+    // `in T name;`, or the block name of `in Block { ... } instance;`
+    if ((c == ';' || c == '{') && sawIn && lastName == name) return last;
     if (c == ';' || c == '{' || c == '}') {
       sawIn = false;
       lastName.clear();
@@ -147,11 +148,14 @@ FragmentInterface reflectFragmentSource(const std::string& source, const std::st
     if (r.name.rfind("gl_", 0) == 0) continue;  // gl_FragCoord etc. are not vertex outputs
     FragmentInput in;
     in.name = r.name;
+    if (r.block)  // located at `in Block {`
+      throw InputError(findDeclaration(source, fileName, r.blockName),
+                       fmt::format("fragment input block '{}' ('{}'): interface blocks are not supported as inputs (the "
+                                   "generated vertex shader writes, and validation captures, plain outputs); declare "
+                                   "each member as a plain 'in' variable with layout(location = N) (matrices and "
+                                   "arrays are supported)",
+                                   r.blockName, r.name));
     in.loc = findDeclaration(source, fileName, r.name);
-    if (r.block)
-      throw InputError(in.loc, fmt::format("fragment input '{}' is in an interface block; declare plain 'in' variables "
-                                           "(matrices and arrays are supported)",
-                                           r.name));
     if (!r.type)
       throw InputError(in.loc, fmt::format("fragment input '{}' has type '{}'; supported: scalars, vectors, mat3, mat4 "
                                            "and 1-D arrays of them",

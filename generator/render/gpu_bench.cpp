@@ -197,7 +197,14 @@ constexpr double kRunToRunSpread = 0.005;
 
 GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   const TargetEnv env = opts.render.gen.targetEnv;
+  // Every program is validated on the device that times it, which is opened first: a named
+  // device's own limits constrain the search.
+  ValidateOptions vo;
+  vo.device = opts.render.device;
+  vo.validationLayers = opts.render.validationLayers;
+  Validator validator(vo);
   GenerateOptions gen = opts.render.gen;
+  const std::string limits = applyDeviceLimits(gen, opts.limits, validator.harness());
   gen.capture = false;
   LoadedInputs in = loadInputs(gen);
   const Rig& rig = in.rig;
@@ -271,10 +278,6 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
 
   // Validated on the device that times them, fed exactly as timed: the timed pose and a
   // hostile random one (a rest pose hides a wrong bone index).
-  ValidateOptions vo;
-  vo.device = opts.render.device;
-  vo.validationLayers = opts.render.validationLayers;
-  Validator validator(vo);
   ValidationScene vscene{scene.mesh, {scene.pose}, scene.shape};
   vscene.poses.push_back(rt::makeRandomPose(scene.shape, 1, rt::hostilePoseOptions(scene.shape.uniformScale)));
   limitActiveTargets(rig, vscene.poses, 1);
@@ -290,6 +293,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   rt::Renderer renderer(validator.harness());
   GpuBenchReport rep;
   rep.device = validator.harness().deviceName();
+  rep.limits = limits;
   rep.driver = renderer.driver();
   rep.vertices = scene.mesh.vertexCount;
   rep.triangles = scene.indices.size() / 3;
@@ -363,9 +367,10 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
 }
 
 std::string formatGpuBench(const GpuBenchReport& r) {
-  std::string s = fmt::format("device: {} (driver: {})\nmesh: {} vertices, {} triangles; {} draws per frame, median of {} frames, best of {} rounds; "
+  std::string s = fmt::format("device: {} (driver: {})\n{}mesh: {} vertices, {} triangles; {} draws per frame, median of {} frames, best of {} rounds; "
                               "rasterization on: {}x{} target\n\n",
-                              r.device, r.driver, r.vertices, r.triangles, r.drawsPerFrame, r.frames, r.rounds, r.width, r.height);
+                              r.device, r.driver, r.limits.empty() ? "" : r.limits + "\n", r.vertices, r.triangles,
+                              r.drawsPerFrame, r.frames, r.rounds, r.width, r.height);
   const GpuBenchRow* gen = nullptr;
   for (const auto& row : r.rows)
     if (row.label == "generated") gen = &row;

@@ -15,11 +15,13 @@
 
 #include "render/render.h"
 #include "search/device_profile.h"
+#include "validate/validate.h"
 
 namespace sg {
 
 struct GpuBenchOptions {
   RenderOptions render;        // gen, device, size, mesh ("dawn"), lighting
+  DeviceLimitsOptions limits;  // the search's limits from the device (validate/validate.h)
   std::string handPortPath;    // "" = none; GLSL with the generated shader's interface
   bool floor = true;           // the pass-through program
   bool alternatives = true;    // every forced alternative (as validate --cross-check)
@@ -50,6 +52,7 @@ struct GpuBenchRow {
 
 struct GpuBenchReport {
   std::string device, driver;
+  std::string limits;  // the device limits the plans were searched under ("" = the flags)
   size_t vertices = 0, triangles = 0;
   uint32_t drawsPerFrame = 0, frames = 0, rounds = 0, width = 0, height = 0;
   std::vector<GpuBenchRow> rows;

@@ -263,7 +263,34 @@ int64_t evalNode(const Expr::Node& n, const ExprEnv& env, const SourceLoc& loc) 
   return 0;
 }
 
+// Whether the subtree has no names and no has(); the first always-evaluated constant part
+// that fails goes to `found`. Recursion is bounded by the parse (kMaxExprDepth).
+bool constantPart(const Expr::Node& n, bool always, const SourceLoc& loc, std::optional<Diagnostic>& found) {
+  bool constant = n.kind == Expr::Node::Num;
+  if (n.kind == Expr::Node::Unary) constant = constantPart(*n.a, always, loc, found);
+  if (n.kind == Expr::Node::Binary) {
+    const bool shortCircuit = n.text == "&&" || n.text == "||";
+    bool a = constantPart(*n.a, always, loc, found);
+    bool b = constantPart(*n.b, always && !shortCircuit, loc, found);
+    constant = a && b;
+  }
+  if (constant && always && !found) {
+    try {
+      evalNode(n, ExprEnv{}, loc);
+    } catch (const InputError& e) {
+      found = e.diagnostic();
+    }
+  }
+  return constant;
+}
+
 }  // namespace
+
+std::optional<Diagnostic> Expr::failsForEveryRig() const {
+  std::optional<Diagnostic> found;
+  if (root_) constantPart(*root_, true, loc_, found);
+  return found;
+}
 
 Expr Expr::parse(const std::string& text, const SourceLoc& loc) {
   Expr e;

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "common/diagnostics.h"
@@ -29,6 +30,9 @@ class Expr {
   static Expr parse(const std::string& text, const SourceLoc& loc);
   // Throws InputError (unknown name, division by zero, 64-bit overflow).
   int64_t eval(const ExprEnv& env) const;
+  // The error every rig gets: a part without names or has() that is always evaluated (not
+  // the right side of && or ||) and fails (overflow, division by zero). nullopt if none.
+  std::optional<Diagnostic> failsForEveryRig() const;
   const std::string& text() const { return text_; }
   bool empty() const { return !root_; }
   struct Node;

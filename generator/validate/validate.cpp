@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <type_traits>
 #include <random>
 #include <set>
 
@@ -186,6 +187,36 @@ Validator::Validator(const ValidateOptions& opts) : opts_(opts) {
   ho.deviceName = opts.device;
   ho.validation = opts.validationLayers;
   harness_ = std::make_unique<rt::Harness>(ho);
+  limits_ = applyDeviceLimits(opts_.gen, opts.limits, *harness_);
+}
+
+std::string applyDeviceLimits(GenerateOptions& gen, const DeviceLimitsOptions& o, const rt::Harness& device) {
+  if (!o.fromDevice) return "";
+  const VkPhysicalDeviceLimits& lim = device.limits();
+  std::vector<std::string> parts, clamped;
+  // A given limit stays when the device allows it, else the device's; not given: the device's.
+  auto set = [&](auto& value, uint64_t deviceValue, uint64_t cap, bool given, const char* flag, const char* vkName,
+                 const char* what) {
+    using T = std::remove_reference_t<decltype(value)>;
+    const uint64_t dv = std::min(deviceValue, cap);
+    if (!given) {
+      value = static_cast<T>(dv);
+    } else if (static_cast<uint64_t>(value) > dv) {
+      clamped.push_back(fmt::format("{} {} clamped to the device's {} {}", flag, value, vkName, dv));
+      value = static_cast<T>(dv);
+    }
+    parts.push_back(fmt::format("{} {}{}", value, what, given ? " (given)" : ""));
+  };
+  set(gen.maxAttributes, lim.maxVertexInputAttributes, 4096, o.attributesGiven, "--max-attributes",
+      "maxVertexInputAttributes", "vertex attributes");
+  set(gen.maxUniformBlockBytes, lim.maxUniformBufferRange, uint64_t{1} << 30, o.uniformBytesGiven,
+      "--max-uniform-bytes", "maxUniformBufferRange", "uniform bytes");
+  set(gen.maxStorageBuffers, lim.maxPerStageDescriptorStorageBuffers, 4096, false, "", "", "storage buffers");
+  set(gen.maxStorageBufferBytes, lim.maxStorageBufferRange, uint64_t{1} << 40, false, "", "", "bytes per storage buffer");
+  std::string line = "limits of " + device.deviceName() + ": ";
+  for (size_t i = 0; i < parts.size(); ++i) line += (i ? ", " : "") + parts[i];
+  for (const auto& c : clamped) line += "; " + c;
+  return line;
 }
 
 Validator::~Validator() = default;
@@ -362,8 +393,12 @@ ValidateReport Validator::run(const ValidationScene& scene) { return run(scene, 
 ValidateReport Validator::run(const ValidationScene& scene, const GenerateOptions& options) {
   ValidateReport report;
   report.device = harness_->deviceName();
+  report.limits = limits_;
   report.validationLayers = harness_->validationEnabled();
   GenerateOptions gen = options;
+  // A whole model's primitives arrive with the command line's options: the device's limits
+  // apply to each as to a single rig (idempotent for opts_.gen, which has them already).
+  applyDeviceLimits(gen, opts_.limits, *harness_);
   // Through HLSL: the shipped build is translated (its text is what `generate --emit hlsl`
   // writes) and the capture is added to the module compiled back from it.
   gen.capture = opts_.via == ValidateVia::Spirv;
@@ -425,8 +460,11 @@ ValidateReport Validator::run(const ValidationScene& scene, const GenerateOption
 }
 
 std::string formatReport(const ValidateReport& report) {
-  std::string s = fmt::format("device: {} (validation layers {}), running {}\n", report.device,
+  std::string s = fmt::format("device: {} (validation layers {}), running {}
+", report.device,
                               report.validationLayers ? "on" : "not available", report.via);
+  if (!report.limits.empty()) s += report.limits + "
+";
   for (const auto& run : report.runs) {
     s += fmt::format("{}: plan cost {}, {} vertices: {}\n", run.label, run.planCost, run.vertices,
                      run.pass ? "PASS" : "FAIL");

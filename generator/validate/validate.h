@@ -58,6 +58,7 @@ struct RunReport {
 struct ValidateReport {
   std::string device;
   std::string via = "SPIR-V";  // what ran: "SPIR-V", or "HLSL 5.0 (compiled back by glslang)"
+  std::string limits;  // the device limits the plans were searched under (applyDeviceLimits)
   bool validationLayers = false;
   std::vector<RunReport> runs;
   bool pass = true;
@@ -83,9 +84,24 @@ void limitActiveTargets(const Rig& rig, std::vector<rt::Pose>& poses, uint32_t s
 // from the shipped SPIR-V, compiled back by glslang's HLSL front end (docs/hlsl-msl.md).
 enum class ValidateVia { Spirv, Hlsl };
 
+// The search's device limits when a plan is run on a named device (docs/limits.md, "Device
+// limits"): `validate --device` and `bench --device` read them from the Vulkan physical
+// device; a limit given on the command line is kept below the device's and clamped to it
+// above (a plan over the device's limits could not run there).
+struct DeviceLimitsOptions {
+  bool fromDevice = false;
+  bool attributesGiven = false;    // --max-attributes
+  bool uniformBytesGiven = false;  // --max-uniform-bytes
+};
+// Sets gen's maxAttributes, maxUniformBlockBytes, maxStorageBuffers and
+// maxStorageBufferBytes from `device` as `o` says; returns one line saying what was used
+// and where from ("" when o.fromDevice is false: gen is left as it is).
+std::string applyDeviceLimits(GenerateOptions& gen, const DeviceLimitsOptions& o, const rt::Harness& device);
+
 struct ValidateOptions {
   GenerateOptions gen;
   ValidateVia via = ValidateVia::Spirv;
+  DeviceLimitsOptions limits;
   bool crossCheck = false;  // also force each alternative derivation and check it
   Tolerance tolerance;
   std::string device;       // "" = lavapipe
@@ -116,6 +132,7 @@ class Validator {
 
   ValidateOptions opts_;
   std::unique_ptr<rt::Harness> harness_;
+  std::string limits_;  // applyDeviceLimits's line
   size_t reportedMessages_ = 0;  // layer messages already attributed to a run (setup's go to the first)
 };
 

@@ -920,6 +920,27 @@ TEST(Expr, DivisionByZero) {
   EXPECT_MSG(d2, "division by zero");
 }
 
+// A failure no rig can avoid (check's error without a rig): a constant part that is always
+// evaluated. A part with a name, or behind && / ||, may be some rig's business.
+TEST(Expr, FailsForEveryRig) {
+  auto every = [](const std::string& text) {
+    return sg::Expr::parse(text, sg::SourceLoc{"r.yaml", 3, 9}).failsForEveryRig();
+  };
+  auto d = every("bones * (4611686018427387904 * 4)");
+  ASSERT_TRUE(d);
+  EXPECT_EQ(d->loc.col, 9 + 29);  // the inner '*'
+  EXPECT_NE(d->message.find("integer overflow in expression (4611686018427387904 * 4)"), std::string::npos);
+  EXPECT_TRUE(every("9223372036854775807 + 1"));
+  EXPECT_TRUE(every("bones + 1 / 0"));
+  EXPECT_TRUE(every("(1 / 0) && bones"));  // the left side is always evaluated
+  EXPECT_FALSE(every("bones * 4611686018427387904 * 4"));  // fine for bones == 0
+  EXPECT_FALSE(every("bones > 0 && 1 / 0"));               // only for rigs with bones
+  EXPECT_FALSE(every("has(morph.position) || 1 / 0"));
+  EXPECT_FALSE(every("0 && 1 / 0"));  // constant, and short-circuited: never fails
+  EXPECT_TRUE(every("4611686018427387904 * 2 - 1"));  // 2^63 overflows before the - 1
+  EXPECT_FALSE(every("(bones + 3) / 4 * 2 + 1"));
+}
+
 TEST(Expr, ParseErrors) {
   auto d = errorOf([&] { sg::Expr::parse("1 +", sg::SourceLoc{"r.yaml", 2, 5}); });
   EXPECT_LOC(d, "r.yaml", 2, 5 + 3);

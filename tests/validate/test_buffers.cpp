@@ -184,4 +184,49 @@ TEST(Buffers, MorphStressTestThroughBuffers) {
   EXPECT_TRUE(has(rep.runs[0].rules, "object_position_morphed_buffer"));
 }
 
+// validate --device NAME: the named device's own limits replace the ones every device
+// guarantees. lavapipe's maxUniformBufferRange holds the 300-bone palette (19,200 bytes,
+// over the guaranteed 16,384), so the palette comes from the uniform block, not a buffer.
+// A given limit is kept below the device's and clamped above it.
+TEST(Buffers, NamedDeviceLimitsComeFromTheDevice) {
+  sg::ValidateOptions vo;
+  vo.gen.rigPath = dataPath("limb8_palette300.rig.yaml");
+  vo.gen.fragmentPath = dataPath("world.frag");
+  vo.gen.rulesPaths = {sourcePath("rules/standard.yaml")};
+  vo.device = "llvmpipe";
+  vo.limits.fromDevice = true;
+  sg::ValidationScene scene = sg::proceduralScene(sg::loadRigFile(vo.gen.rigPath), "limb", 3, 2);
+  sg::Validator v(vo);
+  const VkPhysicalDeviceLimits& lim = v.harness().limits();
+  ASSERT_GE(lim.maxUniformBufferRange, 300u * 64u);
+  ASSERT_GT(lim.maxVertexInputAttributes, 16u);
+  sg::ValidateReport rep = v.run(scene);
+  std::cout << sg::formatReport(rep);
+  expectAllPass(rep);
+  EXPECT_TRUE(has(rep.runs[0].rules, "skin_matrix_blend")) << rep.limits;
+  EXPECT_FALSE(has(rep.runs[0].rules, "skin_matrix_blend_buffer_palette"));
+  EXPECT_NE(rep.limits.find(std::to_string(lim.maxVertexInputAttributes) + " vertex attributes, " +
+                            std::to_string(lim.maxUniformBufferRange) + " uniform bytes"),
+            std::string::npos)
+      << rep.limits;
+  EXPECT_NE(sg::formatReport(rep).find(rep.limits), std::string::npos);
+
+  sg::GenerateOptions given;
+  given.maxAttributes = 8;
+  given.maxUniformBlockBytes = 1u << 30;
+  std::string line = sg::applyDeviceLimits(given, {true, true, true}, v.harness());
+  EXPECT_EQ(given.maxAttributes, 8);
+  EXPECT_EQ(given.maxUniformBlockBytes, lim.maxUniformBufferRange);
+  EXPECT_NE(line.find("8 vertex attributes (given)"), std::string::npos) << line;
+  EXPECT_NE(line.find("--max-uniform-bytes 1073741824 clamped to the device's maxUniformBufferRange " +
+                      std::to_string(lim.maxUniformBufferRange)),
+            std::string::npos)
+      << line;
+  // Without a named device the guaranteed limits stay: validation checks generate's plan.
+  sg::GenerateOptions portable;
+  EXPECT_EQ(sg::applyDeviceLimits(portable, {}, v.harness()), "");
+  EXPECT_EQ(portable.maxAttributes, 16);
+  EXPECT_EQ(portable.maxUniformBlockBytes, 16384u);
+}
+
 }  // namespace
