@@ -48,6 +48,7 @@ struct RenderCommand {
   // MODEL.glb#*: every primitive generated and posed first (a failure names its primitive
   // and nothing is drawn or written), then drawn under one camera.
   RenderResult renderModel(RenderSession& session, const std::vector<GltfPart>& parts) {
+    checkWholeModelAnimation(parts, ro.animation);
     std::vector<ModelPart> programs;
     std::vector<std::string> failed =
         forEachPart(parts, [&](const GltfPart& part) { programs.push_back(modelPart(ro, part)); });

@@ -6,6 +6,7 @@
 
 #include "cli/commands.h"
 #include "common/diagnostics.h"
+#include "validate/gltf_scene.h"
 
 namespace sg {
 
@@ -16,6 +17,20 @@ std::optional<std::vector<GltfPart>> wholeModelParts(const std::string& rigPath)
                      fmt::format("'#*' selects every primitive of a glTF model (.gltf, .glb); '{}' is not one",
                                  rigPath.substr(0, rigPath.size() - 2)));
   return gltfParts(parseGltfRef(rigPath, true).file);
+}
+
+void checkWholeModelAnimation(const std::vector<GltfPart>& parts, const std::string& animation) {
+  if (animation.empty() || parts.empty()) return;
+  GltfImportOptions o;
+  o.mesh = parts.front().mesh;
+  o.primitive = parts.front().primitive;
+  std::optional<GltfImport> first;
+  try {
+    first = importGltf(parseGltfRef(parts.front().ref).file, o);
+  } catch (const InputError&) {
+    return;  // that primitive's own failure is reported with the others
+  }
+  findGltfAnimation(first->data, animation);
 }
 
 std::vector<std::string> forEachPart(const std::vector<GltfPart>& parts,
