@@ -86,7 +86,8 @@ std::string wholeModelIndex(const std::string& command, const std::string& rigPa
     list.push_back(std::move(e));
   }
   index["primitives"] = std::move(list);
-  return index.dump(2) + "\n";
+  // Paths are bytes on Linux: invalid UTF-8 in one is replaced (U+FFFD), not an exception.
+  return index.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace sg
