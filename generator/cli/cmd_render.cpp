@@ -48,10 +48,13 @@ struct RenderCommand {
   // MODEL.glb#*: every primitive generated and posed first (a failure names its primitive
   // and nothing is drawn or written), then drawn under one camera.
   RenderResult renderModel(RenderSession& session, const std::vector<GltfPart>& parts) {
+    checkWholeModelAnimation(parts, ro.animation);
     std::vector<ModelPart> programs;
     std::vector<std::string> failed =
         forEachPart(parts, [&](const GltfPart& part) { programs.push_back(modelPart(ro, part)); });
     failIfPartsFailed(ro.gen.rigPath, parts.size(), failed);
+    for (const auto& p : programs)
+      for (const auto& n : p.notes) std::cerr << fmt::format("{}: warning: {}: {}\n", ro.gen.rigPath, p.name, n);
     frameModel(programs, ro.camera, float(ro.width) / float(ro.height));
     FragmentProgram frag = compileFragmentFile(ro.gen.fragmentPath, ro.gen.targetEnv);
     return session.renderModel(programs, frag, texturesFor(frag, ro.lighting), ro);

@@ -103,6 +103,7 @@ struct ValidateCommand {
     so.times = times;
     so.animation = animation;
     so.morphWeight = morphWeight;
+    checkWholeModelAnimation(parts, animation);
     Validator v(vo);
     std::vector<std::string> lines(parts.size());
     std::string header;

@@ -6,6 +6,7 @@
 
 #include "cli/commands.h"
 #include "common/diagnostics.h"
+#include "validate/gltf_scene.h"
 
 namespace sg {
 
@@ -16,6 +17,20 @@ std::optional<std::vector<GltfPart>> wholeModelParts(const std::string& rigPath)
                      fmt::format("'#*' selects every primitive of a glTF model (.gltf, .glb); '{}' is not one",
                                  rigPath.substr(0, rigPath.size() - 2)));
   return gltfParts(parseGltfRef(rigPath, true).file);
+}
+
+void checkWholeModelAnimation(const std::vector<GltfPart>& parts, const std::string& animation) {
+  if (animation.empty() || parts.empty()) return;
+  GltfImportOptions o;
+  o.mesh = parts.front().mesh;
+  o.primitive = parts.front().primitive;
+  std::optional<GltfImport> first;
+  try {
+    first = importGltf(parseGltfRef(parts.front().ref).file, o);
+  } catch (const InputError&) {
+    return;  // that primitive's own failure is reported with the others
+  }
+  findGltfAnimation(first->data, animation);
 }
 
 std::vector<std::string> forEachPart(const std::vector<GltfPart>& parts,
@@ -71,7 +86,8 @@ std::string wholeModelIndex(const std::string& command, const std::string& rigPa
     list.push_back(std::move(e));
   }
   index["primitives"] = std::move(list);
-  return index.dump(2) + "\n";
+  // Paths are bytes on Linux: invalid UTF-8 in one is replaced (U+FFFD), not an exception.
+  return index.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace sg

@@ -17,6 +17,10 @@ namespace sg {
 // "#*" after a rig that is not a glTF model and for a model without primitives.
 std::optional<std::vector<GltfPart>> wholeModelParts(const std::string& rigPath);
 
+// The animation belongs to the model, not to a primitive: an unknown name is refused once,
+// before the primitives run, instead of once per primitive. ("" = the first: nothing to check.)
+void checkWholeModelAnimation(const std::vector<GltfPart>& parts, const std::string& animation);
+
 // Runs `body` on every part. A part that throws (InputError or any std::exception) is
 // reported on standard error, its primitive named, and the next part still runs. Returns the
 // names of the parts that failed, in order.

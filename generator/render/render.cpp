@@ -66,15 +66,49 @@ ModelPart modelPart(const RenderOptions& opts, const GltfPart& part) {
   p.name = part.name;
   p.gen = generate(o.gen);
   p.scene = renderScene(p.gen.in.rig, o);
+  // Other instances: every node of the scene (depth first, each once) that draws this mesh.
+  GltfImportOptions io;
+  io.mesh = part.mesh;
+  io.primitive = part.primitive;
+  GltfImport model = importGltf(parseGltfRef(part.ref).file, io);
+  const GltfModelData& d = model.data;
+  std::vector<int> todo(d.sceneRoots.rbegin(), d.sceneRoots.rend());
+  std::vector<char> seen(d.nodes.size(), 0);
+  while (!todo.empty()) {
+    int n = todo.back();
+    todo.pop_back();
+    if (seen[static_cast<size_t>(n)]) continue;
+    seen[static_cast<size_t>(n)] = 1;
+    const GltfNode& node = d.nodes[static_cast<size_t>(n)];
+    todo.insert(todo.end(), node.children.rbegin(), node.children.rend());
+    if (node.mesh != d.mesh || n == d.meshNode) continue;
+    if (node.skin >= 0 || d.skin >= 0) {  // a skin places the mesh, not the node
+      p.notes.push_back(fmt::format("node {} also instantiates mesh {} with a skin; it is not drawn again", n, d.mesh));
+      continue;
+    }
+    GltfImport instance = model;
+    instance.data.meshNode = n;
+    GltfSceneOptions so;
+    so.times = {opts.time};
+    so.animation = opts.animation;
+    so.morphWeight = opts.gltfMorphWeight;
+    p.instances.push_back(gltfScene(instance, so).poses.front());
+  }
   return p;
 }
 
 void frameModel(std::vector<ModelPart>& parts, const RenderCamera& cam, float aspect) {
   std::vector<glm::vec3> world;
-  for (const auto& p : parts)
+  for (const auto& p : parts) {
     for (const auto& w : rt::referenceValues("world.position", p.scene.mesh, p.scene.pose, p.scene.shape))
       world.emplace_back(w);
-  for (auto& p : parts) frameCameraOn(world, cam, aspect, p.scene.pose);
+    for (const auto& pose : p.instances)
+      for (const auto& w : rt::referenceValues("world.position", p.scene.mesh, pose, p.scene.shape)) world.emplace_back(w);
+  }
+  for (auto& p : parts) {
+    frameCameraOn(world, cam, aspect, p.scene.pose);
+    for (auto& pose : p.instances) frameCameraOn(world, cam, aspect, pose);
+  }
 }
 
 rt::Image mergeByDepth(const std::vector<rt::Image>& images) {
@@ -250,11 +284,16 @@ RenderResult RenderSession::renderModel(const std::vector<ModelPart>& parts, con
   std::vector<rt::Image> images;
   RenderResult r;
   for (const auto& p : parts) {
-    RenderResult one = render(p.gen, fragment, textures, p.scene, opts);
-    images.push_back(std::move(one.image));
-    r.planCost += one.planCost;
-    r.device = one.device;
-    r.validationMessages.insert(r.validationMessages.end(), one.validationMessages.begin(), one.validationMessages.end());
+    RenderScene scene = p.scene;
+    for (size_t i = 0; i <= p.instances.size(); ++i) {
+      if (i > 0) scene.pose = p.instances[i - 1];
+      RenderResult one = render(p.gen, fragment, textures, scene, opts);
+      images.push_back(std::move(one.image));
+      if (i == 0) r.planCost += one.planCost;
+      r.device = one.device;
+      r.validationMessages.insert(r.validationMessages.end(), one.validationMessages.begin(),
+                                  one.validationMessages.end());
+    }
   }
   r.image = mergeByDepth(images);
   if (partImages) *partImages = std::move(images);

@@ -73,9 +73,13 @@ struct ModelPart {
   std::string name;  // gltfPartName
   GenerateResult gen;
   RenderScene scene;
+  // The other nodes of the scene that draw this (unskinned) mesh, each pose with its node's
+  // world transform as model.matrix: a mesh instanced by several nodes is drawn at each.
+  std::vector<rt::Pose> instances;
+  std::vector<std::string> notes;  // instances not drawn, and why
 };
 ModelPart modelPart(const RenderOptions& opts, const GltfPart& part);
-// One camera framing every part's posed world positions, set on every part's pose.
+// One camera framing every part's posed world positions (instances too), set on every pose.
 void frameModel(std::vector<ModelPart>& parts, const RenderCamera& cam, float aspect);
 // Per pixel, the colour of the nearest surface among `images` (smallest depth; ties go to
 // the earlier image), which is what drawing them all in one depth-tested pass writes for
@@ -112,7 +116,8 @@ class RenderSession {
   RenderResult render(const GenerateResult& gen, const FragmentProgram& fragment, const std::vector<rt::Texture>& textures,
                       const RenderScene& scene, const RenderOptions& opts);
   // A whole model: every part drawn with its own program under the parts' shared camera
-  // (frameModel), merged by depth. `partImages`, when given, receives each part's own image.
+  // (frameModel), merged by depth. `partImages`, when given, receives each draw's own image
+  // (a part, then its instances).
   // planCost is the sum of the parts' costs.
   RenderResult renderModel(const std::vector<ModelPart>& parts, const FragmentProgram& fragment,
                            const std::vector<rt::Texture>& textures, const RenderOptions& opts,

@@ -304,5 +304,55 @@ TEST(WholeModel, RenderCoversTheUnionOfThePrimitivesSilhouettes) {
   fs::remove(png);
 }
 
+// A mesh that two nodes instantiate is drawn at both: one primitive, one program, two
+// triangles in the picture, side by side (translations -2 and +2 on x).
+TEST(WholeModel, RenderDrawsEveryNodeThatInstantiatesAMesh) {
+  fs::path d = scratch("instances");
+  fs::create_directories(d);
+  std::ofstream(d / "m.gltf")
+      << R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}],)"
+         R"("bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
+         R"("meshes":[{"name":"tri","primitives":[{"attributes":{"POSITION":0}}]}],)"
+         R"("nodes":[{"mesh":0,"translation":[-2,0,0]},{"mesh":0,"translation":[2,0,0]}],"scenes":[{"nodes":[0,1]}]})";
+  RenderOptions ro;
+  ro.gen.rigPath = (d / "m.gltf").string() + "#*";
+  ro.gen.fragmentPath = dataPath("minimal.frag");
+  ro.gen.rulesPaths = {sourcePath("rules/standard.yaml")};
+  ro.width = ro.height = 96;
+  std::vector<GltfPart> gp = gltfParts((d / "m.gltf").string());
+  ASSERT_EQ(gp.size(), 1u);
+  std::vector<ModelPart> parts{modelPart(ro, gp[0])};
+  ASSERT_EQ(parts[0].instances.size(), 1u);
+  frameModel(parts, ro.camera, 1.0f);
+  RenderSession session("", false);
+  FragmentProgram fp = compileFragmentFile(ro.gen.fragmentPath, ro.gen.targetEnv);
+  std::vector<rt::Image> draws;
+  RenderResult r = session.renderModel(parts, fp, texturesFor(fp, ro.lighting), ro, &draws);
+  ASSERT_EQ(draws.size(), 2u);
+  // Each instance covers pixels on its own side of the image and none of the other's.
+  auto columns = [](const rt::Image& im) {
+    uint32_t lo = im.width, hi = 0;
+    size_t n = 0;
+    for (uint32_t y = 0; y < im.height; ++y)
+      for (uint32_t x = 0; x < im.width; ++x)
+        if (im.depth[size_t(y) * im.width + x] < 1.0f) {
+          lo = std::min(lo, x);
+          hi = std::max(hi, x);
+          ++n;
+        }
+    return std::make_tuple(lo, hi, n);
+  };
+  auto [lo0, hi0, n0] = columns(draws[0]);
+  auto [lo1, hi1, n1] = columns(draws[1]);
+  auto [loW, hiW, nW] = columns(r.image);
+  EXPECT_GT(n0, 0u);
+  EXPECT_GT(n1, 0u);
+  EXPECT_LT(hi0, lo1) << "the node at x = -2 is drawn left of the one at x = +2";
+  EXPECT_EQ(nW, n0 + n1);
+  EXPECT_EQ(loW, lo0);
+  EXPECT_EQ(hiW, hi1);
+  fs::remove_all(d);
+}
+
 }  // namespace
 }  // namespace sg

@@ -232,6 +232,14 @@ case("whole-rig-import-needs-output", {"m.gltf": text(model([POS]))}, "rig impor
      "-o: is required with a whole model")
 case("whole-rig-import-mesh-option", {"m.gltf": text(model([POS]))}, "rig import @D/m.gltf#* --mesh 0 -o @O/rigs", 2,
      "--mesh: does not apply")
+many = model([POS], extra={"meshes": [{"name": "tri", "primitives": [{"attributes": {"POSITION": 0}}] * 1025}]})
+case("whole-too-many-primitives", {"m.gltf": json.dumps(many).encode()},
+     "generate --rig @D/m.gltf#* -f tests/gltf/data/minimal.frag -r rules/standard.yaml -o @O/shaders", 1,
+     "the model has 1025 mesh primitives; a whole model (#*) takes at most 1024 (kMaxGltfParts)")
+case("whole-unknown-animation", {},
+     "validate --rig tests/gltf/data/RobotExpressive/RobotExpressive.glb#* -f tests/gltf/data/lit.frag "
+     "-r rules/standard.yaml --animation Nope --time 0.5", 1,
+     "RobotExpressive.glb: error: the model has no animation 'Nope' (it has 'Dance',")
 case("whole-selection-malformed", {"m.gltf": text(model([POS]))}, "rig import @D/m.gltf#** -o @O/rigs", 1,
      "'#**' does not select a primitive", "or MODEL.gltf#* (every primitive)")
 
