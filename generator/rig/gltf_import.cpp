@@ -162,6 +162,22 @@ bool storageAllowed(const tinygltf::Accessor& a, int type, Storage s) {
   }
   return false;
 }
+
+// The vertex format that holds a normalized integer accessor as stored (a VEC3 in the x4
+// form: glTF aligns each element to 4 bytes, so the fourth component is the padding), or
+// none: float, and integers read unnormalized, which need a decode the rig cannot state yet.
+std::optional<VertexFormat> storedFormat(const tinygltf::Accessor& a) {
+  if (!a.normalized || (a.type != TINYGLTF_TYPE_VEC2 && a.type != TINYGLTF_TYPE_VEC3 && a.type != TINYGLTF_TYPE_VEC4))
+    return std::nullopt;
+  const bool two = a.type == TINYGLTF_TYPE_VEC2;
+  switch (a.componentType) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: return two ? VertexFormat::Snorm8x2 : VertexFormat::Snorm8x4;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return two ? VertexFormat::Unorm8x2 : VertexFormat::Unorm8x4;
+    case TINYGLTF_COMPONENT_TYPE_SHORT: return two ? VertexFormat::Snorm16x2 : VertexFormat::Snorm16x4;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return two ? VertexFormat::Unorm16x2 : VertexFormat::Unorm16x4;
+    default: return std::nullopt;
+  }
+}
 const char* storageText(Storage s) {
   switch (s) {
     case Storage::Float: return "float";
@@ -244,12 +260,17 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   auto isFloat = [](const tinygltf::Accessor* a, int type) {
     return a->componentType == TINYGLTF_COMPONENT_TYPE_FLOAT && a->type == type;
   };
-  // Quantized storage the table allows: noted, then read (dequantized) as float.
-  auto stored = [&](const std::string& name, const tinygltf::Accessor* a, int type, Storage st) {
+  // Quantized storage the table allows: noted, then read (dequantized) as float. `asStored`:
+  // the rig's format for it when a vertex format holds it as stored (storedFormat), else float.
+  auto stored = [&](const std::string& name, const tinygltf::Accessor* a, int type, Storage st,
+                    std::optional<VertexFormat> asStored = std::nullopt) {
     if (!storageAllowed(*a, type, st)) return false;
     if (a->componentType != TINYGLTF_COMPONENT_TYPE_FLOAT)
-      imp.notes.push_back(fmt::format("{} is stored {} (KHR_mesh_quantization): expanded to float for the shader",
-                                      name, formatText(imp.attributes[infoIndex.at(name)])));
+      imp.notes.push_back(
+          asStored ? fmt::format("{} is stored {} (KHR_mesh_quantization): fed to the shader as stored, {}", name,
+                                 formatText(imp.attributes[infoIndex.at(name)]), formatName(*asStored))
+                   : fmt::format("{} is stored {} (KHR_mesh_quantization): expanded to float for the shader", name,
+                                 formatText(imp.attributes[infoIndex.at(name)])));
     return true;
   };
   auto carried = [&](const std::string& name, const std::string& rigName, VertexFormat f) {
@@ -294,21 +315,24 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
 
   bool hasNormal = false, hasTangent = false;
   if (const auto* a = accessorOf("NORMAL")) {
-    if (stored("NORMAL", a, TINYGLTF_TYPE_VEC3, Storage::SignedNormalized)) {
+    const std::optional<VertexFormat> asStored = storedFormat(*a);
+    if (stored("NORMAL", a, TINYGLTF_TYPE_VEC3, Storage::SignedNormalized, asStored)) {
       hasNormal = true;
-      rig.attributes.push_back(makeAttribute("normal", VertexFormat::Float32x3, {{"vertex.normal", ""}}, file));
-      carried("NORMAL", "normal", VertexFormat::Float32x3);
+      const VertexFormat f = asStored.value_or(VertexFormat::Float32x3);
+      rig.attributes.push_back(makeAttribute("normal", f, {{"vertex.normal", asStored ? "xyz" : ""}}, file));
+      carried("NORMAL", "normal", f);
       data.streams["vertex.normal"] = reader.stream(readAttr("NORMAL"), 0, 3, where + " attribute NORMAL");
     } else {
       skip("NORMAL", fmt::format("normals are VEC3 of {}", storageText(Storage::SignedNormalized)));
     }
   }
   if (const auto* a = accessorOf("TANGENT")) {
-    if (stored("TANGENT", a, TINYGLTF_TYPE_VEC4, Storage::SignedNormalized)) {
+    const std::optional<VertexFormat> asStored = storedFormat(*a);
+    if (stored("TANGENT", a, TINYGLTF_TYPE_VEC4, Storage::SignedNormalized, asStored)) {
       hasTangent = true;
-      rig.attributes.push_back(makeAttribute("tangent", VertexFormat::Float32x4,
-                                             {{"vertex.tangent", "xyz"}, {"vertex.handedness", "w"}}, file));
-      carried("TANGENT", "tangent", VertexFormat::Float32x4);
+      const VertexFormat f = asStored.value_or(VertexFormat::Float32x4);
+      rig.attributes.push_back(makeAttribute("tangent", f, {{"vertex.tangent", "xyz"}, {"vertex.handedness", "w"}}, file));
+      carried("TANGENT", "tangent", f);
       AccessorData d = readAttr("TANGENT");
       data.streams["vertex.tangent"] = reader.stream(d, 0, 3, where + " attribute TANGENT");
       data.streams["vertex.handedness"] = reader.stream(d, 3, 1, where + " attribute TANGENT");
@@ -319,11 +343,12 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   for (int t = 0; t < 2; ++t) {
     std::string name = fmt::format("TEXCOORD_{}", t);
     if (const auto* a = accessorOf(name)) {
-      if (stored(name, a, TINYGLTF_TYPE_VEC2, Storage::Any)) {
+      const std::optional<VertexFormat> asStored = storedFormat(*a);
+      if (stored(name, a, TINYGLTF_TYPE_VEC2, Storage::Any, asStored)) {
         std::string rn = fmt::format("texcoord{}", t);
-        rig.attributes.push_back(
-            makeAttribute(rn, VertexFormat::Float32x2, {{fmt::format("vertex.texcoord{}", t), ""}}, file));
-        carried(name, rn, VertexFormat::Float32x2);
+        const VertexFormat f = asStored.value_or(VertexFormat::Float32x2);
+        rig.attributes.push_back(makeAttribute(rn, f, {{fmt::format("vertex.texcoord{}", t), ""}}, file));
+        carried(name, rn, f);
         data.streams[fmt::format("vertex.texcoord{}", t)] = reader.stream(readAttr(name), 0, 2, where + " attribute " + name);
       } else {
         skip(name, fmt::format("texture coordinates are VEC2 of {}", storageText(Storage::Any)));

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <sstream>
 
 #include "../core/core_test_util.h"
@@ -83,8 +84,25 @@ TEST(GltfQuantized, StorageDecodesWithTheSpecFormulas) {
   EXPECT_EQ(at("morph.normal[0]", 0, 0), -1.0f);
   EXPECT_FLOAT_EQ(at("morph.normal[0]", 0, 1), 16384.0f / 32767.0f);
   EXPECT_EQ(at("morph.normal[0]", 2, 2), 1.0f);
-  // Re-expanded to float for the shader (feeding the stored format is a later step).
-  for (const auto& a : imp.rig.attributes) EXPECT_EQ(std::string(formatName(a.format)).rfind("float32", 0), 0u) << a.name;
+  // Normalized integers are fed as stored (a VEC3 in the x4 form, its w the padding); the
+  // rest is expanded to float: positions and TEXCOORD_1 are integers read unnormalized.
+  std::map<std::string, std::string> formats;
+  for (const auto& a : imp.rig.attributes) formats[a.name] = formatName(a.format);
+  EXPECT_EQ(formats["position"], "float32x3");
+  EXPECT_EQ(formats["normal"], "snorm8x4");
+  EXPECT_EQ(formats["tangent"], "snorm16x4");
+  EXPECT_EQ(formats["texcoord0"], "unorm8x2");
+  EXPECT_EQ(formats["texcoord1"], "float32x2");
+  // Stored as read: re-encoding the dequantized values gives them back exactly.
+  for (const auto& a : imp.rig.attributes)
+    for (const auto& part : a.provides) {
+      const std::string swz = part.swizzle.empty() ? std::string("xyzw").substr(0, size_t(formatComponents(a.format)))
+                                                   : part.swizzle;
+      for (const auto& v : s.at(part.semantic))
+        for (size_t k = 0; k < swz.size(); ++k)
+          EXPECT_EQ(storedValue(a.format, int(std::string("xyzw").find(swz[k])), v[int(k)]), v[int(k)])
+              << a.name << " " << part.semantic;
+    }
   // The dequantization transform is the node's, as stored: the model matrix scales by 0.5.
   auto G = gltfNodeGlobals(imp.data, -1, 0.0);
   EXPECT_EQ(G[0] * glm::dvec4(2, 4, 6, 1), glm::dvec4(2, 4, 6, 1));  // 0.5 * (2,4,6) + (1,2,3)
