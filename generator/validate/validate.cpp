@@ -460,11 +460,9 @@ ValidateReport Validator::run(const ValidationScene& scene, const GenerateOption
 }
 
 std::string formatReport(const ValidateReport& report) {
-  std::string s = fmt::format("device: {} (validation layers {}), running {}
-", report.device,
+  std::string s = fmt::format("device: {} (validation layers {}), running {}\n", report.device,
                               report.validationLayers ? "on" : "not available", report.via);
-  if (!report.limits.empty()) s += report.limits + "
-";
+  if (!report.limits.empty()) s += report.limits + "\n";
   for (const auto& run : report.runs) {
     s += fmt::format("{}: plan cost {}, {} vertices: {}\n", run.label, run.planCost, run.vertices,
                      run.pass ? "PASS" : "FAIL");
