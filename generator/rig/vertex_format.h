@@ -32,7 +32,7 @@ bool formatIsFloat32(VertexFormat f);  // stored exactly: nothing to quantize
 // The value the device reads for component `c` of an element whose value is v.
 // Error bounds, for v inside the format's range: unorm b bits |e| <= 0.5 / (2^b - 1) on
 // [0, 1]; snorm b bits |e| <= 0.5 / (2^(b-1) - 1) on [-1, 1] (outside the range, clamped);
-// float16 round to nearest even, |e| <= 2^-11 |v| for 2^-14 <= |v| <= 65504 (above: inf);
+// float16 (GLM) nearest, ties away from 0: |e| <= 2^-11 |v| on [2^-14, 65504], above: inf;
 // uint: rounded and clamped to the type. NaN is stored as 0 by the fixed-point formats.
 float storedValue(VertexFormat f, int c, float v);
 // Writes one element of `f` (formatBytes(f) bytes, little-endian) from its components.

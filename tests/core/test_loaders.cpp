@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -206,7 +207,7 @@ TEST(RigLoader, DawnFaceUniforms) {
 
 // What the device reads back from each stored format, against the Vulkan spec's
 // conversions worked by hand ("Fixed-Point Data Conversions": unorm c / (2^b - 1), snorm
-// max(c / (2^(b-1) - 1), -1), round to nearest; binary16 round to nearest even).
+// max(c / (2^(b-1) - 1), -1), round to nearest; binary16 to the nearest, ties away from 0).
 TEST(VertexFormats, StoredValuesFollowTheVulkanConversions) {
   using sg::VertexFormat;
   using sg::storedValue;
@@ -224,10 +225,13 @@ TEST(VertexFormats, StoredValuesFollowTheVulkanConversions) {
   EXPECT_FLOAT_EQ(storedValue(VertexFormat::Snorm10_10_10_2, 1, 0.5f), 256.0f / 511.0f);  // 255.5 -> 256
   EXPECT_FLOAT_EQ(storedValue(VertexFormat::Snorm10_10_10_2, 3, -0.4f), 0.0f);  // 2-bit snorm: -1, 0, 1
   EXPECT_FLOAT_EQ(storedValue(VertexFormat::Snorm10_10_10_2, 3, -0.6f), -1.0f);
-  // binary16: 0.1 is 0x2E66 = 1638 / 16384; 1 + 2^-11 is a tie, to even: 1.
+  // binary16 (10 fraction bits): 0.1 is 0x2E66 = 1638 / 16384; to the nearest, a tie (1 + 2^-11,
+  // halfway between 1 and 1 + 2^-10) away from zero, as GLM's packHalf1x16 rounds.
   EXPECT_FLOAT_EQ(storedValue(VertexFormat::Float16x2, 0, 0.1f), 1638.0f / 16384.0f);
-  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Float16x4, 1, 1.0f + 0x1p-11f), 1.0f);
-  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Float16x4, 1, 1.0f + 3 * 0x1p-12f), 1.0f + 0x1p-10f);
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Float16x4, 1, 1.0f + 0x1p-12f), 1.0f);
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Float16x4, 1, 1.0f + 0x1p-11f), 1.0f + 0x1p-10f);
+  EXPECT_FLOAT_EQ(storedValue(VertexFormat::Float16x4, 2, -1.0f - 3 * 0x1p-12f), -1.0f - 0x1p-10f);
+  EXPECT_EQ(storedValue(VertexFormat::Float16x2, 1, 1e5f), std::numeric_limits<float>::infinity());
   EXPECT_FLOAT_EQ(storedValue(VertexFormat::Uint8x2, 0, 300.0f), 255.0f);
   EXPECT_FLOAT_EQ(storedValue(VertexFormat::Uint16x2, 1, 2.5f), 3.0f);
   EXPECT_FLOAT_EQ(storedValue(VertexFormat::Float32x3, 2, 0.1f), 0.1f);
