@@ -153,7 +153,10 @@ TEST_P(GltfValidate, PassesAtEveryTimeAndCatchesAWrongPose) {
   for (const auto& o : control.outputs)
     if (o.name == "world_position" || o.name == "gl_Position") positionCaught = positionCaught || !o.pass;
   EXPECT_TRUE(positionCaught);
-  std::cout << formatReport(ValidateReport{report.device, report.validationLayers, {control}, control.pass});
+  ValidateReport controlReport = report;
+  controlReport.runs = {control};
+  controlReport.pass = control.pass;
+  std::cout << formatReport(controlReport);
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, GltfValidate, ::testing::ValuesIn(cases()),
