@@ -13,9 +13,9 @@ const float kRoughness = 0.45;
 
 void main() {
   vec3 n = normalize(vNormal);
-  if (!gl_FrontFacing) n = -n;
   vec3 base = mix(vec3(0.8, 0.55, 0.45), vec3(0.35, 0.4, 0.6), step(0.5, fract(8.0 * vUv.x)));  // a checker "map"
   vec3 v = normalize(vViewPosition);  // towards the eye
+  n = faceforward(n, -v, n);          // both sides lit, whatever the winding convention
   vec3 h = normalize(kLightDir + v);
   float ndotl = max(dot(n, kLightDir), 0.0);
   float ndoth = max(dot(n, h), 0.0);

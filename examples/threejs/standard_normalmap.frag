@@ -23,8 +23,8 @@ vec3 perturbedNormal(vec3 n, vec3 t, vec3 b, vec2 uv) {
 
 void main() {
   vec3 n = perturbedNormal(normalize(vNormal), normalize(vTangent), normalize(vBitangent), vUv);
-  if (!gl_FrontFacing) n = -n;
   vec3 v = normalize(vViewPosition);  // towards the eye
+  n = faceforward(n, -v, n);          // both sides lit, whatever the winding convention
   vec3 h = normalize(kLightDir + v);
   float ndotl = max(dot(n, kLightDir), 0.0);
   float ndoth = max(dot(n, h), 0.0);

@@ -62,6 +62,7 @@ struct RenderCommand {
 
   int run() {
     ro.gen = args.resolve();
+    ro.limits = {!ro.device.empty(), args.maxAttributes->count() > 0, args.maxUniformBytes->count() > 0};
     ro.validationLayers = !noLayers;
     if (morphWeight) {
       ro.morphWeight = static_cast<float>(*morphWeight);
@@ -90,6 +91,7 @@ struct RenderCommand {
     writeFilesAtomically({{output, png}});
     size_t covered = 0;
     for (float d : r.image.depth) covered += d < 1.0f;
+    if (!r.limits.empty()) std::cout << r.limits << "\n";
     std::cout << fmt::format("{}: {}x{} on {}, plan cost {}, {} of {} pixels covered\n", output, r.image.width,
                              r.image.height, r.device, r.planCost, covered, r.image.depth.size());
     for (const auto& m : r.validationMessages) std::cerr << "shadergen: warning: validation layer: " << m << "\n";
@@ -107,7 +109,7 @@ struct BenchCommand {
 
   int run() {
     bo.render.gen = args.resolve();
-    bo.limits = {!bo.render.device.empty(), args.maxAttributes->count() > 0, args.maxUniformBytes->count() > 0};
+    bo.render.limits = {!bo.render.device.empty(), args.maxAttributes->count() > 0, args.maxUniformBytes->count() > 0};
     bo.render.validationLayers = !noLayers;
     unsigned w = 0, h = 0;
     char tail = 0;
@@ -141,7 +143,9 @@ void registerRender(CLI::App& app, CliState& state) {
   sub->add_option("--mesh", cmd->ro.mesh, "Procedural mesh: head (default), limb, dawn (180k vertices)")
       ->check(CLI::IsMember({"head", "limb", "dawn"}));
   sub->add_option("--size", cmd->size, "Image size WIDTHxHEIGHT (default 512x512)");
-  sub->add_option("--device", cmd->ro.device, "Vulkan device name (substring); default lavapipe");
+  sub->add_option("--device", cmd->ro.device,
+                  "Vulkan device name (substring); default lavapipe. A named device's own limits constrain the search, "
+                  "as in validate --device");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer");
   sub->add_option("--time", cmd->ro.time, "glTF rig (MODEL.glb#m/p, or MODEL.glb#* for the whole model): animation time in seconds (default 0)")
       ->check(finiteNumber(false));

@@ -204,7 +204,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   vo.validationLayers = opts.render.validationLayers;
   Validator validator(vo);
   GenerateOptions gen = opts.render.gen;
-  const std::string limits = applyDeviceLimits(gen, opts.limits, validator.harness());
+  const std::string limits = applyDeviceLimits(gen, opts.render.limits, validator.harness());
   gen.capture = false;
   LoadedInputs in = loadInputs(gen);
   const Rig& rig = in.rig;

@@ -15,13 +15,11 @@
 
 #include "render/render.h"
 #include "search/device_profile.h"
-#include "validate/validate.h"
 
 namespace sg {
 
 struct GpuBenchOptions {
-  RenderOptions render;        // gen, device, size, mesh ("dawn"), lighting
-  DeviceLimitsOptions limits;  // the search's limits from the device (validate/validate.h)
+  RenderOptions render;        // gen, device, limits, size, mesh ("dawn"), lighting
   std::string handPortPath;    // "" = none; GLSL with the generated shader's interface
   bool floor = true;           // the pass-through program
   bool alternatives = true;    // every forced alternative (as validate --cross-check)

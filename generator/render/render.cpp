@@ -303,11 +303,14 @@ RenderResult RenderSession::renderModel(const std::vector<ModelPart>& parts, con
 RenderResult RenderSession::render(const RenderOptions& opts) {
   GenerateOptions g = opts.gen;
   g.capture = false;
+  const std::string limits = applyDeviceLimits(g, opts.limits, *harness_);
   GenerateResult gen = generate(g);
   FragmentProgram frag = compileFragmentFile(g.fragmentPath, g.targetEnv);
   std::vector<rt::Texture> textures = texturesFor(frag, opts.lighting);
   RenderScene scene = renderScene(gen.in.rig, opts);
-  return render(gen, frag, textures, scene, opts);
+  RenderResult r = render(gen, frag, textures, scene, opts);
+  r.limits = limits;
+  return r;
 }
 
 // --- PNG ----------------------------------------------------------------------------------

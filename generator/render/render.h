@@ -28,6 +28,7 @@ struct RenderCamera {
 struct RenderOptions {
   GenerateOptions gen;            // capture is ignored (render builds never capture)
   std::string device;             // "" = lavapipe
+  DeviceLimitsOptions limits;     // a named device's own limits for the search (validate/validate.h)
   bool validationLayers = true;
   uint32_t width = 512, height = 512;
   std::string mesh = "head";      // procedural mesh: head, limb, dawn (glTF rigs draw their own mesh)
@@ -98,6 +99,7 @@ struct RenderResult {
   std::string device;
   std::vector<std::string> rules;  // the plan drawn
   int64_t planCost = 0;
+  std::string limits;  // the device limits searched under (applyDeviceLimits; "" = the flags)
   std::vector<std::string> validationMessages;
 };
 

@@ -85,7 +85,7 @@ void limitActiveTargets(const Rig& rig, std::vector<rt::Pose>& poses, uint32_t s
 enum class ValidateVia { Spirv, Hlsl };
 
 // The search's device limits when a plan is run on a named device (docs/limits.md, "Device
-// limits"): `validate --device` and `bench --device` read them from the Vulkan physical
+// limits"): `validate`, `render` and `bench --device` read them from the Vulkan physical
 // device; a limit given on the command line is kept below the device's and clamped to it
 // above (a plan over the device's limits could not run there).
 struct DeviceLimitsOptions {

@@ -322,6 +322,32 @@ check_rig)
     ok "and the sparse form too" || fail "check printed: $(head -5 last.err)"
   ;;
 
+device_limits)
+  # validate / render / bench --device: the named device's own limits (docs/limits.md). The
+  # 300-bone palette (19,200 bytes) is over the guaranteed 16,384-byte uniform block but
+  # within lavapipe's: without --device the palette comes from a buffer, with it from the block.
+  L=(--rig "$SRC/tests/validate/data/limb8_palette300.rig.yaml" -f "$SRC/tests/validate/data/world.frag"
+    -r "$SRC/rules/standard.yaml" --mesh limb)
+  expect 0 "validate (guaranteed limits)" -- "$SG" validate "${L[@]}" --poses 1
+  grep -q 'limits of' last.out && fail "limits read without --device" || ok "no device limits without --device"
+  grep -q '^chosen plan: plan cost 109,' last.out && ok "buffer palette (cost 109)" || fail "validate printed: $(head -4 last.out)"
+  expect 0 "validate --device llvmpipe" -- "$SG" validate "${L[@]}" --poses 1 --device llvmpipe
+  grep -q '^limits of llvmpipe.*: [0-9]* vertex attributes, [0-9]* uniform bytes, [0-9]* storage buffers' last.out &&
+    ok "prints the device's limits" || fail "validate --device printed: $(head -4 last.out)"
+  grep -q '^chosen plan: plan cost 101,' last.out && ok "palette in the uniform block (cost 101)" ||
+    fail "validate --device printed: $(head -5 last.out)"
+  expect 0 "validate --device with a flag above the device's" -- "$SG" validate "${L[@]}" --poses 1 --device llvmpipe --max-attributes 4096
+  grep -q -- "--max-attributes 4096 clamped to the device's maxVertexInputAttributes" last.out && ok "clamped, and says so" ||
+    fail "validate printed: $(head -4 last.out)"
+  expect 0 "render --device llvmpipe" -- "$SG" render "${L[@]}" --device llvmpipe --size 16x16 -o limb.png
+  grep -q '^limits of llvmpipe' last.out && grep -q 'plan cost 101,' last.out && ok "render searches under them too" ||
+    fail "render printed: $(cat last.out)"
+  expect 0 "bench --device llvmpipe" -- "$SG" bench "${L[@]}" --device llvmpipe --frames 1 --rounds 1 --draws 1 \
+    --no-alternatives --no-floor --size 16x16
+  grep -q '^limits of llvmpipe' last.out && grep -q '^| generated | pass | 101 |' last.out && ok "bench searches under them too" ||
+    fail "bench printed: $(head -12 last.out)"
+  ;;
+
 build)
   # `shadergen build`: one process, cache across runs (and between two concurrent builds),
   # unchanged outputs untouched, byte-identical to `generate --set`, located errors.
