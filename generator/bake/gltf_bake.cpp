@@ -312,21 +312,13 @@ GltfBakeResult bakeGltfOcclusion(const std::string& file, const GltfBakeOptions&
   }
   std::vector<glm::dmat4> G = gltfNodeGlobals(sceneData, anim, t);
 
-  // Instances: every node of the scene drawing a mesh, then each primitive's baking instance
-  // (the node the rig import poses it with) if the scene does not already hold it.
-  // Depth first, pre-order, without recursion (node chains can be as long as the file) and
-  // each node once (a scene may list a root twice).
+  // Instances: every node of the scene drawing a mesh (gltfSceneNodes' order), then each
+  // primitive's baking instance (the node the rig import poses it with) if the scene does not
+  // already hold it.
   std::vector<Instance> instances;
-  std::vector<int> todo(sceneData.sceneRoots.rbegin(), sceneData.sceneRoots.rend());
-  std::vector<char> seen(sceneData.nodes.size(), 0);
-  while (!todo.empty()) {
-    int n = todo.back();
-    todo.pop_back();
-    if (seen[static_cast<size_t>(n)]) continue;
-    seen[static_cast<size_t>(n)] = 1;
+  for (int n : gltfSceneNodes(sceneData)) {
     const GltfNode& node = sceneData.nodes[static_cast<size_t>(n)];
     if (node.mesh >= 0 && node.mesh < static_cast<int>(model.meshes.size())) instances.push_back({n, node.mesh});
-    todo.insert(todo.end(), node.children.rbegin(), node.children.rend());
   }
   std::vector<size_t> bakeInstance(prims.size());
   for (size_t i = 0; i < prims.size(); ++i) {

@@ -66,21 +66,14 @@ ModelPart modelPart(const RenderOptions& opts, const GltfPart& part) {
   p.name = part.name;
   p.gen = generate(o.gen);
   p.scene = renderScene(p.gen.in.rig, o);
-  // Other instances: every node of the scene (depth first, each once) that draws this mesh.
+  // Other instances: every node of the scene that draws this mesh.
   GltfImportOptions io;
   io.mesh = part.mesh;
   io.primitive = part.primitive;
   GltfImport model = importGltf(parseGltfRef(part.ref).file, io);
   const GltfModelData& d = model.data;
-  std::vector<int> todo(d.sceneRoots.rbegin(), d.sceneRoots.rend());
-  std::vector<char> seen(d.nodes.size(), 0);
-  while (!todo.empty()) {
-    int n = todo.back();
-    todo.pop_back();
-    if (seen[static_cast<size_t>(n)]) continue;
-    seen[static_cast<size_t>(n)] = 1;
+  for (int n : gltfSceneNodes(d)) {
     const GltfNode& node = d.nodes[static_cast<size_t>(n)];
-    todo.insert(todo.end(), node.children.rbegin(), node.children.rend());
     if (node.mesh != d.mesh || n == d.meshNode) continue;
     if (node.skin >= 0 || d.skin >= 0) {  // a skin places the mesh, not the node
       p.notes.push_back(fmt::format("node {} also instantiates mesh {} with a skin; it is not drawn again", n, d.mesh));

@@ -675,6 +675,22 @@ GltfRef parseGltfRef(const std::string& path, bool allowWholeModel) {
   return r;
 }
 
+std::vector<int> gltfSceneNodes(const GltfModelData& data) {
+  std::vector<int> order;
+  std::vector<int> todo(data.sceneRoots.rbegin(), data.sceneRoots.rend());
+  std::vector<char> seen(data.nodes.size(), 0);
+  while (!todo.empty()) {
+    int n = todo.back();
+    todo.pop_back();
+    if (seen[static_cast<size_t>(n)]) continue;
+    seen[static_cast<size_t>(n)] = 1;
+    order.push_back(n);
+    const auto& children = data.nodes[static_cast<size_t>(n)].children;
+    todo.insert(todo.end(), children.rbegin(), children.rend());
+  }
+  return order;
+}
+
 std::string gltfPartName(int mesh, int primitive, const std::string& meshName) {
   std::string name = fmt::format("m{}p{}", mesh, primitive);
   if (meshName.empty()) return name;

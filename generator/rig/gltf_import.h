@@ -163,6 +163,10 @@ struct GltfModelData {
   int skin = -1;      // the skin it uses (-1: unskinned)
 };
 
+// The nodes of the model's scene (sceneRoots), depth first, pre-order, each once (a scene may
+// list a root twice), without recursion: node chains can be as long as the file.
+std::vector<int> gltfSceneNodes(const GltfModelData& data);
+
 struct GltfImport {
   Rig rig;
   GltfModelData data;
