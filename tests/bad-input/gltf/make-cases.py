@@ -118,7 +118,7 @@ case("sparse-index-type-float", {"m.gltf": text(sparse(1, idx_type=5126))}, rig_
      "sparse indices must be unsigned byte, short or int")
 case("joints-set-number-overflows", {"m.gltf": text(model([POS], extra={
     "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "JOINTS_99999999999": 0}}]}]}))}, rig_import("@D/m.gltf"), 1,
-     "has JOINTS_99999999999 (4000004 influences per vertex); the rules serve at most 8")
+     "has JOINTS_99999999999 (4000004 influences per vertex); the rules serve at most 16")
 case("position-nan", {"m.gltf": text(model([POS], blob=struct.pack("<9f", 0, 0, 0, float("nan"), 0, 0, 0, 1, 0)))},
      rig_import("@D/m.gltf"), 1, "holds a non-finite value")
 
