@@ -656,13 +656,14 @@ TEST(RulesLoader, StandardLibraryAndDawnIncludes) {
   EXPECT_EQ(line->loc.line, last.line);
   for (const auto& l : blend->glsl) EXPECT_EQ(l.text.find("@use"), std::string::npos) << l.text;
   // Arguments replace the parameters: the sparse tangent rule's text reads its own sum.
-  std::string morph = readText(kSrc + "/rules/morph.yaml");
+  // (through tangent_orthonormal, which uses orthonormal_tangent_into: both in vocabulary.yaml)
+  std::string vocabulary = readText(kSrc + "/rules/vocabulary.yaml");
   for (const auto& r : set.rules) {
     if (r.name != "object_tangent_morphed_sparse_gram_schmidt") continue;
     auto t = std::find_if(r.glsl.begin(), r.glsl.end(), [](const sg::TemplateLine& l) { return l.text == "  vec3 t_ = ${out};"; });
     ASSERT_NE(t, r.glsl.end());
-    EXPECT_EQ(t->loc.file, kSrc + "/rules/morph.yaml");
-    EXPECT_EQ(t->loc.line, posOf(morph, "vec3 t_ = ${t};").line);
+    EXPECT_EQ(t->loc.file, kSrc + "/rules/vocabulary.yaml");
+    EXPECT_EQ(t->loc.line, posOf(vocabulary, "vec3 t_ = ${t};").line);
   }
   // Loading the same file twice is a no-op.
   size_t nRules = set.rules.size();

@@ -357,12 +357,13 @@ TEST(GltfImport, UnsupportedOptionalAttributesAreLeftOutWithANote) {
       pos, rgb, quv, pos));
   GltfImport imp = importGltfText(json, "points.gltf");
   EXPECT_EQ(imp.data.mode, 0);  // POINTS: fine, shaders run per vertex
-  EXPECT_EQ(imp.rig.attributes.size(), 2u);  // position, and the UVs expanded to float
+  EXPECT_EQ(imp.rig.attributes.size(), 2u);  // position, and the UVs as stored (unorm16x2)
   EXPECT_EQ(imp.notes.size(), 3u);
   std::string all;
   for (const auto& n : imp.notes) all += n + "\n";
   EXPECT_NE(all.find("COLOR_0 (float VEC3) is not carried"), std::string::npos) << all;
-  EXPECT_NE(all.find("TEXCOORD_0 is stored normalized unsigned short VEC2 (KHR_mesh_quantization): expanded to float"),
+  EXPECT_NE(all.find("TEXCOORD_0 is stored normalized unsigned short VEC2 (KHR_mesh_quantization): fed to the shader "
+                     "as stored, unorm16x2"),
             std::string::npos)
       << all;
   EXPECT_EQ(imp.data.streams.at("vertex.texcoord0")[1][0], 1.0f);  // 65535 / 65535

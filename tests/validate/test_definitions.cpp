@@ -483,7 +483,7 @@ TEST(Degenerate, FallbackValidatesAndSkippingItIsCaught) {
   EXPECT_TRUE(sgtest::planHas(ok.runs.at(0), "world_normal_inverse_transpose"));
   // The fallback skipped: Gram-Schmidt normalizes a zero vector on the GPU.
   RulesCopy rules("no_fallback");
-  ASSERT_TRUE(rules.edit("morph.yaml", "bvec3(dot(g_, g_) > 1e-6 * dot(t_, t_))", "bvec3(true)"));
+  ASSERT_TRUE(rules.edit("vocabulary.yaml", "bvec3(dot(g_, g_) > 1e-6 * dot(t_, t_))", "bvec3(true)"));
   sg::ValidateReport broken = validateRamp(rules.rulesFile("standard.yaml").string());
   EXPECT_FALSE(broken.pass);
   EXPECT_EQ(failing(broken), (std::set<std::string>{"world_tangent", "world_binormal"}));
