@@ -11,13 +11,7 @@ outdir=${2:-.}
 draws=${SG_DRAWS:-64}
 frames=${SG_FRAMES:-11}
 meshes=${SG_MESHES:-dawn,head}
-export LD_LIBRARY_PATH="$here/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
-export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/shadergen-xdg}
-mkdir -p "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
-sg="$here/bin/shadergen"
-dawn=(--rig "$here/examples/dawn/face.rig.yaml" -f "$here/examples/dawn/face.frag" -r "$here/examples/dawn/rules.yaml"
-      --templates "$here/templates")
-command -v nvidia-smi > /dev/null && nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
+source "$here/gpu_env.sh"
 profile="$outdir/profile.yaml"
 echo "== calibrate (probes and the Dawn face's plans, Dawn scale and the cached head)"
 "$sg" calibrate "${dawn[@]}" --device "$device" --no-validation-layers --meshes "$meshes" \
