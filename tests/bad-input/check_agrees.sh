@@ -9,6 +9,10 @@
 set -uo pipefail
 sg=$1 root=$2
 cd "$root" || exit 2
+W=$(mktemp -d "${TMPDIR:-/tmp}/sg-agrees-XXXXXX")
+trap 'rm -rf "$W"' EXIT
+source tests/support/preload_only_shadergen.sh
+preload_only_shadergen sg "$W"
 declare -A PLAN_ONLY=(
   # The block's size is what the chosen plan reads; check has no plan.
   [rig/bones_too_many_for_uniform_block]=1

@@ -18,6 +18,8 @@ export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/shadergen-xdg}
 mkdir -p "$XDG_RUNTIME_DIR" 2>/dev/null && chmod 700 "$XDG_RUNTIME_DIR" 2>/dev/null
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/sg-corpus-XXXXXX")
 trap 'chmod -R u+rwx "$WORK" 2>/dev/null; rm -rf "$WORK"' EXIT
+source "$SRC/tests/support/preload_only_shadergen.sh"
+preload_only_shadergen SG "$WORK"
 
 cases=()
 if [ $# -gt 0 ]; then

@@ -3,6 +3,8 @@
 # missing message, a signal, a hang, a changed input, an output left behind on failure.
 # A stand-in "shadergen" misbehaves on request; each case must be reported as FAIL.
 set -uo pipefail
+# The stand-in needs no Vulkan driver: no process here gets the sanitizer runs' preload.
+unset LD_PRELOAD
 RUNNER=$(realpath "$(dirname "$0")/run_corpus.sh")
 T=$(mktemp -d "${TMPDIR:-/tmp}/sg-corpus-self-XXXXXX")
 trap 'rm -rf "$T"' EXIT

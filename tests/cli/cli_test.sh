@@ -8,6 +8,8 @@ case_name=$1 SG=$2 SRC=$3 CXX=$4 VERSION=$5 NINJA=${6:-}
 E=$SRC/examples/dawn
 T=$(mktemp -d "${TMPDIR:-/tmp}/sg-cli-XXXXXX")
 trap 'chmod -R u+w "$T" 2>/dev/null; rm -rf "$T"' EXIT
+source "$SRC/tests/support/preload_only_shadergen.sh"
+preload_only_shadergen SG "$T"
 cd "$T"
 
 fails=0
