@@ -57,19 +57,23 @@ build=${SHADERGEN_BUILD_DIR:-build}
 # Release: debug information costs a third of the compile time and most of the link time;
 # configure a tree of your own with RelWithDebInfo or Debug to debug.
 build_type=${SHADERGEN_BUILD_TYPE:-Release}
+# Unity builds: the big headers (glslang, yaml-cpp, CLI11, tinygltf, fmt) are parsed once per
+# batch of 8 files instead of once per file, which halves a cold build (the CLI: 322 s ->
+# 168 s on 2 cores). A tree configured by hand builds file by file; SHADERGEN_UNITY=OFF here.
+unity=(-DCMAKE_UNITY_BUILD="${SHADERGEN_UNITY:-ON}" -DCMAKE_UNITY_BUILD_BATCH_SIZE=8)
 plain_build() {  # plain_build [target...]: only those targets, and then without the suite
   local suite=ON
   [ $# -gt 0 ] && suite=OFF
   # -O2 for Release too: CMake's -O3 compiles slower and bought nothing measurable here.
   cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" -DCMAKE_CXX_FLAGS_RELEASE="-O2 -DNDEBUG" \
-    -DSHADERGEN_BUILD_TESTS=$suite -DSHADERGEN_BUILD_BENCH=$suite >/dev/null
+    "${unity[@]}" -DSHADERGEN_BUILD_TESTS=$suite -DSHADERGEN_BUILD_BENCH=$suite >/dev/null
   if [ $# -gt 0 ]; then cmake --build "$build" --target "$@"; else cmake --build "$build"; fi
 }
 # One instrumented tree serves both the sanitizer suite and the fuzz targets.
 sanitize_build=${SHADERGEN_SANITIZE_BUILD_DIR:-build-sanitize}
 sanitize_build() {
   cmake -S . -B "$sanitize_build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 \
-    -DSHADERGEN_SANITIZE=ON -DSHADERGEN_FUZZ=ON -DSHADERGEN_BUILD_BENCH=OFF
+    "${unity[@]}" -DSHADERGEN_SANITIZE=ON -DSHADERGEN_FUZZ=ON -DSHADERGEN_BUILD_BENCH=OFF
   (source cmake/sanitizers/env.sh && cmake --build "$sanitize_build")
 }
 sanitize_test() {

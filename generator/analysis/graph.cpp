@@ -20,7 +20,7 @@ extern char** environ;
 namespace sg {
 namespace {
 
-std::string quote(const std::string& s) {
+std::string dotQuote(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
     if (c == '"' || c == '\\') out += '\\';
@@ -31,7 +31,7 @@ std::string quote(const std::string& s) {
 
 // Label text: '\n' becomes DOT's centred line break.
 std::string label(const std::string& s) {
-  std::string q = quote(s);
+  std::string q = dotQuote(s);
   std::string out;
   for (char c : q) out += c == '\n' ? std::string("\\n") : std::string(1, c);
   return out;
@@ -66,9 +66,9 @@ std::string planToDot(const LoadedInputs& in, const Plan& plan) {
     for (const auto& s : v.semantics)
       if (int f = p.findFact(s); f >= 0 && !producer.count(f)) noteInput(f);
 
-  auto inputId = [](const std::string& key) { return quote("in:" + key); };
-  auto ruleId = [&](int a) { return quote("rule:" + p.actions[a].name); };
-  auto outId = [](const std::string& name) { return quote("out:" + name); };
+  auto inputId = [](const std::string& key) { return dotQuote("in:" + key); };
+  auto ruleId = [&](int a) { return dotQuote("rule:" + p.actions[a].name); };
+  auto outId = [](const std::string& name) { return dotQuote("out:" + name); };
 
   std::string d;
   d += "digraph plan {\n";

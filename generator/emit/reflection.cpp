@@ -7,7 +7,7 @@
 namespace sg {
 namespace {
 
-std::string quote(const std::string& s) {
+std::string jsonQuote(const std::string& s) {
   std::string o = "\"";
   for (char c : s) {
     if (c == '"' || c == '\\') o += '\\';
@@ -28,14 +28,14 @@ std::string buffersJson(const EmittedGlsl& glsl) {
     const auto& b = glsl.buffers[i];
     std::string packs;
     for (const auto& [sem, comps] : b.packs)
-      packs += fmt::format("{}{{\"semantic\": {}, \"components\": {}}}", packs.empty() ? "" : ", ", quote(sem), quote(comps));
+      packs += fmt::format("{}{{\"semantic\": {}, \"components\": {}}}", packs.empty() ? "" : ", ", jsonQuote(sem), jsonQuote(comps));
     j += fmt::format("{}\n    {{\"name\": {}, \"semantic\": {}, \"set\": 0, \"binding\": {}, \"layout\": \"std430\", "
                      "\"element\": {}, \"stride\": {}, \"indexing\": {}, \"count\": {}, \"element_index\": {}, "
                      "\"size_bytes\": {}, \"holds\": [{}]}}",
-                     i ? "," : "", quote(b.name + "_data"), quote(b.semantic), b.binding,
-                     quote(std::string(glslName(b.element))), b.strideBytes, quote(b.perVertex ? "per_vertex" : "array"),
-                     b.count, quote(b.perVertex ? fmt::format("vertex * {} + i", b.count) : "i"),
-                     quote(b.perVertex ? fmt::format("vertex_count * {}", b.count * b.strideBytes)
+                     i ? "," : "", jsonQuote(b.name + "_data"), jsonQuote(b.semantic), b.binding,
+                     jsonQuote(std::string(glslName(b.element))), b.strideBytes, jsonQuote(b.perVertex ? "per_vertex" : "array"),
+                     b.count, jsonQuote(b.perVertex ? fmt::format("vertex * {} + i", b.count) : "i"),
+                     jsonQuote(b.perVertex ? fmt::format("vertex_count * {}", b.count * b.strideBytes)
                                        : std::to_string(b.count * b.strideBytes)),
                      packs);
   }
@@ -47,27 +47,27 @@ std::string buffersJson(const EmittedGlsl& glsl) {
 // buffer indices by resource.
 std::string crossJson(const CrossShader& c) {
   const bool hlsl = c.hlsl;
-  std::string j = fmt::format("  {}: {{\n    {}: {}, {}: {}, \"entry_point\": {},\n    \"inputs\": [", quote(hlsl ? "hlsl" : "msl"),
-                              quote(hlsl ? "shader_model" : "version"), quote(c.version),
-                              quote(hlsl ? "profile" : "platform"), quote(c.profile), quote(c.entryPoint));
+  std::string j = fmt::format("  {}: {{\n    {}: {}, {}: {}, \"entry_point\": {},\n    \"inputs\": [", jsonQuote(hlsl ? "hlsl" : "msl"),
+                              jsonQuote(hlsl ? "shader_model" : "version"), jsonQuote(c.version),
+                              jsonQuote(hlsl ? "profile" : "platform"), jsonQuote(c.profile), jsonQuote(c.entryPoint));
   auto variables = [&](const std::vector<CrossVariable>& vars) {
     std::string v;
     for (size_t i = 0; i < vars.size(); ++i) {
       const CrossVariable& x = vars[i];
       std::string slots = x.slots > 1 ? fmt::format(", \"{}\": {}", hlsl ? "semantic_count" : "locations", x.slots) : "";
-      v += fmt::format("{}\n      {{\"name\": {}, \"location\": {}, {}: {}{}}}", i ? "," : "", quote(x.name), x.location,
-                       quote(hlsl ? "semantic" : "attribute"), quote(x.binding), slots);
+      v += fmt::format("{}\n      {{\"name\": {}, \"location\": {}, {}: {}{}}}", i ? "," : "", jsonQuote(x.name), x.location,
+                       jsonQuote(hlsl ? "semantic" : "attribute"), jsonQuote(x.binding), slots);
     }
     return v + (vars.empty() ? "]" : "\n    ]");
   };
   j += variables(c.inputs) + ",\n    \"outputs\": [" + variables(c.outputs) + ",\n    \"resources\": [";
   for (size_t i = 0; i < c.resources.size(); ++i) {
     const CrossResource& r = c.resources[i];
-    std::string where = hlsl ? fmt::format("\"register\": {}, \"space\": 0", quote(r.slot))
+    std::string where = hlsl ? fmt::format("\"register\": {}, \"space\": 0", jsonQuote(r.slot))
                              : fmt::format("\"buffer\": {}", r.index);
     j += fmt::format("{}\n      {{\"name\": {}, \"variable\": {}, \"kind\": {}, {}, \"set\": {}, \"binding\": {}}}",
-                     i ? "," : "", quote(r.name), quote(r.variable),
-                     quote(r.uniformBlock ? (hlsl ? "cbuffer" : "constant") : (hlsl ? "ByteAddressBuffer" : "device const")),
+                     i ? "," : "", jsonQuote(r.name), jsonQuote(r.variable),
+                     jsonQuote(r.uniformBlock ? (hlsl ? "cbuffer" : "constant") : (hlsl ? "ByteAddressBuffer" : "device const")),
                      where, r.set, r.binding);
   }
   j += c.resources.empty() ? "]" : "\n    ]";
@@ -97,20 +97,20 @@ std::string buffersHeader(const EmittedGlsl& glsl, const std::string& symbol) {
 std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spirv,
                            const DeviceProfile* profile, const PlanCostPrediction* predicted, const CrossShader* hlsl,
                            const CrossShader* msl) {
-  std::string j = "{\n  \"rig\": " + quote(rig.name) + ",\n  \"inputs\": [";
+  std::string j = "{\n  \"rig\": " + jsonQuote(rig.name) + ",\n  \"inputs\": [";
   for (size_t i = 0; i < glsl.inputs.size(); ++i) {
     const auto& in = glsl.inputs[i];
     const RigAttribute& a = rig.attributes[in.attribute];
     std::string sems;
     for (const auto& p : a.provides) {
       std::string s = in.target >= 0 ? fmt::format("{}[{}]", p.semantic, in.target) : p.semantic;
-      sems += fmt::format("{}{{\"semantic\": {}, \"components\": {}}}", sems.empty() ? "" : ", ", quote(s),
-                          quote(p.swizzle.empty() ? std::string("xyzw").substr(0, formatComponents(a.format)) : p.swizzle));
+      sems += fmt::format("{}{{\"semantic\": {}, \"components\": {}}}", sems.empty() ? "" : ", ", jsonQuote(s),
+                          jsonQuote(p.swizzle.empty() ? std::string("xyzw").substr(0, formatComponents(a.format)) : p.swizzle));
     }
     j += fmt::format("{}\n    {{\"name\": {}, \"location\": {}, \"attribute\": {}, \"target\": {}, \"format\": {}, "
                      "\"type\": {}, \"provides\": [{}]}}",
-                     i ? "," : "", quote(in.name), in.location, quote(a.name), in.target, quote(formatName(a.format)),
-                     quote(std::string(glslName(in.type))), sems);
+                     i ? "," : "", jsonQuote(in.name), in.location, jsonQuote(a.name), in.target, jsonQuote(formatName(a.format)),
+                     jsonQuote(std::string(glslName(in.type))), sems);
   }
   j += "\n  ],\n";
   j += fmt::format("  \"uniform_block\": {{\"name\": \"ShadergenUniforms\", \"set\": 0, \"binding\": 0, \"size\": {}, "
@@ -124,16 +124,16 @@ std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvM
       if (x.name == u.name) l = &x;
     j += fmt::format("{}\n    {{\"name\": {}, \"semantic\": {}, \"type\": {}, \"array\": {}, \"offset\": {}, "
                      "\"array_stride\": {}, \"matrix_stride\": {}}}",
-                     i ? "," : "", quote(u.name), quote(ru.semantic), quote(std::string(glslName(ru.type))),
+                     i ? "," : "", jsonQuote(u.name), jsonQuote(ru.semantic), jsonQuote(std::string(glslName(ru.type))),
                      ru.arraySize, l ? l->offset : 0, l ? l->arrayStride : 0, l ? l->matrixStride : 0);
   }
   j += "\n  ]},\n";
   j += buffersJson(glsl);
   if (profile && predicted) {
     j += fmt::format("  \"predicted_cost\": {{\"device\": {}, \"ns_per_vertex\": {:.6f}, \"terms\": {{",
-                     quote(profile->device), predicted->totalNanoseconds);
+                     jsonQuote(profile->device), predicted->totalNanoseconds);
     for (size_t t = 0; t < kTermCount; ++t)
-      j += fmt::format("{}\n    {}: {{\"amount\": {}, \"ns\": {:.6f}}}", t ? "," : "", quote(termName(static_cast<int>(t))),
+      j += fmt::format("{}\n    {}: {{\"amount\": {}, \"ns\": {:.6f}}}", t ? "," : "", jsonQuote(termName(static_cast<int>(t))),
                        predicted->amounts[t], predicted->nanoseconds[t]);
     j += "\n  }},\n";
   }
@@ -143,10 +143,10 @@ std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvM
   for (size_t i = 0; i < glsl.outputs.size(); ++i) {
     const auto& o = glsl.outputs[i];
     std::string sems;
-    for (const auto& s : o.semantics) sems += (sems.empty() ? "" : ", ") + quote(s);
+    for (const auto& s : o.semantics) sems += (sems.empty() ? "" : ", ") + jsonQuote(s);
     std::string array = o.arraySize ? fmt::format(", \"array_size\": {}", o.arraySize) : "";
     j += fmt::format("{}\n    {{\"name\": {}, \"location\": {}, \"type\": {}{}, \"semantics\": [{}]}}", i ? "," : "",
-                     quote(o.name), o.location, quote(std::string(glslName(o.type))), array, sems);
+                     jsonQuote(o.name), o.location, jsonQuote(std::string(glslName(o.type))), array, sems);
   }
   j += "\n  ]\n}\n";
   return j;

@@ -21,7 +21,7 @@ bool validSwizzle(const std::string& s, int components) {
   return true;
 }
 
-bool validSemanticName(const std::string& s) {
+bool validRigSemanticName(const std::string& s) {
   if (s.empty()) return false;
   for (char c : s)
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '[' || c == ']')) return false;
@@ -121,7 +121,7 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
     auto addPart = [&](const YAML::Node& semNode, const YAML::Node* swzNode) {
       ProvidedPart p;
       p.semantic = y.scalar(semNode, "a semantic name");
-      if (!validSemanticName(p.semantic)) y.fail(semNode, fmt::format("'{}' is not a valid semantic name", p.semantic));
+      if (!validRigSemanticName(p.semantic)) y.fail(semNode, fmt::format("'{}' is not a valid semantic name", p.semantic));
       if (swzNode) {
         p.swizzle = y.scalar(*swzNode, "a swizzle");
         if (!validSwizzle(p.swizzle, n))
@@ -158,7 +158,7 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
       un.type = *ty;
       if (!body["semantic"]) y.fail(body, fmt::format("uniform '{}' has no 'semantic'", un.name));
       un.semantic = y.scalar(body["semantic"], "'semantic'");
-      if (!validSemanticName(un.semantic)) y.fail(body["semantic"], fmt::format("'{}' is not a valid semantic name", un.semantic));
+      if (!validRigSemanticName(un.semantic)) y.fail(body["semantic"], fmt::format("'{}' is not a valid semantic name", un.semantic));
       if (!providedSemantics.insert(un.semantic).second)
         y.fail(body["semantic"], fmt::format("semantic '{}' is provided twice", un.semantic));
       if (body["array"]) {

@@ -63,9 +63,9 @@ bool isNumeric(DefType t) { return t != DefType::Bool; }
 DefType vecOf(int n) { return n == 2 ? DefType::Vec2 : n == 3 ? DefType::Vec3 : DefType::Vec4; }
 int matN(DefType t) { return t == DefType::Mat3 ? 3 : 4; }
 
-class Parser {
+class DefinitionParser {
  public:
-  Parser(const std::string& s, std::vector<std::pair<size_t, SourceLoc>> segments) : s_(s), segments_(std::move(segments)) {}
+  DefinitionParser(const std::string& s, std::vector<std::pair<size_t, SourceLoc>> segments) : s_(s), segments_(std::move(segments)) {}
 
   DefNodeP parseAll() {
     if (s_.size() > kMaxDefinitionChars)
@@ -115,8 +115,8 @@ class Parser {
     return n;
   }
   struct Nesting {  // bounds the recursion of the parser itself
-    Parser& p;
-    Nesting(Parser& p, size_t at) : p(p) {
+    DefinitionParser& p;
+    Nesting(DefinitionParser& p, size_t at) : p(p) {
       if (++p.nesting_ > kMaxDefinitionDepth)
         p.fail(at, fmt::format("definition is nested deeper than {} levels", kMaxDefinitionDepth));
     }
@@ -591,10 +591,10 @@ void collectReads(const DefNode& n, std::vector<int>& out) {
 
 }  // namespace
 
-DefNodeP parseDefinition(const std::string& text, const SourceLoc& loc) { return Parser(text, {{0, loc}}).parseAll(); }
+DefNodeP parseDefinition(const std::string& text, const SourceLoc& loc) { return DefinitionParser(text, {{0, loc}}).parseAll(); }
 
 DefNodeP parseDefinition(const std::string& text, const std::vector<std::pair<size_t, SourceLoc>>& segments) {
-  return Parser(text, segments).parseAll();
+  return DefinitionParser(text, segments).parseAll();
 }
 
 std::vector<int> definitionReads(const DefNode& root) {

@@ -303,7 +303,7 @@ class OpenSetHeuristic {
   std::vector<char> zone_, before_;
 };
 
-struct Node {
+struct RegressionNode {
   int64_t g;
   int64_t h;
   int parent;
@@ -311,11 +311,11 @@ struct Node {
   bool closed;
 };
 
-struct OpenEntry {
+struct RegressionOpenEntry {
   int64_t f, g;
   int64_t seq;
   int node;
-  bool operator>(const OpenEntry& o) const {
+  bool operator>(const RegressionOpenEntry& o) const {
     if (f != o.f) return f > o.f;
     if (g != o.g) return g < o.g;  // deeper first among equal f
     return seq < o.seq;            // then newest: dives, deterministic
@@ -355,7 +355,7 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
   // items decide which completions still fit (docs/search.md, "Resource limits").
   std::vector<uint64_t> states;
   std::vector<int64_t> usage;  // node i's usage: [i * L, (i + 1) * L)
-  std::vector<Node> nodes;
+  std::vector<RegressionNode> nodes;
   const size_t OW = static_cast<size_t>(t.words), W = OW + static_cast<size_t>(t.itemWords);
   const size_t L = t.itemWords ? p.limits.size() : 0;
   auto stateOf = [&](int i) { return states.data() + static_cast<size_t>(i) * W; };
@@ -367,13 +367,13 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
   };
   auto same = [&](int a, int b) { return std::equal(stateOf(a), stateOf(a) + W, stateOf(b)); };
   std::unordered_set<int, decltype(hashOf), decltype(same)> index(1024, hashOf, same);
-  std::priority_queue<OpenEntry, std::vector<OpenEntry>, std::greater<>> open;
+  std::priority_queue<RegressionOpenEntry, std::vector<RegressionOpenEntry>, std::greater<>> open;
   auto finish = [&](std::optional<Plan> plan) {
     st.finalCost = plan ? plan->cost : -1;
     st.totalSeconds = budget.seconds();
-    st.peakBytes = static_cast<int64_t>(states.capacity() * sizeof(uint64_t) + nodes.capacity() * sizeof(Node) +
+    st.peakBytes = static_cast<int64_t>(states.capacity() * sizeof(uint64_t) + nodes.capacity() * sizeof(RegressionNode) +
                                         index.bucket_count() * sizeof(void*) + index.size() * 24 +
-                                        open.size() * sizeof(OpenEntry));
+                                        open.size() * sizeof(RegressionOpenEntry));
     return plan;
   };
   if (t.unsolvable) return finish(std::nullopt);
@@ -422,15 +422,15 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
   const int64_t g0 = p.fixedCost;  // what every plan pays (a device profile's fixed terms)
   int64_t h0 = estimate(stateOf(0));
   st.initialH = g0 + h0;
-  nodes.push_back(Node{g0, h0, -1, -1, false});
+  nodes.push_back(RegressionNode{g0, h0, -1, -1, false});
   index.insert(0);
   int64_t seq = 0;
-  open.push(OpenEntry{g0 + h0, g0, seq++, 0});
+  open.push(RegressionOpenEntry{g0 + h0, g0, seq++, 0});
   std::vector<uint64_t> child(W);
   std::vector<int64_t> childUse(L);
 
   while (!open.empty()) {
-    OpenEntry e = open.top();
+    RegressionOpenEntry e = open.top();
     open.pop();
     if (nodes[e.node].closed || e.g != nodes[e.node].g) continue;  // stale entry
     nodes[e.node].closed = true;
@@ -462,20 +462,20 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
       auto it = index.find(id);
       if (it != index.end()) {
         states.resize(states.size() - W);
-        Node& old = nodes[*it];
+        RegressionNode& old = nodes[*it];
         if (ng >= old.g) continue;
         // Cheaper path to a known open set (LM-cut is admissible, not consistent): reopen.
         if (old.closed) ++st.reopened;  // same items, so the same usage
-        old = Node{ng, old.h, e.node, o, false};
-        open.push(OpenEntry{ng + old.h, ng, seq++, *it});
+        old = RegressionNode{ng, old.h, e.node, o, false};
+        open.push(RegressionOpenEntry{ng + old.h, ng, seq++, *it});
         continue;
       }
       // Pathmax: a child's estimate never drops below its parent's less the step cost.
       int64_t hv = std::max(estimate(stateOf(id)), hParent - op.cost);
-      nodes.push_back(Node{ng, hv, e.node, o, false});
+      nodes.push_back(RegressionNode{ng, hv, e.node, o, false});
       usage.insert(usage.end(), childUse.begin(), childUse.end());
       index.insert(id);
-      open.push(OpenEntry{ng + hv, ng, seq++, id});
+      open.push(RegressionOpenEntry{ng + hv, ng, seq++, id});
     }
   }
   return finish(std::nullopt);
