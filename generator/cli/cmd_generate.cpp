@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <iostream>
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 #include "cli/commands.h"
@@ -56,6 +57,10 @@ void GenerateArgs::add(CLI::App& cmd) {
   cmd.add_option("--templates", opts.templateDir, "Directory with vertex.glsl templates");
   cmd.add_option("--ban", opts.bannedRules, "Exclude a rule from the search (force an alternative)");
   cmd.add_option("--set", sets, "Set a rig deformer parameter: NAME=VALUE (level-of-detail rigs: morph_targets=2)");
+  cmd.add_option("--max-error", maxErrors,
+                 "Error budget of an encoded vertex semantic: SEMANTIC=ANGLE with unit deg or rad "
+                 "(vertex.normal=0.1deg). Stored encodings that can err more are not offered to the search "
+                 "(docs/rig-format.md, \"Encodings\")");
 }
 
 GenerateOptions GenerateArgs::resolve() const {
@@ -88,6 +93,24 @@ GenerateOptions GenerateArgs::resolve() const {
     if (eq == std::string::npos || eq == 0 || used == 0 || eq + 1 + used != kv.size() || value < 0)
       throw CLI::ValidationError("--set", "expected NAME=VALUE with a non-negative integer VALUE, got '" + kv + "'");
     o.rigParams[kv.substr(0, eq)] = value;
+  }
+  for (const auto& kv : maxErrors) {
+    const auto eq = kv.find('=');
+    const std::string number = eq == std::string::npos ? "" : kv.substr(eq + 1);
+    const bool deg = number.size() > 3 && number.compare(number.size() - 3, 3, "deg") == 0;
+    const bool rad = number.size() > 3 && number.compare(number.size() - 3, 3, "rad") == 0;
+    double value = -1;
+    size_t used = 0;
+    try {
+      if (deg || rad) value = std::stod(number.substr(0, number.size() - 3), &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (eq == 0 || used == 0 || used + 3 != number.size() || !std::isfinite(value) || value <= 0)
+      throw CLI::ValidationError("--max-error",
+                                 "expected SEMANTIC=ANGLE with a positive ANGLE in deg or rad (vertex.normal=0.1deg), "
+                                 "got '" + kv + "'");
+    o.maxErrorDegrees[kv.substr(0, eq)] = rad ? value * 180 / 3.14159265358979323846 : value;
   }
   return o;
 }
@@ -228,6 +251,7 @@ struct GenerateCommand {
     refuseClobbering(outPaths, inputFiles(r.in, r.inputsRead));
     writeFilesAtomically(files);
     if (stats) std::cout << describeStats(r.stats);
+    for (const auto& n : r.in.notes) std::cerr << formatDiagnostic(n) << "\n";
     if (!quiet) {
       printPlan(r, o);
       for (const auto& f : files) std::cout << "wrote " << f.path << "\n";

@@ -22,6 +22,7 @@ struct GenerateArgs {
   GenerateOptions opts;
   std::vector<std::string> maps;  // "Name=sem[,sem...]"
   std::vector<std::string> sets;  // "param=value" (rig deformer parameters)
+  std::vector<std::string> maxErrors;  // "semantic=0.1deg" (error budgets)
   std::string targetEnv = "vulkan1.0";
   CLI::Option* maxAttributes = nullptr;  // whether the device limits were given (applyDeviceLimits)
   CLI::Option* maxUniformBytes = nullptr;

@@ -12,6 +12,7 @@
 #include "emit/reflection.h"
 #include "rig/gltf_import.h"
 #include "rig/rig_lod.h"
+#include "rig/vertex_encoding.h"
 
 namespace sg {
 
@@ -50,13 +51,15 @@ std::vector<Diagnostic> unreachableInputs(const LoadedInputs& in) {
   return out;
 }
 
-// Several located errors as one InputError, in source order (the first is the primary one).
-[[noreturn]] void throwAll(std::vector<Diagnostic> errors) {
+// Several located errors as one InputError, in source order (the first is the primary one),
+// then the notes that explain them.
+[[noreturn]] void throwAll(std::vector<Diagnostic> errors, const std::vector<Diagnostic>& notes = {}) {
   std::stable_sort(errors.begin(), errors.end(), [](const Diagnostic& a, const Diagnostic& b) {
     return std::tie(a.loc.file, a.loc.line, a.loc.col) < std::tie(b.loc.file, b.loc.line, b.loc.col);
   });
   InputError e(errors[0]);
   e.related.assign(errors.begin() + 1, errors.end());
+  e.related.insert(e.related.end(), notes.begin(), notes.end());
   throw e;
 }
 
@@ -147,7 +150,7 @@ Plan searchStage(const LoadedInputs& in, const SearchOptions& opts, SearchStats*
                                  "from storage buffers) stays within them",
                                  in.rig.name, broken.empty() ? "more than the limits allow" : broken));
   }
-  if (std::vector<Diagnostic> all = unreachableInputs(in); !all.empty()) throwAll(std::move(all));
+  if (std::vector<Diagnostic> all = unreachableInputs(in); !all.empty()) throwAll(std::move(all), in.notes);
   std::string why = formatUnreachable(p, analyzeUnreachable(p, in.rules, in.varyings));
   // Point at the first fragment input whose request cannot be met.
   SourceLoc at{in.fragment.file, 0, 0};
@@ -158,7 +161,9 @@ Plan searchStage(const LoadedInputs& in, const SearchOptions& opts, SearchStats*
       if (f >= 0 && !reach[f] && at.line == 0) at = v.loc.line ? v.loc : at;
     }
   if (!why.empty() && why.back() == '\n') why.pop_back();
-  throw InputError(at, fmt::format("the request cannot be met for rig '{}':\n{}", in.rig.name, why));
+  InputError err(at, fmt::format("the request cannot be met for rig '{}':\n{}", in.rig.name, why));
+  err.related = in.notes;
+  throw err;
 }
 
 EmittedGlsl emitStage(const LoadedInputs& in, const Plan& plan, const TemplateSet& templates,
@@ -226,9 +231,18 @@ std::vector<std::string> inputsRead(const LoadedInputs& in, const TemplateSet& t
 LoadedInputs loadInputs(const GenerateOptions& opts) {
   Rig rig = loadRigStage(opts.rigPath);
   if (!opts.rigParams.empty()) rig = rigWithParameters(rig, opts.rigParams, SourceLoc{});
-  LoadedInputs in = instantiateStage(std::move(rig), loadRulesStage(opts.rulesPaths),
-                                     loadFragmentStage(opts.fragmentPath, opts.targetEnv), opts.overrides,
-                                     opts.conventions);
+  std::vector<Diagnostic> notes;
+  if (!opts.maxErrorDegrees.empty()) rig = withinErrorBudgets(rig, opts.maxErrorDegrees, notes);
+  RuleSet rules = loadRulesStage(opts.rulesPaths);
+  FragmentInterface fragment = loadFragmentStage(opts.fragmentPath, opts.targetEnv);
+  LoadedInputs in;
+  try {
+    in = instantiateStage(std::move(rig), std::move(rules), std::move(fragment), opts.overrides, opts.conventions);
+  } catch (InputError& e) {  // a request the budgets made unsatisfiable says so
+    e.related.insert(e.related.end(), notes.begin(), notes.end());
+    throw;
+  }
+  in.notes = std::move(notes);
   if (!opts.deviceProfilePath.empty()) priceStage(in, loadDeviceProfileStage(opts.deviceProfilePath));
   for (const auto& b : opts.bannedRules)  // a misspelt --ban would otherwise change nothing silently
     if (std::none_of(in.rules.rules.begin(), in.rules.rules.end(), [&](const Rule& r) { return r.name == b; }))

@@ -7,6 +7,7 @@
 
 #include "common/yaml_util.h"
 #include "rig/rig.h"
+#include "rig/vertex_encoding.h"
 
 namespace sg {
 namespace {
@@ -129,6 +130,13 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
       }
       if (!providedSemantics.insert(p.semantic).second)
         y.fail(semNode, fmt::format("semantic '{}' is provided twice", p.semantic));
+      // An encoded value is decoded by its rule from the whole attribute, in a format
+      // whose error is known (rig/vertex_encoding.h).
+      if (const VertexEncoding* e = encodingOf(p.semantic);
+          e && (!encodingMaxError(*e, a.format) || (p.swizzle.empty() ? n : static_cast<int>(p.swizzle.size())) != 2))
+        y.fail(swzNode ? *swzNode : body["format"],
+               fmt::format("'{}' ({} {}) must be stored in {}, not {}{}", p.semantic, e->name, e->source,
+                           encodingFormats(*e), formatName(a.format), p.swizzle.empty() ? "" : " ." + p.swizzle));
       a.provides.push_back(p);
     };
     if (prov.IsScalar()) {

@@ -5,6 +5,7 @@
 #include <optional>
 #include <vector>
 
+#include "common/diagnostics.h"
 #include "interface/fragment_interface.h"
 #include "rig/rig.h"
 #include "rules/rules.h"
@@ -21,6 +22,9 @@ struct LoadedInputs {
   Problem problem;
   // The device profile the problem is priced with (priceStage); none: instruction slots.
   std::optional<DeviceProfile> profile;
+  // What loading left out and why (error budgets' removals): printed by the CLI, and
+  // attached to an error when the request then cannot be met.
+  std::vector<Diagnostic> notes;
 };
 
 }  // namespace sg

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "rig/vertex_encoding.h"
 #include "validate/poses.h"
 
 namespace sg {
@@ -48,8 +49,7 @@ int swizzleIndex(char c) { return c == 'x' ? 0 : c == 'y' ? 1 : c == 'z' ? 2 : 3
 // value the device reads back from its stored form, so the reference sees exactly what the
 // GPU reads. A part's stream component k is the attribute's component of its swizzle's
 // k-th letter (10-10-10-2 stores w in 2 bits, x, y and z in 10).
-rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
-  rt::Mesh m = mesh;
+void quantizeStreams(const Rig& rig, rt::Mesh& m) {
   for (const auto& a : rig.attributes) {
     if (formatIsFloat32(a.format)) continue;
     const int n = formatComponents(a.format);
@@ -64,6 +64,44 @@ rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
             v[static_cast<int>(k)] = storedValue(a.format, swizzleIndex(swz[k]), v[static_cast<int>(k)]);
       }
   }
+}
+
+// The encoded semantics the rig stores (rig/vertex_encoding.h).
+std::vector<const VertexEncoding*> storedEncodings(const Rig& rig) {
+  std::vector<const VertexEncoding*> out;
+  for (const auto& a : rig.attributes)
+    for (const auto& p : a.provides)
+      if (const VertexEncoding* e = encodingOf(p.semantic); e && !a.perMorphTarget) out.push_back(e);
+  return out;
+}
+
+rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
+  rt::Mesh m = mesh;
+  // An encoded stream the mesh lacks is encoded from its float source; after rounding to
+  // the stored format, the source becomes the decode of what the device reads. So the
+  // reference, the GPU's decode and a float attribute the rig offers beside the code all
+  // carry one vector, and a decode rule is checked exactly (its rounding is the budget's
+  // business, not validation's).
+  const auto encodings = storedEncodings(rig);
+  for (const VertexEncoding* e : encodings) {
+    auto src = m.streams.find(e->source);
+    if (m.has(e->encoded) || src == m.streams.end()) continue;
+    std::vector<glm::vec4> code(m.vertexCount, glm::vec4(0));
+    for (size_t v = 0; v < m.vertexCount && v < src->second.size(); ++v)
+      code[v] = glm::vec4(glm::vec2(octahedralEncode(glm::dvec3(src->second[v]))), 0, 0);
+    m.streams[e->encoded] = std::move(code);
+  }
+  quantizeStreams(rig, m);
+  if (encodings.empty()) return m;
+  for (const VertexEncoding* e : encodings) {
+    if (!m.has(e->encoded)) continue;
+    const auto& code = m.at(e->encoded);
+    auto& src = m.streams[e->source];
+    src.resize(m.vertexCount, glm::vec4(0));
+    for (size_t v = 0; v < m.vertexCount; ++v)
+      src[v] = glm::vec4(glm::vec3(octahedralDecode(glm::dvec2(code[v]))), src[v].w);
+  }
+  quantizeStreams(rig, m);  // a source the rig stores too, in a rounded format
   return m;
 }
 

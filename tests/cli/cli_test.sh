@@ -122,7 +122,7 @@ depfile)
     fail "target line: $(head -1 d/face.vert.d)"
   # Every input read: rig, fragment, the rules file and everything it includes, the template.
   want=("$E/face.rig.yaml" "$E/face.frag" "$E/rules.yaml" "$SRC/templates/vertex.glsl")
-  for r in standard vocabulary morph skinning frames view projection buffers conventions; do want+=("$SRC/rules/$r.yaml"); done
+  for r in standard vocabulary encodings morph skinning frames view projection buffers conventions; do want+=("$SRC/rules/$r.yaml"); done
   deps=$(tail -n +2 d/face.vert.d | sed 's/^ *//; s/ *\\$//')
   for w in "${want[@]}"; do
     w=$(realpath -ms "$w")
