@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <set>
 #include <stdexcept>
 #include <tuple>
 
@@ -228,22 +229,81 @@ std::vector<std::string> inputsRead(const LoadedInputs& in, const TemplateSet& t
 
 // ---- the stages in order ------------------------------------------------------------------
 
+namespace {
+
+// The search under the options' bans and device limits (what generateWith runs).
+Plan searchUnderOptions(LoadedInputs& in, const GenerateOptions& opts, SearchStats* stats) {
+  if (!opts.bannedRules.empty()) in.problem = withoutRules(in.problem, opts.bannedRules);
+  setDeviceLimits(in.problem, opts.maxAttributes, opts.maxUniformBlockBytes, opts.maxStorageBuffers);
+  dropOversizedBuffers(in.problem, opts.maxVertices, opts.maxStorageBufferBytes);
+  return searchStage(in, SearchOptions{opts.searchEngine, opts.heuristic, opts.searchLimits}, stats);
+}
+
+LoadedInputs instantiateAndPrice(Rig rig, const RuleSet& rules, const FragmentInterface& fragment,
+                                 const GenerateOptions& opts, const std::optional<DeviceProfile>& profile) {
+  LoadedInputs in = instantiateStage(std::move(rig), rules, fragment, opts.overrides, opts.conventions);
+  if (profile) priceStage(in, *profile);
+  return in;
+}
+
+// A rig that stores a value both as itself and encoded (docs/rig-format.md, "Encodings")
+// offers a choice the planning model cannot state: a provided value is true from the
+// start, so its decode rule would never be used. Each combination of one form per value
+// is instantiated and searched, and the cheapest plan's inputs kept (ties: the plain form).
+// At most two values have an encoding, so at most four searches.
+LoadedInputs cheapestStoredForms(const Rig& rig, const RuleSet& rules, const FragmentInterface& fragment,
+                                 const GenerateOptions& opts, const std::optional<DeviceProfile>& profile,
+                                 std::vector<Diagnostic>& notes) {
+  std::vector<const VertexEncoding*> twice;
+  for (const auto& e : vertexEncodings())
+    if (attributeProviding(rig, e.source) && attributeProviding(rig, e.encoded)) twice.push_back(&e);
+  if (twice.empty()) return instantiateAndPrice(rig, rules, fragment, opts, profile);
+  std::optional<LoadedInputs> best;
+  int64_t bestCost = 0;
+  std::set<std::string> bestDropped;
+  for (uint32_t mask = 0; mask < (1u << twice.size()); ++mask) {
+    std::set<std::string> dropped;
+    for (size_t i = 0; i < twice.size(); ++i) dropped.insert((mask >> i) & 1 ? twice[i]->source : twice[i]->encoded);
+    try {
+      LoadedInputs cand = instantiateAndPrice(withoutProvided(rig, dropped), rules, fragment, opts, profile);
+      LoadedInputs searched = cand;
+      const int64_t cost = searchUnderOptions(searched, opts, nullptr).cost;
+      if (!best || cost < bestCost) best = std::move(cand), bestCost = cost, bestDropped = dropped;
+    } catch (const InputError&) {
+      continue;  // this combination cannot serve the request; another may
+    }
+  }
+  if (!best) return instantiateAndPrice(rig, rules, fragment, opts, profile);  // the full rig's own error
+  for (const VertexEncoding* e : twice) {
+    const bool encoded = bestDropped.count(e->source) != 0;
+    const std::string& used = encoded ? e->encoded : e->source;
+    const std::string& other = encoded ? e->source : e->encoded;
+    notes.push_back(Diagnostic{Severity::Note, attributeProviding(rig, used)->loc,
+                               fmt::format("{}: the plan reads {}; the rig also stores {}, which would not make it "
+                                           "cheaper", e->source, used, other)});
+  }
+  return std::move(*best);
+}
+
+}  // namespace
+
 LoadedInputs loadInputs(const GenerateOptions& opts) {
   Rig rig = loadRigStage(opts.rigPath);
   if (!opts.rigParams.empty()) rig = rigWithParameters(rig, opts.rigParams, SourceLoc{});
   std::vector<Diagnostic> notes;
   if (!opts.maxErrorDegrees.empty()) rig = withinErrorBudgets(rig, opts.maxErrorDegrees, notes);
-  RuleSet rules = loadRulesStage(opts.rulesPaths);
-  FragmentInterface fragment = loadFragmentStage(opts.fragmentPath, opts.targetEnv);
+  const RuleSet rules = loadRulesStage(opts.rulesPaths);
+  const FragmentInterface fragment = loadFragmentStage(opts.fragmentPath, opts.targetEnv);
+  std::optional<DeviceProfile> profile;
+  if (!opts.deviceProfilePath.empty()) profile = loadDeviceProfileStage(opts.deviceProfilePath);
   LoadedInputs in;
   try {
-    in = instantiateStage(std::move(rig), std::move(rules), std::move(fragment), opts.overrides, opts.conventions);
+    in = cheapestStoredForms(rig, rules, fragment, opts, profile, notes);
   } catch (InputError& e) {  // a request the budgets made unsatisfiable says so
     e.related.insert(e.related.end(), notes.begin(), notes.end());
     throw;
   }
   in.notes = std::move(notes);
-  if (!opts.deviceProfilePath.empty()) priceStage(in, loadDeviceProfileStage(opts.deviceProfilePath));
   for (const auto& b : opts.bannedRules)  // a misspelt --ban would otherwise change nothing silently
     if (std::none_of(in.rules.rules.begin(), in.rules.rules.end(), [&](const Rule& r) { return r.name == b; }))
       throw InputError(SourceLoc{}, fmt::format("--ban {}: no rule of that name in the rules files", b));
@@ -271,10 +331,7 @@ GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts) {
 
 GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const GenerateOptions& opts) {
   GenerateResult res;
-  if (!opts.bannedRules.empty()) in.problem = withoutRules(in.problem, opts.bannedRules);
-  setDeviceLimits(in.problem, opts.maxAttributes, opts.maxUniformBlockBytes, opts.maxStorageBuffers);
-  dropOversizedBuffers(in.problem, opts.maxVertices, opts.maxStorageBufferBytes);
-  res.plan = searchStage(in, SearchOptions{opts.searchEngine, opts.heuristic, opts.searchLimits}, &res.stats);
+  res.plan = searchUnderOptions(in, opts, &res.stats);
   EmitOptions eo;
   eo.capture = opts.capture;
   eo.heuristic = opts.heuristic;

@@ -68,27 +68,36 @@ Rig withinErrorBudgets(const Rig& rig, const std::map<std::string, double>& budg
     if (std::none_of(vertexEncodings().begin(), vertexEncodings().end(), [&](const auto& e) { return e.source == semantic; }))
       throw InputError(SourceLoc{}, fmt::format("--max-error {}: no encoding stores '{}' (budgets apply to {})", semantic,
                                                 semantic, sources));
-  Rig out = rig;
-  out.attributes.clear();
-  for (RigAttribute a : rig.attributes) {
-    std::vector<ProvidedPart> kept;
+  std::set<std::string> over;
+  for (const RigAttribute& a : rig.attributes)
     for (const auto& p : a.provides) {
       const VertexEncoding* e = encodingOf(p.semantic);
       auto budget = e ? budgets.find(e->source) : budgets.end();
       const std::optional<double> err = e ? encodingMaxError(*e, a.format) : std::nullopt;
-      if (budget != budgets.end() && err && *err > budget->second) {
-        notes.push_back(Diagnostic{Severity::Note, a.loc,
-                                   fmt::format("{} (attribute '{}', {}) is not offered to the search: it errs up to {:.3g} {}, "
-                                               "over the budget of {:.3g} {} for {} (--max-error)",
-                                               p.semantic, a.name, formatName(a.format), *err, e->unit,
-                                               budget->second, e->unit, e->source)});
-        continue;
-      }
-      kept.push_back(p);
+      if (budget == budgets.end() || !err || *err <= budget->second) continue;
+      over.insert(p.semantic);
+      notes.push_back(Diagnostic{Severity::Note, a.loc,
+                                 fmt::format("{} (attribute '{}', {}) is not offered to the search: it errs up to {:.3g} {}, "
+                                             "over the budget of {:.3g} {} for {} (--max-error)",
+                                             p.semantic, a.name, formatName(a.format), *err, e->unit, budget->second,
+                                             e->unit, e->source)});
     }
-    if (kept.empty()) continue;
-    a.provides = std::move(kept);
-    out.attributes.push_back(std::move(a));
+  return withoutProvided(rig, over);
+}
+
+const RigAttribute* attributeProviding(const Rig& rig, const std::string& semantic) {
+  for (const RigAttribute& a : rig.attributes)
+    for (const auto& p : a.provides)
+      if (p.semantic == semantic && !a.perMorphTarget) return &a;
+  return nullptr;
+}
+
+Rig withoutProvided(const Rig& rig, const std::set<std::string>& semantics) {
+  Rig out = rig;
+  out.attributes.clear();
+  for (RigAttribute a : rig.attributes) {
+    std::erase_if(a.provides, [&](const ProvidedPart& p) { return semantics.count(p.semantic) != 0; });
+    if (!a.provides.empty()) out.attributes.push_back(std::move(a));
   }
   return out;
 }

@@ -6,6 +6,7 @@
 #pragma once
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,12 @@ glm::dvec3 octahedralDecode(const glm::dvec2& e);
 std::optional<double> encodingMaxError(const VertexEncoding& e, VertexFormat f);
 // "snorm8x2, snorm16x2, float16x2, float32x2" for messages.
 std::string encodingFormats(const VertexEncoding& e);
+
+// The attribute that provides `semantic` (per-target streams excepted), or nullptr.
+const RigAttribute* attributeProviding(const Rig& rig, const std::string& semantic);
+// The rig without the parts that provide these semantics (an attribute left with no part
+// goes too): how a stored form is taken out of the search's reach.
+Rig withoutProvided(const Rig& rig, const std::set<std::string>& semantics);
 
 // Error budgets (--max-error): the worst error allowed per source semantic, in the
 // encodings' unit (degrees). The rig without the encoded parts over budget (an attribute
