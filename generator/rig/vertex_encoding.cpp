@@ -64,10 +64,12 @@ Rig withinErrorBudgets(const Rig& rig, const std::map<std::string, double>& budg
   std::string sources;
   for (const auto& e : vertexEncodings())
     if (sources.find(e.source) == std::string::npos) sources += (sources.empty() ? "" : ", ") + e.source;
-  for (const auto& [semantic, budget] : budgets)
+  for (const auto& budget : budgets) {
+    const std::string& semantic = budget.first;  // (Clang 14 cannot capture a structured binding)
     if (std::none_of(vertexEncodings().begin(), vertexEncodings().end(), [&](const auto& e) { return e.source == semantic; }))
       throw InputError(SourceLoc{}, fmt::format("--max-error {}: no encoding stores '{}' (budgets apply to {})", semantic,
                                                 semantic, sources));
+  }
   std::set<std::string> over;
   for (const RigAttribute& a : rig.attributes)
     for (const auto& p : a.provides) {
