@@ -32,6 +32,7 @@ void registerCommands(CLI::App& app, CliState& state) {
   registerRender(app, state);
   registerCalibrate(app, state);
   registerBuild(app, state);
+  registerPack(app, state);
 }
 
 }  // namespace sg

@@ -58,6 +58,7 @@ void registerCheck(CLI::App& app, CliState& state);    // cmd_check.cpp
 void registerExplain(CLI::App& app, CliState& state);  // cmd_explain.cpp: explain + graph
 void registerRig(CLI::App& app, CliState& state);      // cmd_rig.cpp: rig import
 void registerBuild(CLI::App& app, CliState& state);    // cmd_build.cpp: variant manifests
+void registerPack(CLI::App& app, CliState& state);     // cmd_pack.cpp: vertex streams from float data
 void registerBake(CLI::App& app, CliState& state);     // cmd_bake.cpp: bake occlusion
 void registerRender(CLI::App& app, CliState& state);   // cmd_render.cpp: render + bench (GPU timing)
 void registerCalibrate(CLI::App& app, CliState& state);  // cmd_calibrate.cpp: device profiles

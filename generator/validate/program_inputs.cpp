@@ -105,30 +105,6 @@ rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
   return m;
 }
 
-rt::VertexStream buildStream(const Rig& rig, const EmittedInput& in, const rt::Mesh& mesh) {
-  const RigAttribute& a = rig.attributes[in.attribute];
-  const int n = formatComponents(a.format);
-  rt::VertexStream s;
-  s.location = static_cast<uint32_t>(in.location);
-  s.format = vkFormat(a.format);
-  s.stride = static_cast<uint32_t>(formatBytes(a.format));
-  // Gather the parts into one flat array of n components per vertex, then encode.
-  std::vector<float> comps(mesh.vertexCount * static_cast<size_t>(n), 0.0f);
-  for (const auto& p : a.provides) {
-    std::string sem = partSemantic(a, p, in.target);
-    if (!mesh.has(sem))
-      throw InputError(a.loc, fmt::format("mesh '{}' has no data for '{}' (attribute '{}')", mesh.name, sem, a.name));
-    const auto& src = mesh.at(sem);
-    std::string swz = p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(n)) : p.swizzle;
-    for (size_t v = 0; v < mesh.vertexCount; ++v)
-      for (size_t k = 0; k < swz.size(); ++k)
-        comps[v * static_cast<size_t>(n) + static_cast<size_t>(swizzleIndex(swz[k]))] = src[v][static_cast<int>(k)];
-  }
-  s.data.resize(mesh.vertexCount * s.stride);
-  for (size_t v = 0; v < mesh.vertexCount; ++v)
-    encodeElement(a.format, comps.data() + v * static_cast<size_t>(n), s.data.data() + v * s.stride);
-  return s;
-}
 
 // Element bytes of a buffer element from up to 16 float components.
 void putElement(std::vector<uint8_t>& out, size_t at, Type element, const float* comps, int n) {
@@ -259,6 +235,32 @@ UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape
 
 rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh) { return quantizedMesh(rig, mesh); }
 
+rt::VertexStream vertexStream(const Rig& rig, const EmittedInput& in, const rt::Mesh& mesh) {
+  const RigAttribute& a = rig.attributes[in.attribute];
+  const int n = formatComponents(a.format);
+  rt::VertexStream s;
+  s.location = static_cast<uint32_t>(in.location);
+  s.format = vkFormat(a.format);
+  s.stride = static_cast<uint32_t>(formatBytes(a.format));
+  // Gather the parts into one flat array of n components per vertex, then encode.
+  std::vector<float> comps(mesh.vertexCount * static_cast<size_t>(n), 0.0f);
+  for (const auto& p : a.provides) {
+    std::string sem = partSemantic(a, p, in.target);
+    if (!mesh.has(sem))
+      throw InputError(a.loc, fmt::format("mesh '{}' has no data for '{}' (attribute '{}')", mesh.name, sem, a.name));
+    const auto& src = mesh.at(sem);
+    std::string swz = p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(n)) : p.swizzle;
+    for (size_t v = 0; v < mesh.vertexCount; ++v)
+      for (size_t k = 0; k < swz.size(); ++k)
+        comps[v * static_cast<size_t>(n) + static_cast<size_t>(swizzleIndex(swz[k]))] = src[v][static_cast<int>(k)];
+  }
+  s.data.resize(mesh.vertexCount * s.stride);
+  for (size_t v = 0; v < mesh.vertexCount; ++v)
+    encodeElement(a.format, comps.data() + v * static_cast<size_t>(n), s.data.data() + v * s.stride);
+  return s;
+}
+
+
 std::vector<rt::DescriptorBinding> declaredDescriptors(const std::vector<ShaderDescriptor>& reflected) {
   std::vector<rt::DescriptorBinding> out;
   for (const auto& d : reflected)
@@ -291,7 +293,7 @@ UniformValues feedPose(const GenerateResult& r, const rt::Mesh& mesh, const rt::
 rt::ProgramInputs programInputs(const GenerateResult& r, const rt::Mesh& mesh, const rt::Pose& pose) {
   rt::ProgramInputs in;
   in.vertexCount = static_cast<uint32_t>(mesh.vertexCount);
-  for (const auto& i : r.glsl.inputs) in.streams.push_back(buildStream(r.in.rig, i, mesh));
+  for (const auto& i : r.glsl.inputs) in.streams.push_back(vertexStream(r.in.rig, i, mesh));
   in.storageBuffers = buildStorageBuffers(r.in.problem, r.glsl, mesh, rt::Pose{}, true);
   in.declared = declaredDescriptors(r.spirv.descriptors);
   feedPose(r, mesh, pose, in);

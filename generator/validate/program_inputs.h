@@ -33,5 +33,8 @@ std::vector<rt::DescriptorBinding> declaredDescriptors(const std::vector<ShaderD
 // The mesh with every integer/normalized stream rounded as its attribute format stores it
 // (what the GPU reads back), so the reference sees exactly the GPU's values.
 rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh);
+// The stream of one program input over `mesh` (quantizeForRig'd): the attribute's elements
+// encoded in its format, tightly packed (the stride is the format's size).
+rt::VertexStream vertexStream(const Rig& rig, const EmittedInput& in, const rt::Mesh& mesh);
 
 }  // namespace sg

@@ -1,0 +1,52 @@
+#include "validate/pack.h"
+
+#include <nlohmann/json.hpp>
+
+#include "rig/vertex_encoding.h"
+#include "validate/program_inputs.h"
+
+namespace sg {
+
+PackedVertices packVertices(const GenerateResult& r, const rt::Mesh& mesh) {
+  const Rig& rig = r.in.rig;
+  const rt::Mesh quantized = quantizeForRig(rig, mesh);
+  PackedVertices out;
+  out.vertexCount = mesh.vertexCount;
+  nlohmann::json streams = nlohmann::json::array();
+  for (const EmittedInput& in : r.glsl.inputs) {
+    const RigAttribute& a = rig.attributes[static_cast<size_t>(in.attribute)];
+    rt::VertexStream s = vertexStream(rig, in, quantized);
+    const size_t offset = (out.bytes.size() + 15) / 16 * 16;  // any API's buffer-offset alignment
+    out.bytes.resize(offset);
+    out.bytes.insert(out.bytes.end(), s.data.begin(), s.data.end());
+    nlohmann::json provides = nlohmann::json::array();
+    for (const auto& p : a.provides) {
+      nlohmann::json part = {{"semantic", in.target >= 0 ? p.semantic + "[" + std::to_string(in.target) + "]" : p.semantic},
+                             {"components", p.swizzle.empty() ? std::string("xyzw").substr(0, formatComponents(a.format))
+                                                              : p.swizzle}};
+      if (const VertexEncoding* e = encodingOf(p.semantic)) {
+        part["encodes"] = e->source;
+        part["encoding"] = e->name;
+        part["max_error_deg"] = *encodingMaxError(*e, a.format);
+      }
+      provides.push_back(std::move(part));
+    }
+    streams.push_back({{"input", in.name},
+                       {"location", in.location},
+                       {"attribute", a.name},
+                       {"target", in.target},
+                       {"format", formatName(a.format)},
+                       {"offset", offset},
+                       {"stride", s.stride},
+                       {"size", s.data.size()},
+                       {"provides", std::move(provides)}});
+  }
+  const nlohmann::json layout = {{"rig", rig.name},
+                                 {"vertex_count", out.vertexCount},
+                                 {"bytes", out.bytes.size()},
+                                 {"streams", std::move(streams)}};
+  out.layoutJson = layout.dump(2) + "\n";
+  return out;
+}
+
+}  // namespace sg
