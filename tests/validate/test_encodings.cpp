@@ -163,16 +163,19 @@ namespace {
 // A rig storing the frame both ways offers the search a real choice. Instruction slots
 // charge nothing for a location, so the decode only costs: the float frame. The H200
 // profile charges 0.41 ns per location and 0.0024 ns per slot: one location saved for 22
-// slots of decode is cheaper, so the codes. Either plan validates on the device, and the
-// program reads only the attributes of the chosen form.
+// slots of decode is cheaper, so the codes. Lavapipe on a 2-core CPU charges 4.3 ns per
+// location and 1.5 ns per slot: the decode would cost 34 ns to save 4, so the floats, its
+// own choice. Every plan validates on the device, and the chosen rig keeps only the
+// attributes of the chosen form.
 TEST(Octahedral, TheSearchChoosesTheStoredFormPerDevice) {
-  for (bool h200 : {false, true}) {
-    SCOPED_TRACE(h200 ? "H200 profile" : "instruction slots");
+  for (const std::string profile : {"", "nvidia-h200.yaml", "llvmpipe-2core.yaml"}) {
+    const bool h200 = profile == "nvidia-h200.yaml";
+    SCOPED_TRACE(profile.empty() ? "instruction slots" : profile);
     sg::ValidateOptions vo;
     vo.gen.rigPath = dataPath("octahedral_or_float.rig.yaml");
     vo.gen.fragmentPath = dataPath("world.frag");
     vo.gen.rulesPaths = {sourcePath("rules/standard.yaml")};
-    if (h200) vo.gen.deviceProfilePath = sourcePath("devices/nvidia-h200.yaml");
+    if (!profile.empty()) vo.gen.deviceProfilePath = sourcePath("devices/" + profile);
     sg::Rig rig = sg::loadRigFile(vo.gen.rigPath);
     sg::ValidationScene scene = sg::proceduralScene(rig, "limb", 1, 2);
     sg::Validator v(vo);
