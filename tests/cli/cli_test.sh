@@ -429,6 +429,26 @@ device_profile)
   grep -qE "^    buffer_loads +[1-9]" last.out && ok "explain: buffer loads counted" || fail "$(cat last.out)"
   ;;
 
+pack)  # docs/rig-format.md "Packing": the streams and their layout, byte-identical reruns
+  OCT=(--rig "$SRC/tests/validate/data/octahedral.rig.yaml" -f "$SRC/tests/validate/data/world.frag"
+       -r "$SRC/rules/standard.yaml")
+  for d in a b; do
+    expect 0 "pack into $d" -- "$SG" pack "${OCT[@]}" --mesh limb -o "$d/limb" -q
+  done
+  cmp -s a/limb.bin b/limb.bin && ok "identical streams" || fail "limb.bin differs between runs"
+  cmp -s a/limb.json b/limb.json && ok "identical layout" || fail "limb.json differs between runs"
+  # The layout accounts for every byte: the last stream ends where the file does.
+  size=$(stat -c %s a/limb.bin)
+  grep -q "\"bytes\": $size," a/limb.json && ok "layout states the file's $size bytes" || fail "bytes != $size"
+  grep -q '"encoding": "octahedral"' a/limb.json && ok "layout names the encoding" || fail "no encoding in the layout"
+  # A model without the data a stream needs: an error, and nothing written.
+  expect 1 "pack a model lacking normals" -- "$SG" pack "${OCT[@]}" --model "$SRC/tests/gltf/data/gltfpack/SimpleSkin.glb#0/0" -o c/x -q
+  grep -q "octahedral.rig.yaml:12:3: error: mesh 'SimpleSkin/0/0' has no data for 'vertex.normal_octahedral'" last.err &&
+    ok "the error names the stream" || fail "$(cat last.err)"
+  [ ! -e c ] && ok "nothing written on failure" || fail "pack left $(ls c)"
+  expect 2 "--mesh and --model together" -- "$SG" pack "${OCT[@]}" --mesh limb --model x.glb#0/0 -o d/x -q
+  ;;
+
 *)
   echo "unknown case $case_name" >&2
   exit 2
