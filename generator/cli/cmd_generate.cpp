@@ -5,6 +5,8 @@
 #include <iostream>
 #include <algorithm>
 #include <cmath>
+
+#include <glm/glm.hpp>
 #include <set>
 
 #include "cli/commands.h"
@@ -110,7 +112,7 @@ GenerateOptions GenerateArgs::resolve() const {
       throw CLI::ValidationError("--max-error",
                                  "expected SEMANTIC=ANGLE with a positive ANGLE in deg or rad (vertex.normal=0.1deg), "
                                  "got '" + kv + "'");
-    o.maxErrorDegrees[kv.substr(0, eq)] = rad ? value * 180 / 3.14159265358979323846 : value;
+    o.maxErrorDegrees[kv.substr(0, eq)] = rad ? glm::degrees(value) : value;
   }
   return o;
 }

@@ -52,8 +52,7 @@ std::optional<double> encodingMaxError(const VertexEncoding& e, VertexFormat f) 
     default: return std::nullopt;
   }
   perComponent += std::ldexp(1.0, -24);
-  const double kPi = 3.14159265358979323846;
-  return std::sqrt(18.0) * perComponent * 180 / kPi;
+  return glm::degrees(std::sqrt(18.0) * perComponent);
 }
 
 std::string encodingFormats(const VertexEncoding& e) {

@@ -105,7 +105,6 @@ rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
   return m;
 }
 
-
 // Element bytes of a buffer element from up to 16 float components.
 void putElement(std::vector<uint8_t>& out, size_t at, Type element, const float* comps, int n) {
   for (int c = 0; c < n; ++c) {
@@ -259,7 +258,6 @@ rt::VertexStream vertexStream(const Rig& rig, const EmittedInput& in, const rt::
     encodeElement(a.format, comps.data() + v * static_cast<size_t>(n), s.data.data() + v * s.stride);
   return s;
 }
-
 
 std::vector<rt::DescriptorBinding> declaredDescriptors(const std::vector<ShaderDescriptor>& reflected) {
   std::vector<rt::DescriptorBinding> out;

@@ -411,6 +411,7 @@ ValidateReport Validator::run(const ValidationScene& scene, const GenerateOption
   auto t0 = Clock::now();
   GenerateResult chosen = generateFrom(in, gen);
   double genMs = msSince(t0);
+  report.notes = chosen.in.notes;
   // Every run shares the rig's attribute formats: quantize the mesh once.
   const rt::Mesh mesh = quantizeForRig(chosen.in.rig, scene.mesh);
   report.poses = scene.poses;
@@ -463,6 +464,7 @@ std::string formatReport(const ValidateReport& report) {
   std::string s = fmt::format("device: {} (validation layers {}), running {}\n", report.device,
                               report.validationLayers ? "on" : "not available", report.via);
   if (!report.limits.empty()) s += report.limits + "\n";
+  for (const auto& n : report.notes) s += formatDiagnostic(n) + "\n";
   for (const auto& run : report.runs) {
     s += fmt::format("{}: plan cost {}, {} vertices: {}\n", run.label, run.planCost, run.vertices,
                      run.pass ? "PASS" : "FAIL");

@@ -63,6 +63,7 @@ struct ValidateReport {
   std::vector<RunReport> runs;
   bool pass = true;
   std::vector<rt::Pose> poses;  // as run (declared uniforms drawn): what --save-poses writes
+  std::vector<Diagnostic> notes;  // what loading decided (stored forms, error budgets)
 };
 
 // What to run the shader on.

@@ -100,18 +100,25 @@ TEST(Octahedral, StoredErrorStaysWithinTheStatedBoundAndNearIt) {
   EXPECT_FALSE(sg::encodingMaxError(normal, sg::VertexFormat::Unorm16x2));  // no negative codes
 }
 
-sg::ValidateReport validateOctahedral(const std::string& rules, std::map<std::string, double> budgets = {}) {
+// `rig` (tests/validate/data) with world.frag on the limb mesh, in two poses, on lavapipe.
+sg::ValidateReport validateOnLimb(sg::GenerateOptions gen, const std::string& rig) {
   sg::ValidateOptions vo;
-  vo.gen.rigPath = dataPath("octahedral.rig.yaml");
+  vo.gen = std::move(gen);
+  vo.gen.rigPath = dataPath(rig);
   vo.gen.fragmentPath = dataPath("world.frag");
-  vo.gen.rulesPaths = {rules};
-  vo.gen.maxErrorDegrees = std::move(budgets);
-  sg::Rig rig = sg::loadRigFile(vo.gen.rigPath);
-  sg::ValidationScene scene = sg::proceduralScene(rig, "limb", 1, 2);
+  if (vo.gen.rulesPaths.empty()) vo.gen.rulesPaths = {sourcePath("rules/standard.yaml")};
+  sg::ValidationScene scene = sg::proceduralScene(sg::loadRigFile(vo.gen.rigPath), "limb", 1, 2);
   sg::Validator v(vo);
   sg::ValidateReport rep = v.run(scene);
   std::cout << sg::formatReport(rep);
   return rep;
+}
+
+sg::ValidateReport validateOctahedral(const std::string& rules, std::map<std::string, double> budgets = {}) {
+  sg::GenerateOptions gen;
+  gen.rulesPaths = {rules};
+  gen.maxErrorDegrees = std::move(budgets);
+  return validateOnLimb(gen, "octahedral.rig.yaml");
 }
 
 // The frame stored as two octahedral codes in one snorm16x4 location: the plan decodes
@@ -171,22 +178,18 @@ TEST(Octahedral, TheSearchChoosesTheStoredFormPerDevice) {
   for (const std::string profile : {"", "nvidia-h200.yaml", "llvmpipe-2core.yaml"}) {
     const bool h200 = profile == "nvidia-h200.yaml";
     SCOPED_TRACE(profile.empty() ? "instruction slots" : profile);
-    sg::ValidateOptions vo;
-    vo.gen.rigPath = dataPath("octahedral_or_float.rig.yaml");
-    vo.gen.fragmentPath = dataPath("world.frag");
-    vo.gen.rulesPaths = {sourcePath("rules/standard.yaml")};
-    if (!profile.empty()) vo.gen.deviceProfilePath = sourcePath("devices/" + profile);
-    sg::Rig rig = sg::loadRigFile(vo.gen.rigPath);
-    sg::ValidationScene scene = sg::proceduralScene(rig, "limb", 1, 2);
-    sg::Validator v(vo);
-    sg::ValidateReport rep = v.run(scene);
-    std::cout << sg::formatReport(rep);
+    sg::GenerateOptions gen;
+    if (!profile.empty()) gen.deviceProfilePath = sourcePath("devices/" + profile);
+    sg::ValidateReport rep = validateOnLimb(gen, "octahedral_or_float.rig.yaml");
     EXPECT_TRUE(rep.pass);
     ASSERT_FALSE(rep.runs.empty());
     EXPECT_EQ(sgtest::planHas(rep.runs[0], "vertex_normal_from_octahedral"), h200);
     EXPECT_EQ(sgtest::planHas(rep.runs[0], "vertex_tangent_from_octahedral"), h200);
     // What the program reads: the generator's own view of the chosen rig.
-    sg::GenerateResult g = sg::generate(vo.gen);
+    gen.rigPath = dataPath("octahedral_or_float.rig.yaml");
+    gen.fragmentPath = dataPath("world.frag");
+    gen.rulesPaths = {sourcePath("rules/standard.yaml")};
+    sg::GenerateResult g = sg::generate(gen);
     std::set<std::string> read;
     for (const auto& a : g.in.rig.attributes) read.insert(a.name);
     EXPECT_EQ(read.count("frame"), h200 ? 1u : 0u);
@@ -195,6 +198,10 @@ TEST(Octahedral, TheSearchChoosesTheStoredFormPerDevice) {
     EXPECT_NE(g.in.notes[0].message.find(h200 ? "the plan reads vertex.normal_octahedral" : "the plan reads vertex.normal;"),
               std::string::npos)
         << g.in.notes[0].message;
+    // validate says which form it ran.
+    ASSERT_EQ(rep.notes.size(), 2u);
+    EXPECT_EQ(rep.notes[0].message, g.in.notes[0].message);
+    EXPECT_NE(sg::formatReport(rep).find("note: vertex.tangent: the plan reads"), std::string::npos);
   }
 }
 
