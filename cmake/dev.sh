@@ -103,9 +103,9 @@ case "$what" in
     timed test ctest --test-dir "$build" --output-on-failure -j"$(nproc)"
     timed sanitize-build sanitize_build
     timed sanitize-test sanitize_test
-    # CI's share of fuzzing: the seeds replayed and 30 s of search per target (the `fuzz`
+    # CI's share of fuzzing: the seeds replayed and 20 s of search per target (the `fuzz`
     # job runs 60 s, and longer with SHADERGEN_FUZZ_SECONDS).
-    SHADERGEN_FUZZ_SECONDS=${SHADERGEN_FUZZ_SECONDS:-30} timed fuzz fuzz_run
+    SHADERGEN_FUZZ_SECONDS=${SHADERGEN_FUZZ_SECONDS:-20} timed fuzz fuzz_run
     ;;
   build) timed build plain_build ;;
   *) echo "usage: cmake/dev.sh [dawn|test|build|sanitize|fuzz]" >&2; exit 2 ;;
