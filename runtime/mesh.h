@@ -21,6 +21,9 @@ struct Mesh {
   // "skin.joints[s]" (integral values stored as floats), "skin.weights[s]".
   // Unused components are 0. Scalars live in .x.
   std::map<std::string, std::vector<glm::vec4>> streams;
+  // Uniform values that belong to the mesh, not to a pose, by semantic: the bounds of its
+  // bounds-relative positions (mesh.bounds_min, mesh.bounds_extent), derived with them.
+  std::map<std::string, std::vector<double>> uniforms;
 
   bool has(const std::string& semantic) const { return streams.count(semantic) != 0; }
   const std::vector<glm::vec4>& at(const std::string& semantic) const { return streams.at(semantic); }

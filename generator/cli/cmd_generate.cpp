@@ -13,6 +13,7 @@
 #include "cli/output_files.h"
 #include "cli/whole_model.h"
 #include "emit/reflection.h"
+#include "rig/vertex_encoding.h"
 
 namespace sg {
 
@@ -60,8 +61,8 @@ void GenerateArgs::add(CLI::App& cmd) {
   cmd.add_option("--ban", opts.bannedRules, "Exclude a rule from the search (force an alternative)");
   cmd.add_option("--set", sets, "Set a rig deformer parameter: NAME=VALUE (level-of-detail rigs: morph_targets=2)");
   cmd.add_option("--max-error", maxErrors,
-                 "Error budget of an encoded vertex semantic: SEMANTIC=ANGLE with unit deg or rad "
-                 "(vertex.normal=0.1deg). Stored encodings that can err more are not offered to the search "
+                 "Error budget of an encoded vertex semantic: SEMANTIC=ERROR, an angle in deg or rad for a direction "
+                 "(vertex.normal=0.1deg), a fraction of the bounds diagonal for a position (vertex.position=1e-4). Stored encodings that can err more are not offered to the search "
                  "(docs/rig-format.md, \"Encodings\")");
 }
 
@@ -98,21 +99,11 @@ GenerateOptions GenerateArgs::resolve() const {
   }
   for (const auto& kv : maxErrors) {
     const auto eq = kv.find('=');
-    const std::string number = eq == std::string::npos ? "" : kv.substr(eq + 1);
-    const bool deg = number.size() > 3 && number.compare(number.size() - 3, 3, "deg") == 0;
-    const bool rad = number.size() > 3 && number.compare(number.size() - 3, 3, "rad") == 0;
-    double value = -1;
-    size_t used = 0;
-    try {
-      if (deg || rad) value = std::stod(number.substr(0, number.size() - 3), &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (eq == 0 || used == 0 || used + 3 != number.size() || !std::isfinite(value) || value <= 0)
-      throw CLI::ValidationError("--max-error",
-                                 "expected SEMANTIC=ANGLE with a positive ANGLE in deg or rad (vertex.normal=0.1deg), "
-                                 "got '" + kv + "'");
-    o.maxErrorDegrees[kv.substr(0, eq)] = rad ? glm::degrees(value) : value;
+    std::string why = "expected SEMANTIC=ERROR (vertex.normal=0.1deg, vertex.position=1e-4)";
+    const std::optional<double> value =
+        eq == std::string::npos || eq == 0 ? std::nullopt : parseErrorBudget(kv.substr(0, eq), kv.substr(eq + 1), why);
+    if (!value) throw CLI::ValidationError("--max-error", "'" + kv + "': " + why);
+    o.maxError[kv.substr(0, eq)] = *value;
   }
   return o;
 }

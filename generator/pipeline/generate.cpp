@@ -250,7 +250,7 @@ LoadedInputs instantiateAndPrice(Rig rig, const RuleSet& rules, const FragmentIn
 // offers a choice the planning model cannot state: a provided value is true from the
 // start, so its decode rule would never be used. Each combination of one form per value
 // is instantiated and searched, and the cheapest plan's inputs kept (ties: the plain form).
-// At most two values have an encoding, so at most four searches.
+// At most three values have an encoding, so at most eight searches.
 LoadedInputs cheapestStoredForms(const Rig& rig, const RuleSet& rules, const FragmentInterface& fragment,
                                  const GenerateOptions& opts, const std::optional<DeviceProfile>& profile,
                                  std::vector<Diagnostic>& notes) {
@@ -291,7 +291,7 @@ LoadedInputs loadInputs(const GenerateOptions& opts) {
   Rig rig = loadRigStage(opts.rigPath);
   if (!opts.rigParams.empty()) rig = rigWithParameters(rig, opts.rigParams, SourceLoc{});
   std::vector<Diagnostic> notes;
-  if (!opts.maxErrorDegrees.empty()) rig = withinErrorBudgets(rig, opts.maxErrorDegrees, notes);
+  if (!opts.maxError.empty()) rig = withinErrorBudgets(rig, opts.maxError, notes);
   const RuleSet rules = loadRulesStage(opts.rulesPaths);
   const FragmentInterface fragment = loadFragmentStage(opts.fragmentPath, opts.targetEnv);
   std::optional<DeviceProfile> profile;

@@ -32,8 +32,9 @@ struct GenerateOptions {
   std::vector<VaryingOverride> overrides;
   std::vector<std::string> conventions;  // naming conventions (--conventions): empty = all, unambiguous names
   std::map<std::string, int64_t> rigParams;  // deformer parameters set on the rig (--set)
-  // Error budgets per encoded source semantic, in degrees (--max-error; rig/vertex_encoding.h).
-  std::map<std::string, double> maxErrorDegrees;
+  // Error budgets per encoded source semantic, in its encodings' unit: degrees for a direction, a
+  // fraction of the bounds diagonal for a position (--max-error; rig/vertex_encoding.h).
+  std::map<std::string, double> maxError;
   std::vector<std::string> bannedRules;  // force alternatives (cross-check, explain)
   std::string heuristic = "lmcut";
   std::string searchEngine = "auto";  // auto, regression, forward, ip (search/search.h)

@@ -133,7 +133,8 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
       // An encoded value is decoded by its rule from the whole attribute, in a format
       // whose error is known (rig/vertex_encoding.h).
       if (const VertexEncoding* e = encodingOf(p.semantic);
-          e && (!encodingMaxError(*e, a.format) || (p.swizzle.empty() ? n : static_cast<int>(p.swizzle.size())) != 2))
+          e && (!encodingMaxError(*e, a.format) ||
+                (p.swizzle.empty() ? n : static_cast<int>(p.swizzle.size())) != e->components))
         y.fail(swzNode ? *swzNode : body["format"],
                fmt::format("'{}' ({} {}) must be stored in {}, not {}{}", p.semantic, e->name, e->source,
                            encodingFormats(*e), formatName(a.format), p.swizzle.empty() ? "" : " ." + p.swizzle));
@@ -178,6 +179,15 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
       rig.uniforms.push_back(std::move(un));
     }
   }
+  // A code whose decode reads uniforms (bounds-relative positions) is useless without them.
+  for (const RigAttribute& a : rig.attributes)
+    for (const auto& p : a.provides)
+      if (const VertexEncoding* e = encodingOf(p.semantic))
+        for (const std::string& u : e->uniforms)
+          if (!providedSemantics.count(u))
+            throw InputError(a.loc, fmt::format("'{}' ({} {}) is decoded with the uniform '{}', which the rig does not "
+                                                "declare (docs/rig-format.md, \"Encodings\")", p.semantic, e->name,
+                                                e->source, u));
   checkRig(rig);
   return rig;
 }

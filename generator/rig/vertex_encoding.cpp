@@ -11,8 +11,10 @@ namespace sg {
 
 const std::vector<VertexEncoding>& vertexEncodings() {
   static const std::vector<VertexEncoding> all = {
-      {"vertex.normal_octahedral", "vertex.normal", "octahedral", "deg"},
-      {"vertex.tangent_octahedral", "vertex.tangent", "octahedral", "deg"},
+      {"vertex.normal_octahedral", "vertex.normal", "octahedral", "deg", 2, {}},
+      {"vertex.tangent_octahedral", "vertex.tangent", "octahedral", "deg", 2, {}},
+      {"vertex.position_in_bounds", "vertex.position", "bounds", "of the bounds diagonal", 3,
+       {"mesh.bounds_min", "mesh.bounds_extent"}},
   };
   return all;
 }
@@ -21,6 +23,13 @@ const VertexEncoding* encodingOf(const std::string& encodedSemantic) {
   for (const auto& e : vertexEncodings())
     if (e.encoded == encodedSemantic) return &e;
   return nullptr;
+}
+
+std::vector<const VertexEncoding*> encodingsOf(const std::string& sourceSemantic) {
+  std::vector<const VertexEncoding*> out;
+  for (const auto& e : vertexEncodings())
+    if (e.source == sourceSemantic) out.push_back(&e);
+  return out;
 }
 
 namespace {
@@ -41,7 +50,46 @@ glm::dvec3 octahedralDecode(const glm::dvec2& e) {
   return glm::normalize(p);
 }
 
+PositionBounds positionBounds(const std::vector<glm::vec4>& positions) {
+  glm::dvec3 lo(INFINITY), hi(-INFINITY);
+  for (const glm::vec4& p : positions)
+    for (int k = 0; k < 3; ++k)
+      if (std::isfinite(p[k])) lo[k] = std::min(lo[k], double(p[k])), hi[k] = std::max(hi[k], double(p[k]));
+  PositionBounds b;
+  for (int k = 0; k < 3; ++k) {
+    if (!(lo[k] <= hi[k])) continue;  // no finite coordinate on this axis
+    b.min[k] = static_cast<float>(lo[k]);
+    float extent = static_cast<float>(hi[k] - lo[k]);
+    while (double(b.min[k]) + double(extent) < hi[k]) extent = std::nextafter(extent, INFINITY);
+    b.extent[k] = extent;
+  }
+  return b;
+}
+
+glm::dvec3 boundsEncode(const PositionBounds& b, const glm::dvec3& p) {
+  glm::dvec3 code(0);
+  for (int k = 0; k < 3; ++k)
+    if (b.extent[k] > 0 && std::isfinite(p[k])) code[k] = std::clamp((p[k] - b.min[k]) / b.extent[k], 0.0, 1.0);
+  return code;
+}
+
+glm::dvec3 boundsDecode(const PositionBounds& b, const glm::dvec3& code) {
+  return glm::dvec3(b.min) + code * glm::dvec3(b.extent);
+}
+
 std::optional<double> encodingMaxError(const VertexEncoding& e, VertexFormat f) {
+  if (e.name == "bounds") {
+    double perComponent = 0;
+    switch (f) {
+      case VertexFormat::Unorm8x4: perComponent = 0.5 / 255; break;
+      case VertexFormat::Unorm10_10_10_2: perComponent = 0.5 / 1023; break;
+      case VertexFormat::Unorm16x4: perComponent = 0.5 / 65535; break;
+      case VertexFormat::Float16x4: perComponent = std::ldexp(1.0, -12); break;  // codes in [0, 1]: steps <= 2^-11
+      case VertexFormat::Float32x3: case VertexFormat::Float32x4: perComponent = 0; break;
+      default: return std::nullopt;
+    }
+    return perComponent + std::ldexp(1.0, -24);
+  }
   if (e.name != "octahedral") return std::nullopt;
   double perComponent = 0;
   switch (f) {
@@ -56,18 +104,44 @@ std::optional<double> encodingMaxError(const VertexEncoding& e, VertexFormat f) 
 }
 
 std::string encodingFormats(const VertexEncoding& e) {
+  if (e.name == "bounds") return "unorm8x4, unorm10-10-10-2, unorm16x4, float16x4, float32x3/x4 (three components)";
   return e.name == "octahedral" ? "snorm8x2/x4, snorm16x2/x4, float16x2/x4, float32x2/x4 (two components)" : "";
 }
 
+std::optional<double> parseErrorBudget(const std::string& semantic, const std::string& text, std::string& why) {
+  const auto encodings = encodingsOf(semantic);
+  if (encodings.empty()) {
+    std::string sources;
+    for (const auto& e : vertexEncodings())
+      if (sources.find(e.source) == std::string::npos) sources += (sources.empty() ? "" : ", ") + e.source;
+    why = fmt::format("no encoding stores '{}' (budgets apply to {})", semantic, sources);
+    return std::nullopt;
+  }
+  const bool angle = encodings.front()->angular();
+  const bool deg = text.size() > 3 && text.compare(text.size() - 3, 3, "deg") == 0;
+  const bool rad = text.size() > 3 && text.compare(text.size() - 3, 3, "rad") == 0;
+  const std::string number = deg || rad ? text.substr(0, text.size() - 3) : text;
+  double value = -1;
+  size_t used = 0;
+  try {
+    value = std::stod(number, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  const std::string expected = angle ? fmt::format("a positive angle in deg or rad ({}=0.1deg)", semantic)
+                                     : fmt::format("a positive fraction of the bounds diagonal ({}=1e-4)", semantic);
+  if (number.empty() || used != number.size() || !std::isfinite(value) || value <= 0 || (angle != (deg || rad))) {
+    why = fmt::format("expected {}, got '{}'", expected, text);
+    return std::nullopt;
+  }
+  return rad ? glm::degrees(value) : value;
+}
+
 Rig withinErrorBudgets(const Rig& rig, const std::map<std::string, double>& budgets, std::vector<Diagnostic>& notes) {
-  std::string sources;
-  for (const auto& e : vertexEncodings())
-    if (sources.find(e.source) == std::string::npos) sources += (sources.empty() ? "" : ", ") + e.source;
   for (const auto& budget : budgets) {
-    const std::string& semantic = budget.first;  // (Clang 14 cannot capture a structured binding)
-    if (std::none_of(vertexEncodings().begin(), vertexEncodings().end(), [&](const auto& e) { return e.source == semantic; }))
-      throw InputError(SourceLoc{}, fmt::format("--max-error {}: no encoding stores '{}' (budgets apply to {})", semantic,
-                                                semantic, sources));
+    std::string why;
+    if (encodingsOf(budget.first).empty() && !parseErrorBudget(budget.first, "1", why))
+      throw InputError(SourceLoc{}, fmt::format("--max-error {}: {}", budget.first, why));
   }
   std::set<std::string> over;
   for (const RigAttribute& a : rig.attributes)

@@ -21,8 +21,12 @@ namespace sg {
 struct VertexEncoding {
   std::string encoded;  // the stored semantic: "vertex.normal_octahedral"
   std::string source;   // what it encodes: "vertex.normal"
-  std::string name;     // "octahedral"
-  std::string unit;     // the unit of its error: "deg" (an angle)
+  std::string name;     // "octahedral", "bounds"
+  std::string unit;     // the unit of its error: "deg" (an angle), "of the bounds diagonal" (a fraction)
+  int components = 2;   // of the stored code
+  // Uniforms its decode reads, which the host derives from the mesh (bounds: min, extent).
+  std::vector<std::string> uniforms;
+  bool angular() const { return unit == "deg"; }
 };
 
 // Every encoding the standard vocabulary declares.
@@ -36,6 +40,21 @@ const VertexEncoding* encodingOf(const std::string& encodedSemantic);
 glm::dvec2 octahedralEncode(const glm::dvec3& v);
 glm::dvec3 octahedralDecode(const glm::dvec2& e);
 
+// Bounds-relative positions (as KHR_mesh_quantization and Godot 4 store them): the code is
+// the position's place in the mesh's axis-aligned box, (p - min) / extent in [0, 1]^3,
+// which a unorm format holds; the decode is min + code * extent with min and extent as
+// uniforms (mesh.bounds_min, mesh.bounds_extent). The bounds are float32 (what the
+// uniforms carry): min is the smallest coordinate per axis (a float already), extent is
+// max - min rounded up, so every code lies in [0, 1]; a flat axis has extent 0 and code 0.
+// Non-finite coordinates are left out of the bounds and encode as 0.
+struct PositionBounds {
+  glm::vec3 min{0.0f};
+  glm::vec3 extent{0.0f};
+};
+PositionBounds positionBounds(const std::vector<glm::vec4>& positions);
+glm::dvec3 boundsEncode(const PositionBounds& b, const glm::dvec3& p);
+glm::dvec3 boundsDecode(const PositionBounds& b, const glm::dvec3& code);
+
 // The formats an encoding may be stored in, and its worst error there (in its unit), for
 // any input. Octahedral, two components of snorm8 / snorm16 / float16 / float32 (x2, or two
 // of x4, so a normal and a tangent share one location): a stored code is
@@ -44,9 +63,15 @@ glm::dvec3 octahedralDecode(const glm::dvec2& e);
 // moves the point along a path of length <= sqrt(6) e, at least 1/sqrt(3) from the origin,
 // so the direction turns by at most sqrt(18) e radians: snorm8 0.957 deg, snorm16 0.0037
 // deg, float16 0.12 deg (the published maxima for 8 and 16 bits are 0.95 and 0.0037 deg).
+// Bounds, three components of unorm8x4 / unorm10-10-10-2 / unorm16x4 / float16x4 /
+// float32x3/x4: a code is off by at most e per component (half a step of the format, plus
+// the float32 rounding of the code), so each coordinate by e of its axis's extent and the
+// point by at most e of the box's diagonal: unorm8 2.0e-3, 10-bit 4.9e-4, unorm16 7.6e-6.
+// (The decode's own float arithmetic, min + code * extent, rounds as any float transform of
+// the position does, and is not counted.)
 // std::nullopt: the format cannot hold the encoding.
 std::optional<double> encodingMaxError(const VertexEncoding& e, VertexFormat f);
-// "snorm8x2, snorm16x2, float16x2, float32x2" for messages.
+// "snorm8x2/x4, ..." for messages.
 std::string encodingFormats(const VertexEncoding& e);
 
 // The attribute that provides `semantic` (per-target streams excepted), or nullptr.
@@ -55,10 +80,18 @@ const RigAttribute* attributeProviding(const Rig& rig, const std::string& semant
 // goes too): how a stored form is taken out of the search's reach.
 Rig withoutProvided(const Rig& rig, const std::set<std::string>& semantics);
 
-// Error budgets (--max-error): the worst error allowed per source semantic, in the
-// encodings' unit (degrees). The rig without the encoded parts over budget (an attribute
-// left with no part goes too), so the search is never offered them; one note per removal.
-// A budget naming no encoding's source is an InputError.
+// The encodings of a source semantic ("vertex.normal"), or none.
+std::vector<const VertexEncoding*> encodingsOf(const std::string& sourceSemantic);
+
+// Error budgets (--max-error): the worst error allowed per source semantic, in its
+// encodings' unit (degrees for a direction, a fraction of the bounds diagonal for a
+// position). The rig without the encoded parts over budget (an attribute left with no part
+// goes too), so the search is never offered them; one note per removal. A budget naming no
+// encoding's source is an InputError.
 Rig withinErrorBudgets(const Rig& rig, const std::map<std::string, double>& budgets, std::vector<Diagnostic>& notes);
+// A budget as written after "SEMANTIC=": an angle with "deg" or "rad" for a direction, a
+// plain fraction for a position ("1e-4"); the value in the encodings' unit, or std::nullopt
+// with `why` set (also when the semantic has no encoding).
+std::optional<double> parseErrorBudget(const std::string& semantic, const std::string& text, std::string& why);
 
 }  // namespace sg

@@ -27,7 +27,13 @@ PackedVertices packVertices(const GenerateResult& r, const rt::Mesh& mesh) {
       if (const VertexEncoding* e = encodingOf(p.semantic)) {
         part["encodes"] = e->source;
         part["encoding"] = e->name;
-        part["max_error_deg"] = *encodingMaxError(*e, a.format);
+        if (e->angular()) {
+          part["max_error_deg"] = *encodingMaxError(*e, a.format);
+        } else {  // bounds: source = bias + code * scale, the code as the format reads it
+          part["max_error_of_bounds_diagonal"] = *encodingMaxError(*e, a.format);
+          part["bias"] = quantized.uniforms.at(e->uniforms.at(0));
+          part["scale"] = quantized.uniforms.at(e->uniforms.at(1));
+        }
       }
       provides.push_back(std::move(part));
     }
@@ -44,7 +50,9 @@ PackedVertices packVertices(const GenerateResult& r, const rt::Mesh& mesh) {
   const nlohmann::json layout = {{"rig", rig.name},
                                  {"vertex_count", out.vertexCount},
                                  {"bytes", out.bytes.size()},
-                                 {"streams", std::move(streams)}};
+                                 {"streams", std::move(streams)},
+                                 // the values the mesh gives its uniforms (the bounds), by semantic
+                                 {"uniforms", quantized.uniforms}};
   out.layoutJson = layout.dump(2) + "\n";
   return out;
 }

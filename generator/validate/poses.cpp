@@ -20,7 +20,9 @@ const std::set<std::string>& standardUniforms() {
                                               "camera.view",  "camera.projection",      "camera.view_projection",
                                               "model.matrix", "dapple.matrix",
                                               // derived from morph.weights (docs/buffers.md)
-                                              "morph.active_targets", "morph.active_count"};
+                                              "morph.active_targets", "morph.active_count",
+                                              // derived from the mesh (rig/vertex_encoding.h)
+                                              "mesh.bounds_min", "mesh.bounds_extent"};
   return names;
 }
 

@@ -75,20 +75,53 @@ std::vector<const VertexEncoding*> storedEncodings(const Rig& rig) {
   return out;
 }
 
+bool declaresUniform(const Rig& rig, const std::string& semantic) {
+  return std::any_of(rig.uniforms.begin(), rig.uniforms.end(), [&](const RigUniform& u) { return u.semantic == semantic; });
+}
+
+// The mesh's bounds as uniforms, from its float positions, for a rig that reads them.
+void addBounds(const Rig& rig, rt::Mesh& m) {
+  if (!declaresUniform(rig, "mesh.bounds_min") && !declaresUniform(rig, "mesh.bounds_extent")) return;
+  if (m.uniforms.count("mesh.bounds_min") && m.uniforms.count("mesh.bounds_extent")) return;
+  if (!m.has("vertex.position"))
+    throw InputError(SourceLoc{}, fmt::format("mesh '{}' has no positions to take its bounds from", m.name));
+  const PositionBounds b = positionBounds(m.at("vertex.position"));
+  m.uniforms["mesh.bounds_min"] = {b.min.x, b.min.y, b.min.z};
+  m.uniforms["mesh.bounds_extent"] = {b.extent.x, b.extent.y, b.extent.z};
+}
+
+PositionBounds boundsOf(const rt::Mesh& m) {
+  const auto& lo = m.uniforms.at("mesh.bounds_min");
+  const auto& ext = m.uniforms.at("mesh.bounds_extent");
+  PositionBounds b;
+  for (int k = 0; k < 3; ++k) b.min[k] = static_cast<float>(lo[static_cast<size_t>(k)]), b.extent[k] = static_cast<float>(ext[static_cast<size_t>(k)]);
+  return b;
+}
+
+glm::vec4 encodeValue(const VertexEncoding& e, const rt::Mesh& m, const glm::vec4& v) {
+  if (e.name == "bounds") return glm::vec4(glm::vec3(boundsEncode(boundsOf(m), glm::dvec3(v))), 0);
+  return glm::vec4(glm::vec2(octahedralEncode(glm::dvec3(v))), 0, 0);
+}
+
+glm::vec3 decodeValue(const VertexEncoding& e, const rt::Mesh& m, const glm::vec4& code) {
+  if (e.name == "bounds") return glm::vec3(boundsDecode(boundsOf(m), glm::dvec3(code)));
+  return glm::vec3(octahedralDecode(glm::dvec2(code)));
+}
+
 rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
   rt::Mesh m = mesh;
+  addBounds(rig, m);
   // An encoded stream the mesh lacks is encoded from its float source; after rounding to
   // the stored format, the source becomes the decode of what the device reads. So the
   // reference, the GPU's decode and a float attribute the rig offers beside the code all
-  // carry one vector, and a decode rule is checked exactly (its rounding is the budget's
+  // carry one value, and a decode rule is checked exactly (its rounding is the budget's
   // business, not validation's).
   const auto encodings = storedEncodings(rig);
   for (const VertexEncoding* e : encodings) {
     auto src = m.streams.find(e->source);
     if (m.has(e->encoded) || src == m.streams.end()) continue;
     std::vector<glm::vec4> code(m.vertexCount, glm::vec4(0));
-    for (size_t v = 0; v < m.vertexCount && v < src->second.size(); ++v)
-      code[v] = glm::vec4(glm::vec2(octahedralEncode(glm::dvec3(src->second[v]))), 0, 0);
+    for (size_t v = 0; v < m.vertexCount && v < src->second.size(); ++v) code[v] = encodeValue(*e, m, src->second[v]);
     m.streams[e->encoded] = std::move(code);
   }
   quantizeStreams(rig, m);
@@ -98,8 +131,7 @@ rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
     const auto& code = m.at(e->encoded);
     auto& src = m.streams[e->source];
     src.resize(m.vertexCount, glm::vec4(0));
-    for (size_t v = 0; v < m.vertexCount; ++v)
-      src[v] = glm::vec4(glm::vec3(octahedralDecode(glm::dvec2(code[v]))), src[v].w);
+    for (size_t v = 0; v < m.vertexCount; ++v) src[v] = glm::vec4(decodeValue(*e, m, code[v]), src[v].w);
   }
   quantizeStreams(rig, m);  // a source the rig stores too, in a rounded format
   return m;
@@ -216,6 +248,7 @@ std::vector<uint8_t> buildUniforms(const Rig& rig, const EmittedGlsl& glsl, cons
 UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape& shape, const rt::Mesh& mesh,
                             const rt::Pose& pose) {
   UniformValues uniforms = poseUniforms(rig, pose);
+  for (const auto& u : mesh.uniforms) uniforms.insert(u);
   for (const auto& u : rig.uniforms) {
     const SemanticDecl* d = rules.findSemantic(u.semantic);
     if (uniforms.count(u.semantic) || !d || !d->definition) continue;

@@ -117,7 +117,7 @@ sg::ValidateReport validateOnLimb(sg::GenerateOptions gen, const std::string& ri
 sg::ValidateReport validateOctahedral(const std::string& rules, std::map<std::string, double> budgets = {}) {
   sg::GenerateOptions gen;
   gen.rulesPaths = {rules};
-  gen.maxErrorDegrees = std::move(budgets);
+  gen.maxError = std::move(budgets);
   return validateOnLimb(gen, "octahedral.rig.yaml");
 }
 
@@ -161,6 +161,100 @@ TEST(Octahedral, ABudgetTighterThanTheEncodingRemovesIt) {
         << all;
   }
   EXPECT_TRUE(validateOctahedral(sourcePath("rules/standard.yaml"), {{"vertex.normal", 0.01}}).pass);
+}
+
+// Bounds-relative positions, checked from the definition: the bounds hold every point (the
+// smallest coordinate exactly, the extent rounded up by at most one float step), every code
+// lies in [0, 1], and a point read back through each format errs by at most the stated
+// fraction of the box's diagonal, and for 8 bits nearly that much. The box sits far from
+// the origin with very unequal sides, and one axis is flat.
+TEST(Bounds, CodesLieInTheBoxAndDecodeWithinTheStatedError) {
+  const sg::VertexEncoding& position = *sg::encodingOf("vertex.position_in_bounds");
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (const glm::dvec3 size : {glm::dvec3(2, 0.001, 50), glm::dvec3(1, 1, 0)}) {
+    const glm::dvec3 corner(1000, -3, 0.5);
+    std::vector<glm::vec4> points;
+    for (int i = 0; i < 100000; ++i) points.emplace_back(glm::vec3(corner + size * glm::dvec3(u(rng), u(rng), u(rng))), 1);
+    points.emplace_back(NAN, INFINITY, -INFINITY, 1);  // left out of the bounds, encodes as 0
+    const sg::PositionBounds b = sg::positionBounds(points);
+    glm::dvec3 lo(INFINITY), hi(-INFINITY);
+    for (size_t i = 0; i + 1 < points.size(); ++i)
+      lo = glm::min(lo, glm::dvec3(points[i])), hi = glm::max(hi, glm::dvec3(points[i]));
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(double(b.min[k]), lo[k]);
+      EXPECT_GE(double(b.min[k]) + double(b.extent[k]), hi[k]);
+      EXPECT_LE(double(b.extent[k]), (hi[k] - lo[k]) * (1 + std::ldexp(1.0, -22)));
+    }
+    EXPECT_EQ(sg::boundsEncode(b, glm::dvec3(points.back())), glm::dvec3(0));
+    const double diagonal = glm::length(hi - lo);
+    for (sg::VertexFormat f : {sg::VertexFormat::Unorm8x4, sg::VertexFormat::Unorm10_10_10_2, sg::VertexFormat::Unorm16x4,
+                               sg::VertexFormat::Float16x4}) {
+      const double bound = *sg::encodingMaxError(position, f);
+      double worst = 0;
+      for (size_t i = 0; i + 1 < points.size(); ++i) {
+        const glm::vec3 code(sg::boundsEncode(b, glm::dvec3(points[i])));  // stored from float data
+        ASSERT_TRUE(glm::all(glm::greaterThanEqual(code, glm::vec3(0))) && glm::all(glm::lessThanEqual(code, glm::vec3(1))));
+        glm::dvec3 read;
+        for (int k = 0; k < 3; ++k) read[k] = sg::storedValue(f, k, code[k]);
+        worst = std::max(worst, glm::length(sg::boundsDecode(b, read) - glm::dvec3(points[i])) / diagonal);
+      }
+      std::cout << sg::formatName(f) << ": worst " << worst << " of the diagonal, stated " << bound << "\n";
+      EXPECT_LE(worst, bound) << sg::formatName(f);
+      if (f == sg::VertexFormat::Unorm8x4) EXPECT_GE(worst, 0.8 * bound);
+    }
+  }
+  EXPECT_NEAR(*sg::encodingMaxError(position, sg::VertexFormat::Unorm16x4), 7.69e-6, 0.01e-6);  // 0.5/65535 + 2^-24
+  EXPECT_FALSE(sg::encodingMaxError(position, sg::VertexFormat::Snorm16x4));  // codes are in [0, 1]
+}
+
+sg::ValidateReport validateBounds(const std::string& rules, std::map<std::string, double> budgets = {}) {
+  sg::GenerateOptions gen;
+  gen.rulesPaths = {rules};
+  gen.maxError = std::move(budgets);
+  return validateOnLimb(gen, "bounds.rig.yaml");
+}
+
+// A 32-byte vertex in five locations: the position relative to the bounds in unorm16, the
+// frame in octahedral codes. Every decode runs on the device and agrees with the reference.
+TEST(Bounds, PackedVertexValidatesOnTheDevice) {
+  sg::ValidateReport rep = validateBounds(sourcePath("rules/standard.yaml"));
+  EXPECT_TRUE(rep.pass);
+  ASSERT_FALSE(rep.runs.empty());
+  EXPECT_TRUE(sgtest::planHas(rep.runs[0], "vertex_position_from_bounds"));
+  EXPECT_TRUE(sgtest::planHas(rep.runs[0], "vertex_normal_from_octahedral"));
+}
+
+// A decode that forgets the bounds' scale puts every point in a unit box at the corner:
+// validation fails the outputs that depend on the position, and only those.
+TEST(Bounds, PlantedMissingScaleFailsValidation) {
+  sgtest::RulesCopy rules("bounds_missing_scale");
+  ASSERT_TRUE(rules.edit("encodings.yaml", "${vertex.position_in_bounds} * ${mesh.bounds_extent}", "${vertex.position_in_bounds}"));
+  sg::ValidateReport broken = validateBounds(rules.rulesFile("standard.yaml").string());
+  EXPECT_FALSE(broken.pass);
+  const std::set<std::string> failed = sgtest::failingOutputs(broken.runs.at(0));
+  EXPECT_TRUE(failed.count("world_position")) << ::testing::PrintToString(failed);
+  EXPECT_TRUE(failed.count("gl_Position")) << ::testing::PrintToString(failed);
+  EXPECT_FALSE(failed.count("world_normal"));
+  EXPECT_FALSE(failed.count("world_tangent"));
+}
+
+// A position budget below unorm16's 7.6e-6 of the diagonal removes the code (the rig has
+// no other position); 1e-4 (the packed-layout target) keeps it.
+TEST(Bounds, ABudgetTighterThanTheEncodingRemovesIt) {
+  try {
+    validateBounds(sourcePath("rules/standard.yaml"), {{"vertex.position", 1e-6}});
+    FAIL() << "expected the request to fail";
+  } catch (const sg::InputError& e) {
+    std::string all = sg::formatDiagnostic(e.diagnostic());
+    for (const auto& d : e.related) all += "\n" + sg::formatDiagnostic(d);
+    EXPECT_NE(all.find("bounds.rig.yaml:12:3: note: vertex.position_in_bounds (attribute 'position', unorm16x4) is not "
+                       "offered to the search: it errs up to 7.69e-06 of the bounds diagonal, over the budget of 1e-06 of "
+                       "the bounds diagonal"),
+              std::string::npos)
+        << all;
+  }
+  EXPECT_TRUE(validateBounds(sourcePath("rules/standard.yaml"), {{"vertex.position", 1e-4}}).pass);
 }
 
 }  // namespace
@@ -210,9 +304,11 @@ TEST(Octahedral, TheSearchChoosesTheStoredFormPerDevice) {
 namespace {
 
 // The packer on a real model: AnimatedMorphSphere's rig as `rig import` derives it, edited
-// to store the normal as an octahedral snorm16x2 code and the tangent as one beside its
-// handedness. The bytes it writes, read back by the layout alone (offset, stride, format),
-// decode to the model's own float normals and tangents within the stated 0.0037 degrees.
+// to store the normal as an octahedral snorm16x2 code, the tangent as one beside its
+// handedness and the position relative to the bounds in unorm16. The bytes it writes, read
+// back by the layout alone (offset, stride, format, bias and scale), decode to the model's
+// own float normals and tangents within the stated 0.0037 degrees, its positions within
+// the stated 7.7e-6 of the bounds diagonal.
 TEST(Pack, RealModelsFrameReadBackFromTheLayoutWithinTheStatedError) {
   const std::string model = std::string(SG_SHARED_DIR) + "/models/AnimatedMorphSphere/AnimatedMorphSphere.gltf#0/0";
   if (!std::filesystem::exists(std::string(SG_SHARED_DIR) + "/models/AnimatedMorphSphere")) GTEST_SKIP() << "no ../shared";
@@ -224,8 +320,13 @@ TEST(Pack, RealModelsFrameReadBackFromTheLayoutWithinTheStatedError) {
     } else if (a.name == "tangent") {
       a.format = sg::VertexFormat::Snorm16x4;
       a.provides = {{"vertex.tangent_octahedral", "xy"}, {"vertex.handedness", "z"}};
+    } else if (a.name == "position") {
+      a.format = sg::VertexFormat::Unorm16x4;
+      a.provides = {{"vertex.position_in_bounds", "xyz"}};
     }
   }
+  rig.uniforms.push_back({"bounds_min", "mesh.bounds_min", sg::Type::Vec3, "", 0, {}});
+  rig.uniforms.push_back({"bounds_extent", "mesh.bounds_extent", sg::Type::Vec3, "", 0, {}});
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("sg_pack_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const std::string rigPath = (dir / "sphere.rig.yaml").string();
@@ -280,6 +381,30 @@ TEST(Pack, RealModelsFrameReadBackFromTheLayoutWithinTheStatedError) {
   EXPECT_GT(worstNormal, 0.0);  // the data really went through 16 bits (the sphere's tangents are
   // all +x, which the code holds exactly: they check the stream's place and its handedness)
   EXPECT_EQ(handednessWrong, 0u);
+
+  // The position: bias + code * scale from the layout alone, against the model's floats.
+  const nlohmann::json position = streamOf("position");
+  ASSERT_EQ(position["format"], "unorm16x4");
+  const nlohmann::json& part = position["provides"][0];
+  ASSERT_EQ(part["encodes"], "vertex.position");
+  const double positionBound = part["max_error_of_bounds_diagonal"];
+  EXPECT_EQ(layout["uniforms"]["mesh.bounds_min"], part["bias"]);
+  const auto& p = scene.mesh.at("vertex.position");
+  glm::dvec3 lo(INFINITY), hi(-INFINITY);
+  for (const glm::vec4& q : p) lo = glm::min(lo, glm::dvec3(q)), hi = glm::max(hi, glm::dvec3(q));
+  double worstPosition = 0;
+  for (size_t v = 0; v < scene.mesh.vertexCount; ++v) {
+    glm::dvec3 read;
+    for (int c = 0; c < 3; ++c) {
+      uint16_t raw;
+      std::memcpy(&raw, packed.bytes.data() + position["offset"].get<size_t>() + v * position["stride"].get<size_t>() + 2 * c, 2);
+      read[c] = part["bias"][c].get<double>() + raw / 65535.0 * part["scale"][c].get<double>();
+    }
+    worstPosition = std::max(worstPosition, glm::length(read - glm::dvec3(p[v])) / glm::length(hi - lo));
+  }
+  std::cout << "worst position " << worstPosition << " of the bounds diagonal (stated " << positionBound << ")\n";
+  EXPECT_LE(worstPosition, positionBound);
+  EXPECT_GT(worstPosition, 0.0);
 }
 
 }  // namespace
