@@ -287,15 +287,10 @@ LoadedInputs cheapestStoredForms(const Rig& rig, const RuleSet& rules, const Fra
 
 }  // namespace
 
-LoadedInputs loadInputs(const GenerateOptions& opts) {
-  Rig rig = loadRigStage(opts.rigPath);
-  if (!opts.rigParams.empty()) rig = rigWithParameters(rig, opts.rigParams, SourceLoc{});
+LoadedInputs prepareInputs(Rig rig, const RuleSet& rules, const FragmentInterface& fragment, const GenerateOptions& opts,
+                           const std::optional<DeviceProfile>& profile) {
   std::vector<Diagnostic> notes;
   if (!opts.maxError.empty()) rig = withinErrorBudgets(rig, opts.maxError, notes);
-  const RuleSet rules = loadRulesStage(opts.rulesPaths);
-  const FragmentInterface fragment = loadFragmentStage(opts.fragmentPath, opts.targetEnv);
-  std::optional<DeviceProfile> profile;
-  if (!opts.deviceProfilePath.empty()) profile = loadDeviceProfileStage(opts.deviceProfilePath);
   LoadedInputs in;
   try {
     in = cheapestStoredForms(rig, rules, fragment, opts, profile, notes);
@@ -304,6 +299,17 @@ LoadedInputs loadInputs(const GenerateOptions& opts) {
     throw;
   }
   in.notes = std::move(notes);
+  return in;
+}
+
+LoadedInputs loadInputs(const GenerateOptions& opts) {
+  Rig rig = loadRigStage(opts.rigPath);
+  if (!opts.rigParams.empty()) rig = rigWithParameters(rig, opts.rigParams, SourceLoc{});
+  const RuleSet rules = loadRulesStage(opts.rulesPaths);
+  const FragmentInterface fragment = loadFragmentStage(opts.fragmentPath, opts.targetEnv);
+  std::optional<DeviceProfile> profile;
+  if (!opts.deviceProfilePath.empty()) profile = loadDeviceProfileStage(opts.deviceProfilePath);
+  LoadedInputs in = prepareInputs(std::move(rig), rules, fragment, opts, profile);
   for (const auto& b : opts.bannedRules)  // a misspelt --ban would otherwise change nothing silently
     if (std::none_of(in.rules.rules.begin(), in.rules.rules.end(), [&](const Rule& r) { return r.name == b; }))
       throw InputError(SourceLoc{}, fmt::format("--ban {}: no rule of that name in the rules files", b));

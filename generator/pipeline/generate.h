@@ -76,6 +76,13 @@ struct GenerateResult {
 const char* shadergenVersion();
 
 LoadedInputs loadInputs(const GenerateOptions& opts);
+// The stages after loading, for a rig already loaded (loadInputs and `build` share them):
+// the error budgets (opts.maxError) take over-budget encodings out of the rig; a value the
+// rig stores both as itself and encoded is read in the form whose plan is cheapest; then
+// instantiation (opts.overrides, opts.conventions) and, with a profile, pricing. The
+// result's notes say what the budgets removed and which stored form is read.
+LoadedInputs prepareInputs(Rig rig, const RuleSet& rules, const FragmentInterface& fragment, const GenerateOptions& opts,
+                           const std::optional<DeviceProfile>& profile);
 
 // Throws InputError for bad inputs or unsatisfiable requests (naming the missing values).
 GenerateResult generate(const GenerateOptions& opts);

@@ -96,6 +96,10 @@ std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v,
     h.field(ov.name);
     for (const auto& sem : ov.semantics) h.field(sem);
   }
+  if (!m.maxError.empty()) {  // only then: earlier manifests keep their cache keys
+    h.field("max_error");
+    for (const auto& [semantic, budget] : m.maxError) h.field(semantic).field(fmt::format("{:.17g}", budget));
+  }
   if (!v.pass->conventions.empty()) {  // only then: earlier manifests keep their cache keys
     h.field("conventions");
     for (const auto& c : v.pass->conventions) h.field(c);
@@ -177,10 +181,11 @@ void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v,
       break;
     }
   Rig rig = v.params.empty() ? base : rigWithParameters(base, v.params, paramsAt);
-  LoadedInputs in = instantiateStage(std::move(rig), s.rules, s.fragments.at(v.pass->fragment), v.pass->maps,
-                                     v.pass->conventions);
-  if (s.profile) priceStage(in, *s.profile);
   GenerateOptions o;
+  o.overrides = v.pass->maps;
+  o.conventions = v.pass->conventions;
+  o.maxError = m.maxError;
+  LoadedInputs in = prepareInputs(std::move(rig), s.rules, s.fragments.at(v.pass->fragment), o, s.profile);
   o.heuristic = m.heuristic;
   o.targetEnv = m.targetEnv;
   o.optimize = m.optimize;

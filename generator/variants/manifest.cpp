@@ -9,6 +9,7 @@
 
 #include "common/yaml_util.h"
 #include "rig/gltf_import.h"
+#include "rig/vertex_encoding.h"
 
 namespace sg {
 namespace {
@@ -54,7 +55,8 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
   YAML::Node root = parseYaml(text, file);
   y.expectMap(root, "a manifest");
   y.checkKeys(root, {"output", "rules", "templates", "target_env", "optimize", "heuristic", "emit", "rigs", "passes",
-                     "axes", "exclude", "name", "device_profile", "hlsl_shader_model", "msl_version", "msl_platform"});
+                     "axes", "exclude", "name", "device_profile", "max_error", "hlsl_shader_model", "msl_version",
+                     "msl_platform"});
   m.outputDir = resolvePath(file, root["output"] ? y.scalar(root["output"], "'output'") : "shaders");
   if (!root["rules"]) y.fail(root, "the manifest needs 'rules' (a rules file or a list of them)");
   for (const auto& r : scalarOrList(y, root["rules"], "'rules'")) m.rules.push_back(resolvePath(file, r));
@@ -65,6 +67,16 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
       y.fail(root["target_env"], fmt::format("unknown target_env '{}' (vulkan1.0, vulkan1.1, vulkan1.2, vulkan1.3)", env));
   }
   if (root["device_profile"]) m.deviceProfile = resolvePath(file, y.scalar(root["device_profile"], "'device_profile'"));
+  if (root["max_error"]) {  // { vertex.normal: 0.1deg, vertex.position: 1e-4 }, as --max-error
+    y.expectMap(root["max_error"], "'max_error'");
+    for (const auto& kv : root["max_error"]) {
+      const std::string semantic = y.scalar(kv.first, "a semantic");
+      std::string why;
+      const std::optional<double> budget = parseErrorBudget(semantic, y.scalar(kv.second, "an error budget"), why);
+      if (!budget) y.fail(encodingsOf(semantic).empty() ? kv.first : kv.second, why);
+      m.maxError[semantic] = *budget;
+    }
+  }
   if (root["optimize"]) m.optimize = y.boolean(root["optimize"], "'optimize'");
   if (root["heuristic"]) {
     m.heuristic = y.scalar(root["heuristic"], "'heuristic'");

@@ -58,6 +58,8 @@ struct Manifest {
   TargetEnv targetEnv = TargetEnv::Vulkan1_0;
   bool optimize = false;
   std::string heuristic = "lmcut";
+  // `max_error:` error budgets per encoded semantic, in its encodings' unit (GenerateOptions::maxError).
+  std::map<std::string, double> maxError;
   std::string deviceProfile;  // `device_profile:` (docs/device-profiles.md); "" = instruction slots
   HlslOptions hlsl;           // `hlsl_shader_model:`, when emit has hlsl (docs/hlsl-msl.md)
   MslOptions msl;             // `msl_version:`, `msl_platform:`, when emit has msl

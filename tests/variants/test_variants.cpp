@@ -304,3 +304,54 @@ TEST(Build, MissingSharedInputIsALocatedError) {
   auto d = errorOf([&] { buildVariants(m, expandVariants(m), {}); });
   EXPECT_NE(d.loc.file.find("body.rig.yaml"), std::string::npos) << d.loc.file << ": " << d.message;
 }
+
+// A rig storing its frame both as floats and as octahedral codes: a build chooses the form
+// as generate does (under the H200 profile, the codes), and `max_error` takes the codes out
+// as --max-error does (then the floats) — byte for byte what generate() writes each time.
+TEST(Build, StoredFormsAndErrorBudgetsAreGeneratesChoices) {
+  const std::string data = std::string(SG_SOURCE_DIR) + "/tests/validate/data/";
+  for (const std::string budget : {"", "max_error: { vertex.normal: 0.001deg }\n"}) {
+    SCOPED_TRACE(budget);
+    auto dir = freshDir(budget.empty() ? "forms" : "budget");
+    writeText(dir / "m.yaml", "output: out\nrules: " + std::string(SG_SOURCE_DIR) + "/rules/standard.yaml\n" +
+                                  "device_profile: " + SG_SOURCE_DIR + "/devices/nvidia-h200.yaml\n" + budget +
+                                  "rigs:\n  limb: " + data + "octahedral_or_float.rig.yaml\n"
+                                  "passes:\n  world: " + data + "world.frag\n");
+    Manifest m = loadManifest((dir / "m.yaml").string());
+    std::vector<Variant> variants = expandVariants(m);
+    BuildReport r = buildVariants(m, variants, BuildOptions{});
+    ASSERT_EQ(r.failed, 0u);
+    ASSERT_EQ(r.variants.size(), 1u);
+    GenerateOptions o;
+    o.rigPath = data + "octahedral_or_float.rig.yaml";
+    o.fragmentPath = data + "world.frag";
+    o.rulesPaths = m.rules;
+    o.deviceProfilePath = m.deviceProfile;
+    o.maxError = m.maxError;
+    o.outputName = r.variants[0].outputs.at("glsl");
+    GenerateResult g = generate(o);
+    const std::string glsl = filesOf(r).at(r.variants[0].outputs.at("glsl"));
+    EXPECT_EQ(glsl, g.glsl.text);
+    EXPECT_EQ(glsl.find("vertex_normal_from_octahedral") != std::string::npos, budget.empty());
+  }
+}
+
+TEST(Manifest, ErrorBudgetsAreChecked) {
+  auto dir = freshDir("mb");
+  const std::string head = "rules: r.yaml\nrigs:\n  face: f.rig.yaml\npasses:\n  color: c.frag\n";
+  auto fail = [&](const std::string& text) {
+    writeText(dir / "bad.yaml", head + text);
+    return errorOf([&] { loadManifest((dir / "bad.yaml").string()); });
+  };
+  auto d = fail("max_error: { vertex.normal: 0.1 }\n");
+  EXPECT_NE(d.message.find("expected a positive angle in deg or rad"), std::string::npos) << d.message;
+  EXPECT_EQ(d.loc.line, 6);
+  EXPECT_EQ(d.loc.col, 29);
+  d = fail("max_error: { world.normal: 1deg }\n");
+  EXPECT_NE(d.message.find("no encoding stores 'world.normal'"), std::string::npos) << d.message;
+  EXPECT_EQ(d.loc.col, 14);
+  d = fail("max_error: { vertex.position: 1deg }\n");
+  EXPECT_NE(d.message.find("a positive fraction of the bounds diagonal"), std::string::npos) << d.message;
+  EXPECT_EQ(loadManifestText(head + "max_error: { vertex.position: 1e-4, vertex.normal: 0.1rad }\n", "m.yaml").maxError,
+            (std::map<std::string, double>{{"vertex.normal", glm::degrees(0.1)}, {"vertex.position", 1e-4}}));
+}
