@@ -2,7 +2,8 @@
 # Packs `shadergen bench` for a machine without a package registry (docs/performance.md):
 # the stripped shadergen, the shared libraries it needs beyond glibc/libstdc++ and the
 # Vulkan loader (the target brings those; its GPU driver brings the ICD), the rules,
-# templates and the Dawn example, bench/gpu_run.sh and bench/gpu_calibrate.sh (and gpu_env.sh, which both source).
+# templates, device profiles and the Dawn example, bench/gpu_run.sh, gpu_calibrate.sh and
+# gpu_layouts.sh (and gpu_env.sh, which they source).
 # Usage: bash bench/gpu_bundle.sh [BUILD_DIR=build] [OUT=build/shadergen-gpu.tar.gz]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -19,8 +20,8 @@ ldd "$build/generator/cli/shadergen" | awk '$3 ~ /^\// {print $3}' | while read 
     *) cp -L "$lib" "$stage/sg/lib/" ;;
   esac
 done
-cp -r "$root/rules" "$root/templates" "$stage/sg/"
+cp -r "$root/rules" "$root/templates" "$root/devices" "$stage/sg/"
 cp -r "$root/examples/dawn" "$stage/sg/examples/"
-cp "$root/bench/gpu_env.sh" "$root/bench/gpu_run.sh" "$root/bench/gpu_calibrate.sh" "$stage/sg/"
+cp "$root/bench/gpu_env.sh" "$root/bench/gpu_run.sh" "$root/bench/gpu_calibrate.sh" "$root/bench/gpu_layouts.sh" "$stage/sg/"
 tar -C "$stage" -czf "$out" sg
 echo "$out: $(du -h "$out" | cut -f1)"

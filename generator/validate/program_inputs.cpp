@@ -66,6 +66,43 @@ void quantizeStreams(const Rig& rig, rt::Mesh& m) {
   }
 }
 
+// Skin weights stored unorm8/16: rounding each weight alone lets a vertex's sum drift from
+// 1 by up to half a step per weight, which shrinks or swells the skin. As gltfpack does,
+// the codes of a vertex whose weights sum to 1 are rounded to sum to exactly 2^bits - 1
+// (largest remainders first), across every weight set of the rig (8 influences: 2 sets).
+void renormaliseWeights(const Rig& rig, rt::Mesh& m) {
+  std::vector<std::string> sets;
+  int bits = 0;
+  for (const auto& a : rig.attributes)
+    for (const auto& p : a.provides) {
+      if (p.semantic.rfind("skin.weights[", 0) != 0) continue;
+      const int b = a.format == VertexFormat::Unorm8x4 ? 8 : a.format == VertexFormat::Unorm16x4 ? 16 : 0;
+      if (b == 0 || (bits != 0 && b != bits) || (!p.swizzle.empty() && p.swizzle != "xyzw")) return;  // floats, or mixed
+      bits = b;
+      if (!m.has(p.semantic)) return;
+      sets.push_back(p.semantic);
+    }
+  if (sets.empty()) return;
+  const double steps = std::ldexp(1.0, bits) - 1;
+  std::vector<double> w(sets.size() * 4), q(w.size());
+  std::vector<size_t> order(w.size());
+  for (size_t v = 0; v < m.vertexCount; ++v) {
+    double sum = 0;
+    for (size_t s = 0; s < sets.size(); ++s)
+      for (int c = 0; c < 4; ++c) sum += w[s * 4 + static_cast<size_t>(c)] = std::max(0.0, double(m.streams[sets[s]][v][c]));
+    if (!(std::abs(sum - 1) <= 1e-3)) continue;  // not a partition of one: rounded as it is
+    double total = 0;
+    for (size_t k = 0; k < w.size(); ++k) total += q[k] = std::floor(w[k] / sum * steps);
+    for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+      return w[a] / sum * steps - q[a] > w[b] / sum * steps - q[b];
+    });
+    for (size_t k = 0; total < steps; ++k, ++total) q[order[k]] += 1;
+    for (size_t s = 0; s < sets.size(); ++s)
+      for (int c = 0; c < 4; ++c) m.streams[sets[s]][v][c] = static_cast<float>(q[s * 4 + static_cast<size_t>(c)] / steps);
+  }
+}
+
 // The encoded semantics the rig stores (rig/vertex_encoding.h).
 std::vector<const VertexEncoding*> storedEncodings(const Rig& rig) {
   std::vector<const VertexEncoding*> out;
@@ -124,6 +161,7 @@ rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
     for (size_t v = 0; v < m.vertexCount && v < src->second.size(); ++v) code[v] = encodeValue(*e, m, src->second[v]);
     m.streams[e->encoded] = std::move(code);
   }
+  renormaliseWeights(rig, m);
   quantizeStreams(rig, m);
   if (encodings.empty()) return m;
   for (const VertexEncoding* e : encodings) {

@@ -31,7 +31,9 @@ UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape
 std::vector<rt::DescriptorBinding> declaredDescriptors(const std::vector<ShaderDescriptor>& reflected);
 
 // The mesh with every integer/normalized stream rounded as its attribute format stores it
-// (what the GPU reads back), so the reference sees exactly the GPU's values.
+// (what the GPU reads back), so the reference sees exactly the GPU's values: encoded
+// streams derived from their sources (and the sources replaced by their decodes), the
+// mesh's bounds as uniforms, unorm skin weights rounded to sum to exactly one.
 rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh);
 // The stream of one program input over `mesh` (quantizeForRig'd): the attribute's elements
 // encoded in its format, tightly packed (the stride is the format's size).
