@@ -197,7 +197,8 @@ struct GenerateCommand {
       for (auto& c : sym)
         if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
       if (sym.empty() || std::isdigit(static_cast<unsigned char>(sym[0]))) sym = "sg_" + sym;
-      files.push_back({pathFor("header"), spirvHeader(r.spirv.words, sym + "_spv") + buffersHeader(r.glsl, sym)});
+      files.push_back({pathFor("header"), spirvHeader(r.spirv.words, sym + "_spv") + vertexInputsHeader(r.in.rig, r.glsl, sym) +
+                                                 buffersHeader(r.glsl, sym)});
     }
     if (kinds.count("hlsl")) files.push_back({pathFor("hlsl"), r.hlsl->text});
     if (kinds.count("msl")) files.push_back({pathFor("msl"), r.msl->text});

@@ -77,6 +77,22 @@ std::string crossJson(const CrossShader& c) {
 
 }  // namespace
 
+std::string vertexInputsHeader(const Rig& rig, const EmittedGlsl& glsl, const std::string& symbol) {
+  std::string prefix;
+  for (char c : symbol) prefix += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  std::string h = "\n// Vertex inputs (docs/rig-format.md): per input, its location, the VkFormat of the attribute\n"
+                  "// that feeds it (the enum's value) and the stride in bytes of a tightly packed stream of it.\n";
+  h += fmt::format("#define {}_INPUT_COUNT {}u\n", prefix, glsl.inputs.size());
+  for (const auto& in : glsl.inputs) {
+    const VertexFormat f = rig.attributes[in.attribute].format;
+    std::string name = prefix + "_";
+    for (char c : in.name) name += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    h += fmt::format("#define {}_LOCATION {}u\n#define {}_FORMAT {}u /* {} */\n#define {}_STRIDE {}u\n", name, in.location,
+                     name, vulkanFormat(f).value, vulkanFormat(f).name, name, formatBytes(f));
+  }
+  return h;
+}
+
 std::string buffersHeader(const EmittedGlsl& glsl, const std::string& symbol) {
   std::string h;
   if (glsl.buffers.empty()) return h;
@@ -108,9 +124,10 @@ std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvM
                           jsonQuote(p.swizzle.empty() ? std::string("xyzw").substr(0, formatComponents(a.format)) : p.swizzle));
     }
     j += fmt::format("{}\n    {{\"name\": {}, \"location\": {}, \"attribute\": {}, \"target\": {}, \"format\": {}, "
-                     "\"type\": {}, \"provides\": [{}]}}",
+                     "\"vk_format\": {}, \"stride\": {}, \"type\": {}, \"provides\": [{}]}}",
                      i ? "," : "", jsonQuote(in.name), in.location, jsonQuote(a.name), in.target, jsonQuote(formatName(a.format)),
-                     jsonQuote(std::string(glslName(in.type))), sems);
+                     jsonQuote(vulkanFormat(a.format).name), formatBytes(a.format), jsonQuote(std::string(glslName(in.type))),
+                     sems);
   }
   j += "\n  ],\n";
   j += fmt::format("  \"uniform_block\": {{\"name\": \"ShadergenUniforms\", \"set\": 0, \"binding\": 0, \"size\": {}, "

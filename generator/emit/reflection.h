@@ -22,5 +22,8 @@ std::string spirvHeader(const std::vector<uint32_t>& words, const std::string& s
 // #defines of every storage buffer's binding, stride and count ("" when there are none),
 // appended to the SPIR-V header.
 std::string buffersHeader(const EmittedGlsl& glsl, const std::string& symbol);
+// The vertex inputs' part of the same header: `<SYMBOL>_INPUT_COUNT`, and per input
+// `<SYMBOL>_<INPUT>_LOCATION`, `_FORMAT` (the VkFormat's value) and `_STRIDE` (bytes).
+std::string vertexInputsHeader(const Rig& rig, const EmittedGlsl& glsl, const std::string& symbol);
 
 }  // namespace sg

@@ -19,31 +19,37 @@ struct FormatInfo {
   int bytes;
   Kind kind;
   std::array<int, 4> bits;  // per component
+  VulkanFormat vulkan;
 };
 constexpr std::array<FormatInfo, kVertexFormatCount> kFormats{{
-    {VertexFormat::Float32x1, "float32", 1, 4, Kind::Float32, {32, 0, 0, 0}},
-    {VertexFormat::Float32x2, "float32x2", 2, 8, Kind::Float32, {32, 32, 0, 0}},
-    {VertexFormat::Float32x3, "float32x3", 3, 12, Kind::Float32, {32, 32, 32, 0}},
-    {VertexFormat::Float32x4, "float32x4", 4, 16, Kind::Float32, {32, 32, 32, 32}},
-    {VertexFormat::Unorm8x4, "unorm8x4", 4, 4, Kind::Unorm, {8, 8, 8, 8}},
-    {VertexFormat::Uint8x4, "uint8x4", 4, 4, Kind::Uint, {8, 8, 8, 8}},
-    {VertexFormat::Unorm16x4, "unorm16x4", 4, 8, Kind::Unorm, {16, 16, 16, 16}},
-    {VertexFormat::Uint16x4, "uint16x4", 4, 8, Kind::Uint, {16, 16, 16, 16}},
-    {VertexFormat::Uint32x4, "uint32x4", 4, 16, Kind::Uint, {32, 32, 32, 32}},
-    {VertexFormat::Float16x2, "float16x2", 2, 4, Kind::Float16, {16, 16, 0, 0}},
-    {VertexFormat::Float16x4, "float16x4", 4, 8, Kind::Float16, {16, 16, 16, 16}},
-    {VertexFormat::Snorm8x2, "snorm8x2", 2, 2, Kind::Snorm, {8, 8, 0, 0}},
-    {VertexFormat::Snorm8x4, "snorm8x4", 4, 4, Kind::Snorm, {8, 8, 8, 8}},
-    {VertexFormat::Snorm16x2, "snorm16x2", 2, 4, Kind::Snorm, {16, 16, 0, 0}},
-    {VertexFormat::Snorm16x4, "snorm16x4", 4, 8, Kind::Snorm, {16, 16, 16, 16}},
-    {VertexFormat::Unorm8x2, "unorm8x2", 2, 2, Kind::Unorm, {8, 8, 0, 0}},
-    {VertexFormat::Unorm16x2, "unorm16x2", 2, 4, Kind::Unorm, {16, 16, 0, 0}},
-    {VertexFormat::Unorm10_10_10_2, "unorm10-10-10-2", 4, 4, Kind::Unorm, {10, 10, 10, 2}},
-    {VertexFormat::Snorm10_10_10_2, "snorm10-10-10-2", 4, 4, Kind::Snorm, {10, 10, 10, 2}},
-    {VertexFormat::Uint8x2, "uint8x2", 2, 2, Kind::Uint, {8, 8, 0, 0}},
-    {VertexFormat::Uint16x2, "uint16x2", 2, 4, Kind::Uint, {16, 16, 0, 0}},
+    {VertexFormat::Float32x1, "float32", 1, 4, Kind::Float32, {32, 0, 0, 0}, {"VK_FORMAT_R32_SFLOAT", 100}},
+    {VertexFormat::Float32x2, "float32x2", 2, 8, Kind::Float32, {32, 32, 0, 0}, {"VK_FORMAT_R32G32_SFLOAT", 103}},
+    {VertexFormat::Float32x3, "float32x3", 3, 12, Kind::Float32, {32, 32, 32, 0}, {"VK_FORMAT_R32G32B32_SFLOAT", 106}},
+    {VertexFormat::Float32x4, "float32x4", 4, 16, Kind::Float32, {32, 32, 32, 32}, {"VK_FORMAT_R32G32B32A32_SFLOAT", 109}},
+    {VertexFormat::Unorm8x4, "unorm8x4", 4, 4, Kind::Unorm, {8, 8, 8, 8}, {"VK_FORMAT_R8G8B8A8_UNORM", 37}},
+    {VertexFormat::Uint8x4, "uint8x4", 4, 4, Kind::Uint, {8, 8, 8, 8}, {"VK_FORMAT_R8G8B8A8_UINT", 41}},
+    {VertexFormat::Unorm16x4, "unorm16x4", 4, 8, Kind::Unorm, {16, 16, 16, 16}, {"VK_FORMAT_R16G16B16A16_UNORM", 91}},
+    {VertexFormat::Uint16x4, "uint16x4", 4, 8, Kind::Uint, {16, 16, 16, 16}, {"VK_FORMAT_R16G16B16A16_UINT", 95}},
+    {VertexFormat::Uint32x4, "uint32x4", 4, 16, Kind::Uint, {32, 32, 32, 32}, {"VK_FORMAT_R32G32B32A32_UINT", 107}},
+    {VertexFormat::Float16x2, "float16x2", 2, 4, Kind::Float16, {16, 16, 0, 0}, {"VK_FORMAT_R16G16_SFLOAT", 83}},
+    {VertexFormat::Float16x4, "float16x4", 4, 8, Kind::Float16, {16, 16, 16, 16}, {"VK_FORMAT_R16G16B16A16_SFLOAT", 97}},
+    {VertexFormat::Snorm8x2, "snorm8x2", 2, 2, Kind::Snorm, {8, 8, 0, 0}, {"VK_FORMAT_R8G8_SNORM", 17}},
+    {VertexFormat::Snorm8x4, "snorm8x4", 4, 4, Kind::Snorm, {8, 8, 8, 8}, {"VK_FORMAT_R8G8B8A8_SNORM", 38}},
+    {VertexFormat::Snorm16x2, "snorm16x2", 2, 4, Kind::Snorm, {16, 16, 0, 0}, {"VK_FORMAT_R16G16_SNORM", 78}},
+    {VertexFormat::Snorm16x4, "snorm16x4", 4, 8, Kind::Snorm, {16, 16, 16, 16}, {"VK_FORMAT_R16G16B16A16_SNORM", 92}},
+    {VertexFormat::Unorm8x2, "unorm8x2", 2, 2, Kind::Unorm, {8, 8, 0, 0}, {"VK_FORMAT_R8G8_UNORM", 16}},
+    {VertexFormat::Unorm16x2, "unorm16x2", 2, 4, Kind::Unorm, {16, 16, 0, 0}, {"VK_FORMAT_R16G16_UNORM", 77}},
+    {VertexFormat::Unorm10_10_10_2, "unorm10-10-10-2", 4, 4, Kind::Unorm, {10, 10, 10, 2}, {"VK_FORMAT_A2B10G10R10_UNORM_PACK32", 64}},
+    {VertexFormat::Snorm10_10_10_2, "snorm10-10-10-2", 4, 4, Kind::Snorm, {10, 10, 10, 2}, {"VK_FORMAT_A2B10G10R10_SNORM_PACK32", 65}},
+    {VertexFormat::Uint8x2, "uint8x2", 2, 2, Kind::Uint, {8, 8, 0, 0}, {"VK_FORMAT_R8G8_UINT", 20}},
+    {VertexFormat::Uint16x2, "uint16x2", 2, 4, Kind::Uint, {16, 16, 0, 0}, {"VK_FORMAT_R16G16_UINT", 81}},
 }};
 const FormatInfo& info(VertexFormat f) { return kFormats[static_cast<size_t>(f)]; }
+static_assert([] {
+  for (size_t i = 0; i < kFormats.size(); ++i)
+    if (static_cast<size_t>(kFormats[i].format) != i) return false;
+  return true;
+}(), "kFormats is in enum order");
 
 // The stored integer of a fixed-point or integer component (two's complement for snorm).
 int64_t storedInteger(Kind kind, int bits, float v) {
@@ -70,6 +76,7 @@ int formatComponents(VertexFormat f) { return info(f).components; }
 int formatBytes(VertexFormat f) { return info(f).bytes; }
 bool formatIsInteger(VertexFormat f) { return info(f).kind == Kind::Uint; }
 bool formatIsFloat32(VertexFormat f) { return info(f).kind == Kind::Float32; }
+VulkanFormat vulkanFormat(VertexFormat f) { return info(f).vulkan; }
 bool parseFormat(const std::string& name, VertexFormat& out) {
   for (const auto& i : kFormats)
     if (name == i.name) {

@@ -28,6 +28,13 @@ int formatComponents(VertexFormat f);
 int formatBytes(VertexFormat f);       // bytes per vertex (the stride of a stream of it)
 bool formatIsInteger(VertexFormat f);  // read as uint in the shader (uint8/16/32)
 bool formatIsFloat32(VertexFormat f);  // stored exactly: nothing to quantize
+// The VkFormat a format is read as: its name and enum value (so that the reflection and
+// the C header can name it without a Vulkan header; the runtime casts the value).
+struct VulkanFormat {
+  const char* name;  // "VK_FORMAT_R16G16B16A16_UNORM"
+  uint32_t value;    // 91
+};
+VulkanFormat vulkanFormat(VertexFormat f);
 
 // The value the device reads for component `c` of an element whose value is v.
 // Error bounds, for v inside the format's range: unorm b bits |e| <= 0.5 / (2^b - 1) on

@@ -12,32 +12,7 @@
 namespace sg {
 namespace {
 
-VkFormat vkFormat(VertexFormat f) {
-  switch (f) {
-    case VertexFormat::Float32x1: return VK_FORMAT_R32_SFLOAT;
-    case VertexFormat::Float32x2: return VK_FORMAT_R32G32_SFLOAT;
-    case VertexFormat::Float32x3: return VK_FORMAT_R32G32B32_SFLOAT;
-    case VertexFormat::Float32x4: return VK_FORMAT_R32G32B32A32_SFLOAT;
-    case VertexFormat::Unorm8x4: return VK_FORMAT_R8G8B8A8_UNORM;
-    case VertexFormat::Uint8x4: return VK_FORMAT_R8G8B8A8_UINT;
-    case VertexFormat::Unorm16x4: return VK_FORMAT_R16G16B16A16_UNORM;
-    case VertexFormat::Uint16x4: return VK_FORMAT_R16G16B16A16_UINT;
-    case VertexFormat::Uint32x4: return VK_FORMAT_R32G32B32A32_UINT;
-    case VertexFormat::Float16x2: return VK_FORMAT_R16G16_SFLOAT;
-    case VertexFormat::Float16x4: return VK_FORMAT_R16G16B16A16_SFLOAT;
-    case VertexFormat::Snorm8x2: return VK_FORMAT_R8G8_SNORM;
-    case VertexFormat::Snorm8x4: return VK_FORMAT_R8G8B8A8_SNORM;
-    case VertexFormat::Snorm16x2: return VK_FORMAT_R16G16_SNORM;
-    case VertexFormat::Snorm16x4: return VK_FORMAT_R16G16B16A16_SNORM;
-    case VertexFormat::Unorm8x2: return VK_FORMAT_R8G8_UNORM;
-    case VertexFormat::Unorm16x2: return VK_FORMAT_R16G16_UNORM;
-    case VertexFormat::Unorm10_10_10_2: return VK_FORMAT_A2B10G10R10_UNORM_PACK32;
-    case VertexFormat::Snorm10_10_10_2: return VK_FORMAT_A2B10G10R10_SNORM_PACK32;
-    case VertexFormat::Uint8x2: return VK_FORMAT_R8G8_UINT;
-    case VertexFormat::Uint16x2: return VK_FORMAT_R16G16_UINT;
-  }
-  return VK_FORMAT_UNDEFINED;
-}
+VkFormat vkFormat(VertexFormat f) { return static_cast<VkFormat>(vulkanFormat(f).value); }
 
 std::string partSemantic(const RigAttribute& a, const ProvidedPart& p, int target) {
   return target >= 0 ? fmt::format("{}[{}]", p.semantic, target) : p.semantic;

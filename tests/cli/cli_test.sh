@@ -271,6 +271,20 @@ int main() {
 }
 EOF
   printf '#include "face.spv.h"\nsize_t other_tu_size() { return face_spv_size; }\n' >other.cpp
+  # The packed face's inputs as the header states them, against the Vulkan header's enum.
+  "$SG" generate --rig "$SRC/examples/dawn/face-packed.rig.yaml" -f "$SRC/examples/dawn/face.frag" \
+    -r "$SRC/examples/dawn/rules.yaml" --emit header -o gen/packed.spv.h -q || fail "generate packed"
+  cat >>other.cpp <<'EOF'
+#include "packed.spv.h"
+#include <vulkan/vulkan_core.h>
+static_assert(PACKED_INPUT_COUNT == 16u, "16 inputs");
+static_assert(PACKED_A_COORD_LOCATION == 0u && PACKED_A_COORD_FORMAT == VK_FORMAT_R16G16B16A16_UNORM, "coord");
+static_assert(PACKED_A_COORD_STRIDE == 8u, "coord stride");
+static_assert(PACKED_A_FRAME_FORMAT == VK_FORMAT_R16G16B16A16_SNORM && PACKED_A_FRAME_STRIDE == 8u, "frame");
+static_assert(PACKED_A_HANDEDNESS_FORMAT == VK_FORMAT_R8G8B8A8_SNORM && PACKED_A_HANDEDNESS_STRIDE == 4u, "handedness");
+static_assert(PACKED_A_BONE_WEIGHT_FORMAT == VK_FORMAT_R8G8B8A8_UNORM, "weights");
+static_assert(PACKED_A_SKIN_UVST_FORMAT == VK_FORMAT_R16G16B16A16_SFLOAT, "uvst");
+EOF
   if "$CXX" -std=c++17 -Wall -Wextra -Werror -pedantic -Igen use.cpp other.cpp -o use 2>cxx.log; then
     ok "header compiles in two C++ TUs (-Wall -Wextra -Werror -pedantic)"
     out=$(./use) && [ "$out" = "$bytes" ] && ok "face_spv_size == size of face.spv ($bytes bytes)" || fail "run: exit $? output '$out' (want $bytes)"

@@ -10,6 +10,7 @@
 #include <random>
 
 #include <nlohmann/json.hpp>
+#include <vulkan/vulkan_core.h>
 
 #include "rig/vertex_encoding.h"
 #include "test_util.h"
@@ -442,6 +443,43 @@ TEST(SkinWeights, Unorm8WeightsAreRenormalisedToSumToOne) {
   }
   std::cout << driftedAlone << " of " << q.vertexCount << " vertices would not sum to 255 rounded weight by weight\n";
   EXPECT_GT(driftedAlone, 0u);  // the case is real on this model
+}
+
+}  // namespace
+
+namespace {
+
+// Every vertex format's VkFormat against the Vulkan header: the value the runtime binds and
+// the name the reflection JSON and the C header print (rig/vertex_format.h).
+TEST(VertexFormats, VulkanFormatsAreTheHeadersOwn) {
+  int checked = 0;
+#define SG_EXPECT_VK(F, VK)                                                          \
+  EXPECT_EQ(sg::vulkanFormat(sg::VertexFormat::F).value, static_cast<uint32_t>(VK)); \
+  EXPECT_STREQ(sg::vulkanFormat(sg::VertexFormat::F).name, #VK);                     \
+  ++checked
+  SG_EXPECT_VK(Float32x1, VK_FORMAT_R32_SFLOAT);
+  SG_EXPECT_VK(Float32x2, VK_FORMAT_R32G32_SFLOAT);
+  SG_EXPECT_VK(Float32x3, VK_FORMAT_R32G32B32_SFLOAT);
+  SG_EXPECT_VK(Float32x4, VK_FORMAT_R32G32B32A32_SFLOAT);
+  SG_EXPECT_VK(Unorm8x4, VK_FORMAT_R8G8B8A8_UNORM);
+  SG_EXPECT_VK(Uint8x4, VK_FORMAT_R8G8B8A8_UINT);
+  SG_EXPECT_VK(Unorm16x4, VK_FORMAT_R16G16B16A16_UNORM);
+  SG_EXPECT_VK(Uint16x4, VK_FORMAT_R16G16B16A16_UINT);
+  SG_EXPECT_VK(Uint32x4, VK_FORMAT_R32G32B32A32_UINT);
+  SG_EXPECT_VK(Float16x2, VK_FORMAT_R16G16_SFLOAT);
+  SG_EXPECT_VK(Float16x4, VK_FORMAT_R16G16B16A16_SFLOAT);
+  SG_EXPECT_VK(Snorm8x2, VK_FORMAT_R8G8_SNORM);
+  SG_EXPECT_VK(Snorm8x4, VK_FORMAT_R8G8B8A8_SNORM);
+  SG_EXPECT_VK(Snorm16x2, VK_FORMAT_R16G16_SNORM);
+  SG_EXPECT_VK(Snorm16x4, VK_FORMAT_R16G16B16A16_SNORM);
+  SG_EXPECT_VK(Unorm8x2, VK_FORMAT_R8G8_UNORM);
+  SG_EXPECT_VK(Unorm16x2, VK_FORMAT_R16G16_UNORM);
+  SG_EXPECT_VK(Unorm10_10_10_2, VK_FORMAT_A2B10G10R10_UNORM_PACK32);
+  SG_EXPECT_VK(Snorm10_10_10_2, VK_FORMAT_A2B10G10R10_SNORM_PACK32);
+  SG_EXPECT_VK(Uint8x2, VK_FORMAT_R8G8_UINT);
+  SG_EXPECT_VK(Uint16x2, VK_FORMAT_R16G16_UINT);
+#undef SG_EXPECT_VK
+  EXPECT_EQ(checked, sg::kVertexFormatCount);
 }
 
 }  // namespace
