@@ -57,7 +57,9 @@ struct RenderCommand {
       for (const auto& n : p.notes) std::cerr << fmt::format("{}: warning: {}: {}\n", ro.gen.rigPath, p.name, n);
     frameModel(programs, ro.camera, float(ro.width) / float(ro.height));
     FragmentProgram frag = compileFragmentFile(ro.gen.fragmentPath, ro.gen.targetEnv);
-    return session.renderModel(programs, frag, texturesFor(frag, ro.lighting), ro);
+    RenderResult r = session.renderModel(programs, frag, texturesFor(frag, ro.lighting), ro);
+    for (const auto& p : programs) r.notes.insert(r.notes.end(), p.gen.in.notes.begin(), p.gen.in.notes.end());
+    return r;
   }
 
   int run() {
@@ -87,6 +89,7 @@ struct RenderCommand {
 
     RenderSession session(ro.device, ro.validationLayers);
     RenderResult r = parts ? renderModel(session, *parts) : session.render(ro);
+    for (const auto& n : r.notes) std::cerr << formatDiagnostic(n) << "\n";
     std::string png = encodePng(r.image);
     writeFilesAtomically({{output, png}});
     size_t covered = 0;
@@ -122,6 +125,7 @@ struct BenchCommand {
     bo.alternatives = !noAlternatives;
     bo.floor = !noFloor;
     GpuBenchReport rep = runGpuBench(bo);
+    for (const auto& n : rep.notes) std::cerr << formatDiagnostic(n) << "\n";
     std::cout << formatGpuBench(rep);
     int failed = 0;
     for (const auto& row : rep.rows)

@@ -292,6 +292,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
 
   rt::Renderer renderer(validator.harness());
   GpuBenchReport rep;
+  rep.notes = in.notes;
   rep.device = validator.harness().deviceName();
   rep.limits = limits;
   rep.driver = renderer.driver();

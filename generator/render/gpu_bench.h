@@ -62,6 +62,7 @@ struct GpuBenchReport {
   // timestamps), and the generated program's time over the fastest generated one's.
   double spearmanPredictedOn = NAN;
   double generatedOverFastestOn = NAN;
+  std::vector<Diagnostic> notes;  // loading's (which stored form is read, what budgets removed)
 };
 
 GpuBenchReport runGpuBench(const GpuBenchOptions& opts);

@@ -303,6 +303,7 @@ RenderResult RenderSession::render(const RenderOptions& opts) {
   RenderScene scene = renderScene(gen.in.rig, opts);
   RenderResult r = render(gen, frag, textures, scene, opts);
   r.limits = limits;
+  r.notes = gen.in.notes;
   return r;
 }
 

@@ -101,6 +101,8 @@ struct RenderResult {
   int64_t planCost = 0;
   std::string limits;  // the device limits searched under (applyDeviceLimits; "" = the flags)
   std::vector<std::string> validationMessages;
+  // Loading's notes (which stored form each plan reads, what error budgets removed).
+  std::vector<Diagnostic> notes;
 };
 
 // Owns the device; renders any number of images.

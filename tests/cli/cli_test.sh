@@ -441,6 +441,16 @@ device_profile)
   expect 0 "explain --device-profile" -- "$SG" explain "${DAWN[@]}" --device-profile "$P" --no-alternatives
   grep -q "predicted per vertex on 'example" last.out && ok "explain shows the terms" || fail "$(cat last.out)"
   grep -qE "^    buffer_loads +[1-9]" last.out && ok "explain: buffer loads counted" || fail "$(cat last.out)"
+  # A rig storing its frame both ways: every command that generates says which form it reads.
+  V=$SRC/tests/validate/data
+  FORMS=(--rig "$V/octahedral_or_float.rig.yaml" -f "$V/world.frag" -r "$SRC/rules/standard.yaml" --mesh limb
+         --device-profile "$SRC/devices/nvidia-h200.yaml" --no-validation-layers)
+  expect 0 "render, both forms stored" -- "$SG" render "${FORMS[@]}" -o forms.png
+  grep -q "note: vertex.normal: the plan reads vertex.normal_octahedral" last.err && ok "render names the form read" ||
+    fail "render notes: $(cat last.err)"
+  expect 0 "bench, both forms stored" -- "$SG" bench "${FORMS[@]}" --no-alternatives --draws 1 --frames 1 --raster on
+  grep -q "note: vertex.tangent: the plan reads vertex.tangent_octahedral" last.err && ok "bench names the form read" ||
+    fail "bench notes: $(cat last.err)"
   ;;
 
 pack)  # docs/rig-format.md "Packing": the streams and their layout, byte-identical reruns
