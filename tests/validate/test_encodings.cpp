@@ -115,11 +115,16 @@ sg::ValidateReport validateOnLimb(sg::GenerateOptions gen, const std::string& ri
   return rep;
 }
 
-sg::ValidateReport validateOctahedral(const std::string& rules, std::map<std::string, double> budgets = {}) {
+// `rig` validated with `rules` under error `budgets`.
+sg::ValidateReport validateWith(const std::string& rig, const std::string& rules, std::map<std::string, double> budgets) {
   sg::GenerateOptions gen;
   gen.rulesPaths = {rules};
   gen.maxError = std::move(budgets);
-  return validateOnLimb(gen, "octahedral.rig.yaml");
+  return validateOnLimb(gen, rig);
+}
+
+sg::ValidateReport validateOctahedral(const std::string& rules, std::map<std::string, double> budgets = {}) {
+  return validateWith("octahedral.rig.yaml", rules, std::move(budgets));
 }
 
 // The frame stored as two octahedral codes in one snorm16x4 location: the plan decodes
@@ -210,10 +215,7 @@ TEST(Bounds, CodesLieInTheBoxAndDecodeWithinTheStatedError) {
 }
 
 sg::ValidateReport validateBounds(const std::string& rules, std::map<std::string, double> budgets = {}) {
-  sg::GenerateOptions gen;
-  gen.rulesPaths = {rules};
-  gen.maxError = std::move(budgets);
-  return validateOnLimb(gen, "bounds.rig.yaml");
+  return validateWith("bounds.rig.yaml", rules, std::move(budgets));
 }
 
 // A 32-byte vertex in five locations: the position relative to the bounds in unorm16, the
