@@ -265,6 +265,12 @@ std::string indexJson(const Manifest& m, const BuildReport& r) {
                        jsonString(mslPlatformName(m.msl.platform)));
   if (!m.deviceProfile.empty())  // then "cost" is femtoseconds per vertex on that device
     out += fmt::format("  \"device_profile\": {},\n", jsonString(m.deviceProfile));
+  if (!m.maxError.empty()) {  // in each encoding's unit (degrees, or a fraction of the bounds diagonal)
+    std::string budgets;
+    for (const auto& [semantic, budget] : m.maxError)
+      budgets += fmt::format("{}{}: {:.17g}", budgets.empty() ? "" : ", ", jsonString(semantic), budget);
+    out += fmt::format("  \"max_error\": {{{}}},\n", budgets);
+  }
   std::string rules;
   for (const auto& f : m.rules) rules += (rules.empty() ? "" : ", ") + jsonString(f);
   out += fmt::format("  \"rules\": [{}],\n", rules);

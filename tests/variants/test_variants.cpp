@@ -333,6 +333,9 @@ TEST(Build, StoredFormsAndErrorBudgetsAreGeneratesChoices) {
     const std::string glsl = filesOf(r).at(r.variants[0].outputs.at("glsl"));
     EXPECT_EQ(glsl, g.glsl.text);
     EXPECT_EQ(glsl.find("vertex_normal_from_octahedral") != std::string::npos, budget.empty());
+    // The index records the budgets the outputs were made under.
+    EXPECT_EQ(filesOf(r).at(r.indexPath).find("\"max_error\": {\"vertex.normal\": 0.001}") != std::string::npos,
+              !budget.empty());
   }
 }
 
