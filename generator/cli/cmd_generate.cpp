@@ -5,8 +5,6 @@
 #include <iostream>
 #include <algorithm>
 #include <cmath>
-
-#include <glm/glm.hpp>
 #include <set>
 
 #include "cli/commands.h"

@@ -59,12 +59,14 @@ void renormaliseWeights(const Rig& rig, rt::Mesh& m) {
     }
   if (sets.empty()) return;
   const double steps = std::ldexp(1.0, bits) - 1;
+  std::vector<std::vector<glm::vec4>*> streams;
+  for (const auto& s : sets) streams.push_back(&m.streams.at(s));
   std::vector<double> w(sets.size() * 4), q(w.size());
   std::vector<size_t> order(w.size());
   for (size_t v = 0; v < m.vertexCount; ++v) {
     double sum = 0;
     for (size_t s = 0; s < sets.size(); ++s)
-      for (int c = 0; c < 4; ++c) sum += w[s * 4 + static_cast<size_t>(c)] = std::max(0.0, double(m.streams[sets[s]][v][c]));
+      for (int c = 0; c < 4; ++c) sum += w[s * 4 + static_cast<size_t>(c)] = std::max(0.0, double((*streams[s])[v][c]));
     if (!(std::abs(sum - 1) <= 1e-3)) continue;  // not a partition of one: rounded as it is
     double total = 0;
     for (size_t k = 0; k < w.size(); ++k) total += q[k] = std::floor(w[k] / sum * steps);
@@ -74,7 +76,7 @@ void renormaliseWeights(const Rig& rig, rt::Mesh& m) {
     });
     for (size_t k = 0; total < steps; ++k, ++total) q[order[k]] += 1;
     for (size_t s = 0; s < sets.size(); ++s)
-      for (int c = 0; c < 4; ++c) m.streams[sets[s]][v][c] = static_cast<float>(q[s * 4 + static_cast<size_t>(c)] / steps);
+      for (int c = 0; c < 4; ++c) (*streams[s])[v][c] = static_cast<float>(q[s * 4 + static_cast<size_t>(c)] / steps);
   }
 }
 
@@ -102,7 +104,9 @@ void addBounds(const Rig& rig, rt::Mesh& m) {
   m.uniforms["mesh.bounds_extent"] = {b.extent.x, b.extent.y, b.extent.z};
 }
 
-PositionBounds boundsOf(const rt::Mesh& m) {
+// The bounds `addBounds` put in the mesh; none for an encoding that reads no bounds.
+PositionBounds boundsFor(const VertexEncoding& e, const rt::Mesh& m) {
+  if (e.uniforms.empty()) return {};
   const auto& lo = m.uniforms.at("mesh.bounds_min");
   const auto& ext = m.uniforms.at("mesh.bounds_extent");
   PositionBounds b;
@@ -110,13 +114,13 @@ PositionBounds boundsOf(const rt::Mesh& m) {
   return b;
 }
 
-glm::vec4 encodeValue(const VertexEncoding& e, const rt::Mesh& m, const glm::vec4& v) {
-  if (e.name == "bounds") return glm::vec4(glm::vec3(boundsEncode(boundsOf(m), glm::dvec3(v))), 0);
+glm::vec4 encodeValue(const VertexEncoding& e, const PositionBounds& bounds, const glm::vec4& v) {
+  if (e.name == "bounds") return glm::vec4(glm::vec3(boundsEncode(bounds, glm::dvec3(v))), 0);
   return glm::vec4(glm::vec2(octahedralEncode(glm::dvec3(v))), 0, 0);
 }
 
-glm::vec3 decodeValue(const VertexEncoding& e, const rt::Mesh& m, const glm::vec4& code) {
-  if (e.name == "bounds") return glm::vec3(boundsDecode(boundsOf(m), glm::dvec3(code)));
+glm::vec3 decodeValue(const VertexEncoding& e, const PositionBounds& bounds, const glm::vec4& code) {
+  if (e.name == "bounds") return glm::vec3(boundsDecode(bounds, glm::dvec3(code)));
   return glm::vec3(octahedralDecode(glm::dvec2(code)));
 }
 
@@ -132,8 +136,9 @@ rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
   for (const VertexEncoding* e : encodings) {
     auto src = m.streams.find(e->source);
     if (m.has(e->encoded) || src == m.streams.end()) continue;
+    const PositionBounds bounds = boundsFor(*e, m);
     std::vector<glm::vec4> code(m.vertexCount, glm::vec4(0));
-    for (size_t v = 0; v < m.vertexCount && v < src->second.size(); ++v) code[v] = encodeValue(*e, m, src->second[v]);
+    for (size_t v = 0; v < m.vertexCount && v < src->second.size(); ++v) code[v] = encodeValue(*e, bounds, src->second[v]);
     m.streams[e->encoded] = std::move(code);
   }
   renormaliseWeights(rig, m);
@@ -143,8 +148,9 @@ rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
     if (!m.has(e->encoded)) continue;
     const auto& code = m.at(e->encoded);
     auto& src = m.streams[e->source];
+    const PositionBounds bounds = boundsFor(*e, m);
     src.resize(m.vertexCount, glm::vec4(0));
-    for (size_t v = 0; v < m.vertexCount; ++v) src[v] = glm::vec4(decodeValue(*e, m, code[v]), src[v].w);
+    for (size_t v = 0; v < m.vertexCount; ++v) src[v] = glm::vec4(decodeValue(*e, bounds, code[v]), src[v].w);
   }
   quantizeStreams(rig, m);  // a source the rig stores too, in a rounded format
   return m;
