@@ -71,7 +71,7 @@ glm::dvec3 boundsDecode(const PositionBounds& b, const glm::dvec3& code);
 // the position does, and is not counted.)
 // std::nullopt: the format cannot hold the encoding.
 std::optional<double> encodingMaxError(const VertexEncoding& e, VertexFormat f);
-// "snorm8x2/x4, ..." for messages.
+// The formats it may be stored in, for messages: "snorm8x2, snorm8x4, ... (2 components)".
 std::string encodingFormats(const VertexEncoding& e);
 
 // The attribute that provides `semantic` (per-target streams excepted), or nullptr.

@@ -167,6 +167,14 @@ TEST(Octahedral, ABudgetTighterThanTheEncodingRemovesIt) {
         << all;
   }
   EXPECT_TRUE(validateOctahedral(sourcePath("rules/standard.yaml"), {{"vertex.normal", 0.01}}).pass);
+  // Through the library as through the CLI, a budget for a value no encoding stores is refused.
+  try {
+    validateOctahedral(sourcePath("rules/standard.yaml"), {{"world.normal", 0.01}});
+    FAIL() << "expected the budget to be refused";
+  } catch (const sg::InputError& e) {
+    EXPECT_NE(e.diagnostic().message.find("--max-error world.normal: no encoding stores 'world.normal'"), std::string::npos)
+        << e.diagnostic().message;
+  }
 }
 
 // Bounds-relative positions, checked from the definition: the bounds hold every point (the
