@@ -138,6 +138,7 @@ TEST_P(DawnValidation, ValidatesWithCrossCheckOnLavapipe) {
 
 INSTANTIATE_TEST_SUITE_P(Examples, DawnValidation,
                          ::testing::Values(std::make_pair("face.rig.yaml", "face.frag"),
+                                           std::make_pair("face-packed.rig.yaml", "face.frag"),  // encoded, halves, bytes
                                            std::make_pair("body.rig.yaml", "face.frag"),
                                            std::make_pair("face.rig.yaml", "depth.frag")));
 
