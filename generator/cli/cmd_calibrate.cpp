@@ -15,6 +15,7 @@ struct CalibrateCommand {
   std::string output;
   std::string meshes = "dawn,head";
   bool noLayers = false;
+  bool noCheck = false;
 
   int run() {
     co.validationLayers = !noLayers;
@@ -29,11 +30,13 @@ struct CalibrateCommand {
       if (comma == std::string::npos) break;
       start = comma + 1;
     }
-    if (!co.plans.rigPath.empty() && (co.plans.fragmentPath.empty() || co.plans.rulesPaths.empty()))
+    if (!co.rigs.empty() && (co.plans.fragmentPath.empty() || co.plans.rulesPaths.empty()))
       throw CLI::ValidationError("--rig", "plans need --rig, --fragment and --rules together");
+    co.check = !noCheck;
     if (!output.empty()) {
       std::vector<InputFile> inputs;
-      if (!co.plans.rigPath.empty()) inputs = {{co.plans.rigPath, "the rig"}, {co.plans.fragmentPath, "the fragment shader"}};
+      for (const auto& r : co.rigs) inputs.push_back({r, "a rig"});
+      if (!co.rigs.empty()) inputs.push_back({co.plans.fragmentPath, "the fragment shader"});
       for (const auto& r : co.plans.rulesPaths) inputs.push_back({r, "a rules file"});
       refuseClobbering({output}, inputs);
     }
@@ -58,9 +61,11 @@ void registerCalibrate(CLI::App& app, CliState& state) {
                                                    "its device profile (docs/device-profiles.md)");
   sub->add_option("--device", cmd->co.device, "Vulkan device name (substring); default lavapipe");
   sub->add_option("-o,--output", cmd->output, "Device profile (YAML) to write");
-  sub->add_option("--meshes", cmd->meshes, "Procedural meshes, comma-separated; the first one's fit is the profile "
+  sub->add_option("--meshes", cmd->meshes, "Procedural meshes, comma-separated; all are fitted, meshes of two sizes give per-draw "
+                                           "weights, the first one's size is the profile's vertices_per_draw "
                                            "(default dawn,head: 180,000 and 2,009 vertices)");
-  sub->add_option("--rig", cmd->co.plans.rigPath, "Also time the plan of this rig and its forced alternatives (as bench does)");
+  sub->add_option("--rig", cmd->co.rigs, "Also time the plan of this rig, its forced alternatives and bench's floors; "
+                                         "repeat for several rigs (a packed layout beside the float one)");
   sub->add_option("--fragment,-f", cmd->co.plans.fragmentPath, "With --rig: the fragment shader");
   sub->add_option("--rules,-r", cmd->co.plans.rulesPaths, "With --rig: rules file(s)");
   sub->add_option("--max-attributes", cmd->co.plans.maxAttributes, "With --rig: vertex input attributes (default 16)")
@@ -70,6 +75,9 @@ void registerCalibrate(CLI::App& app, CliState& state) {
       ->check(CLI::Range(1, 4096));
   sub->add_option("--frames", cmd->co.frames, "Timed frames; the median counts (default 9)")->check(CLI::Range(1, 1000));
   sub->add_option("--rounds", cmd->co.rounds, "Timings per program; the best counts (default 2)")->check(CLI::Range(1, 100));
+  sub->add_option("--refits", cmd->co.refits, "With --rig: fits again with the plans each profile chose (default 1)")
+      ->check(CLI::Range(0, 10));
+  sub->add_flag("--no-check", cmd->noCheck, "With --rig: do not time the rigs' plans under the fitted profile afterwards");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer (use for timings)");
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }

@@ -147,8 +147,9 @@ std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvM
   j += "\n  ]},\n";
   j += buffersJson(glsl);
   if (profile && predicted) {
-    j += fmt::format("  \"predicted_cost\": {{\"device\": {}, \"ns_per_vertex\": {:.6f}, \"terms\": {{",
-                     jsonQuote(profile->device), predicted->totalNanoseconds);
+    j += fmt::format("  \"predicted_cost\": {{\"device\": {}, \"ns_per_vertex\": {:.6f}, {}\"terms\": {{",
+                     jsonQuote(profile->device), predicted->totalNanoseconds,
+                     profile->hasDrawWeights() ? fmt::format("\"vertices_per_draw\": {:g}, ", profile->verticesPerDraw) : "");
     for (size_t t = 0; t < kTermCount; ++t)
       j += fmt::format("{}\n    {}: {{\"amount\": {}, \"ns\": {:.6f}}}", t ? "," : "", jsonQuote(termName(static_cast<int>(t))),
                        predicted->amounts[t], predicted->nanoseconds[t]);

@@ -309,6 +309,8 @@ LoadedInputs loadInputs(const GenerateOptions& opts) {
   const FragmentInterface fragment = loadFragmentStage(opts.fragmentPath, opts.targetEnv);
   std::optional<DeviceProfile> profile;
   if (!opts.deviceProfilePath.empty()) profile = loadDeviceProfileStage(opts.deviceProfilePath);
+  // A profile's per-draw weights are spread over the draw's vertices: the given count, when there is one.
+  if (profile && profile->hasDrawWeights() && opts.maxVertices > 0) profile->verticesPerDraw = double(opts.maxVertices);
   LoadedInputs in = prepareInputs(std::move(rig), rules, fragment, opts, profile);
   for (const auto& b : opts.bannedRules)  // a misspelt --ban would otherwise change nothing silently
     if (std::none_of(in.rules.rules.begin(), in.rules.rules.end(), [&](const Rule& r) { return r.name == b; }))

@@ -52,7 +52,8 @@ struct GenerateOptions {
   int maxAttributes = static_cast<int>(kVulkanMinVertexAttributes);
   int maxStorageBuffers = static_cast<int>(kVulkanMinStorageBuffers);  // maxPerStageDescriptorStorageBuffers
   // The most vertices one draw has (0 = unknown): per-vertex storage buffers larger than
-  // maxStorageBufferBytes for that many vertices are not used (docs/buffers.md).
+  // maxStorageBufferBytes for that many vertices are not used (docs/buffers.md), and a device
+  // profile's per-draw weights are spread over that many (its vertices_per_draw otherwise).
   int64_t maxVertices = 0;
   int64_t maxStorageBufferBytes = int64_t{1} << 27;  // maxStorageBufferRange every device has
   // A device profile (docs/device-profiles.md): the plan is the cheapest in predicted time

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <unistd.h>
 #include <map>
+#include <set>
 
 #include "analysis/cost.h"
 #include "common/glsl_compile.h"
@@ -66,7 +67,10 @@ struct ProbeMesh {
 
 ProbeMesh probeMesh(const std::string& name) {
   rt::MeshOptions mo;
-  mo.influences = 0;
+  // The Dawn face's skin (98 bones, 4 influences, each vertex to its nearest bone centres):
+  // the palette probe indexes by it, so its indices diverge within a warp as a skin's do.
+  mo.influences = 4;
+  mo.bones = 98;
   mo.tangents = false;
   mo.occlusion = false;
   ProbeMesh m;
@@ -203,49 +207,54 @@ Probe bufferProbe(const ProbeMesh& m, int n) {
   return p;
 }
 
-// n loads of a mat4 palette (64 entries, std140) at an index read per vertex (a uint
-// attribute), or at the same indices taken from the uniform block; each times the position.
-// The per-vertex indices are coherent, as a skin's are: the mesh's vertices in 64 runs of
-// neighbours, each run one joint. (Hashed indices, every vertex of a warp a different
-// joint, took 29.6 ns per vertex for four loads on the H200 at Dawn scale, 15x their
-// uniform-index twin: a case no skinned mesh has, which made the fit overprice a plan's
-// palette loads.)
+// n <= 4 loads of a mat4 palette (128 entries, std140) at indices read per vertex (the
+// mesh's skin joints, a uint attribute: load i reads palette[joint[i]], as a skin does), or
+// at as many distinct indices taken from the uniform block; each times the position.
+// The per-vertex indices diverge within a warp as much as the skin's nearest bones do: on
+// the 2,009-vertex head a warp spans several bones, at Dawn scale mostly one. (Hashed
+// indices, every vertex of a warp a different joint, took 29.6 ns per vertex for four
+// loads on the H200 at Dawn scale, 15x their uniform-index twin: a case no skinned mesh
+// has, which made the fit overprice a plan's palette loads.)
 Probe paletteProbe(const ProbeMesh& m, int n, bool perVertex) {
   Probe p = baseProbe(m, fmt::format("palette loads {} at a {} index", n, perVertex ? "per-vertex" : "uniform"), 1);
-  constexpr int kEntries = 64;
+  constexpr uint32_t kEntries = 128;
   p.decl += fmt::format("layout(std140, set = 0, binding = 0) uniform Block {{ mat4 palette[{}]; uint base; }} u;\n", kEntries);
   // Both variants read the index attribute (same locations and bytes); only the first uses it.
   p.decl += "layout(location = 1) in uvec4 joint;\n";
+  const auto& joints = m.mesh.streams.at("skin.joints[0]");
   rt::VertexStream s;
   s.location = 1;
   s.format = VK_FORMAT_R8G8B8A8_UINT;
   s.stride = 4;
   s.data.resize(m.mesh.vertexCount * 4);
   for (size_t v = 0; v < m.mesh.vertexCount; ++v)
-    for (int c = 0; c < 4; ++c)
-      s.data[v * 4 + size_t(c)] = static_cast<uint8_t>((v * kEntries / m.mesh.vertexCount + size_t(c)) % kEntries);
+    for (int c = 0; c < 4; ++c) s.data[v * 4 + size_t(c)] = static_cast<uint8_t>(joints[v][c]);
   p.inputs.streams.push_back(s);
   p.amounts[kTermLocations] += 1;
   p.amounts[kTermAttributeBytes] += 4;
   const uint32_t base = 5;
   std::vector<glm::dmat4> palette(kEntries);
   p.inputs.uniformData.assign(kEntries * 64 + 16, 0);
-  for (int e = 0; e < kEntries; ++e)
+  for (uint32_t e = 0; e < kEntries; ++e)
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r) {
-        float f = static_cast<float>(2 * unit(200 + uint32_t(e), uint32_t(c), uint32_t(r)) - 1);
-        palette[size_t(e)][c][r] = f;
+        float f = static_cast<float>(2 * unit(200 + e, uint32_t(c), uint32_t(r)) - 1);
+        palette[e][c][r] = f;
         std::memcpy(p.inputs.uniformData.data() + size_t(e) * 64 + size_t(c) * 16 + size_t(r) * 4, &f, 4);
       }
   std::memcpy(p.inputs.uniformData.data() + kEntries * 64, &base, 4);
-  const char* index = perVertex ? "joint.x" : "u.base";
   p.body = "  o0 = vec4(joint) * 0.001;\n";
-  for (int i = 0; i < n; ++i) p.body += fmt::format("  o0 += u.palette[({} + {}u) & {}u] * a0;\n", index, i, kEntries - 1);
+  for (int i = 0; i < n; ++i)
+    p.body += perVertex ? fmt::format("  o0 += u.palette[joint[{}] & {}u] * a0;\n", i, kEntries - 1)
+                        : fmt::format("  o0 += u.palette[(u.base + {}u) & {}u] * a0;\n", i, kEntries - 1);
   const auto& pos = m.mesh.streams.at("vertex.position");
   for (size_t v = 0; v < m.mesh.vertexCount; ++v) {
-    glm::dvec4 o = glm::dvec4(s.data[v * 4], s.data[v * 4 + 1], s.data[v * 4 + 2], s.data[v * 4 + 3]) * 0.001;
-    const uint32_t idx = perVertex ? s.data[v * 4] : base;
-    for (int i = 0; i < n; ++i) o += palette[(idx + uint32_t(i)) & (kEntries - 1)] * glm::dvec4(pos[v]);
+    const uint8_t* j = &s.data[v * 4];
+    glm::dvec4 o = glm::dvec4(j[0], j[1], j[2], j[3]) * 0.001;
+    for (int i = 0; i < n; ++i) {
+      const uint32_t idx = perVertex ? j[i] & (kEntries - 1) : (base + uint32_t(i)) & (kEntries - 1);
+      o += palette[idx] * glm::dvec4(pos[v]);
+    }
     for (int c = 0; c < 4; ++c) expectedAt(p, v, 0, c) = o[c];
   }
   p.amounts[kTermIndexedUniformLoads] = perVertex ? n : 0;
@@ -272,7 +281,7 @@ std::vector<Probe> makeProbes(const ProbeMesh& m) {
   probes.push_back(fetchProbe(m, 16, kUnorm8x4));  // 16 locations at 76 bytes (4 float32x4: 64)
   for (int n : {0, 16, 64, 256}) probes.push_back(chainProbe(m, n));
   for (int n : {1, 4, 8, 16}) probes.push_back(bufferProbe(m, n));
-  for (int n : {1, 4, 8})
+  for (int n : {1, 2, 4})
     for (bool perVertex : {true, false}) probes.push_back(paletteProbe(m, n, perVertex));
   for (int n : {1, 4, 8, 15}) probes.push_back(outputProbe(m, n));
   return probes;
@@ -335,21 +344,36 @@ double medianOf(std::vector<double> v) {
 
 }  // namespace
 
-DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, const std::string& mesh,
-                               const std::string& deviceName) {
+DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
+                               double workloadVertices) {
   std::vector<const CalibrationSample*> rows;
+  std::set<double> sizes;
   for (const auto& s : samples)
-    if (s.mesh == mesh && s.validated && s.measuredNs > 0) rows.push_back(&s);
-  if (rows.empty()) throw std::runtime_error(fmt::format("calibration: no validated timing on mesh '{}' to fit", mesh));
-  // Relative errors weigh equally: row i divided by its measured time.
-  std::vector<double> a(rows.size() * kTermCount), b(rows.size(), 1.0);
+    if (s.fitted && s.validated && s.measuredNs > 0 && s.vertices > 0) rows.push_back(&s), sizes.insert(s.vertices);
+  if (rows.empty()) throw std::runtime_error("calibration: no validated timing to fit");
+  // Per-draw columns only when meshes of two sizes separate them from the per-vertex ones.
+  const size_t n = sizes.size() > 1 ? 2 * kTermCount : kTermCount;
+  // Relative errors weigh equally: row i divided by its measured time. Each column is scaled
+  // to a largest entry of 1 (per-draw amounts are ~1e-5 of per-vertex ones), then unscaled.
+  std::vector<double> a(rows.size() * n), b(rows.size(), 1.0), scale(n, 0.0);
   for (size_t i = 0; i < rows.size(); ++i)
-    for (int t = 0; t < kTermCount; ++t) a[i * kTermCount + size_t(t)] = double(rows[i]->amounts[size_t(t)]) / rows[i]->measuredNs;
-  NnlsResult fit = nnls(a, rows.size(), kTermCount, b);
+    for (size_t j = 0; j < n; ++j) {
+      const double amount = double(rows[i]->amounts[j % kTermCount]) / (j < kTermCount ? 1.0 : rows[i]->vertices);
+      a[i * n + j] = amount / rows[i]->measuredNs;
+      scale[j] = std::max(scale[j], std::abs(a[i * n + j]));
+    }
+  for (size_t i = 0; i < rows.size(); ++i)
+    for (size_t j = 0; j < n; ++j)
+      if (scale[j] > 0) a[i * n + j] /= scale[j];
+  NnlsResult fit = nnls(a, rows.size(), n, b);
   DeviceProfile profile;
   profile.device = deviceName;
-  for (int t = 0; t < kTermCount; ++t)
-    profile.nanoseconds[size_t(t)] = std::min(fit.x[size_t(t)], kMaxProfileWeightNs);
+  for (size_t j = 0; j < n; ++j) {
+    const double w = scale[j] > 0 ? fit.x[j] / scale[j] : 0.0;
+    if (j < kTermCount) profile.nanoseconds[j] = std::min(w, kMaxProfileWeightNs);
+    else profile.drawNanoseconds[j - kTermCount] = std::min(w, kMaxProfileDrawWeightNs);
+  }
+  if (profile.hasDrawWeights()) profile.verticesPerDraw = workloadVertices;
   return profile;
 }
 
@@ -359,13 +383,15 @@ std::vector<CalibrationFit> evaluateFit(std::vector<CalibrationSample>& samples,
   for (const auto& mesh : meshes) {
     CalibrationFit f;
     f.mesh = mesh;
-    std::vector<double> predicted, measured;
+    std::vector<double> predicted, measured, predictedAll, measuredAll;
     double sq = 0;
     for (auto& s : samples) {
       if (s.mesh != mesh) continue;
-      s.predictedNs = 0;
-      for (int t = 0; t < kTermCount; ++t) s.predictedNs += profile.nanoseconds[size_t(t)] * double(s.amounts[size_t(t)]);
+      s.predictedNs = profile.predictNanoseconds(s.amounts, s.vertices);
       if (!s.validated || s.measuredNs <= 0) continue;
+      predictedAll.push_back(s.predictedNs);
+      measuredAll.push_back(s.measuredNs);
+      if (!s.fitted) continue;
       double rel = (s.predictedNs - s.measuredNs) / s.measuredNs;
       sq += rel * rel;
       f.maxRelativeError = std::max(f.maxRelativeError, std::abs(rel));
@@ -375,6 +401,8 @@ std::vector<CalibrationFit> evaluateFit(std::vector<CalibrationSample>& samples,
     f.samples = measured.size();
     f.rmsRelativeError = f.samples ? std::sqrt(sq / double(f.samples)) : 0;
     f.spearman = spearmanWithinSpread(predicted, measured, 0.005);
+    f.allSamples = measuredAll.size();
+    f.spearmanAll = spearmanWithinSpread(predictedAll, measuredAll, 0.005);
     fits.push_back(f);
   }
   return fits;
@@ -400,6 +428,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
       CalibrationSample s;
       s.label = p.label;
       s.mesh = meshName;
+      s.vertices = double(m.mesh.vertexCount);
       s.amounts = p.amounts;
       try {
         GlslShader renderShader = compileProbe(Stage::Vertex, probeGlsl(p, false), p.label);
@@ -420,7 +449,8 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           req.vertexSpirv = render;
           req.fragmentSpirv = compileProbe(Stage::Fragment, probeFragmentGlsl(p), p.label).spirv();
           req.indices = m.indices;
-          req.width = req.height = 512;
+          req.width = opts.width;
+          req.height = opts.height;
           rt::TimingRequest t;
           t.drawsPerFrame = opts.drawsPerFrame;
           t.frames = opts.frames + 1;
@@ -440,80 +470,147 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
       rep.samples.push_back(std::move(s));
     }
   }
-  // Generated plans: bench's programs (each validated on the device before it is timed).
-  // Without a profile a generation does not count its plans' buffer and indexed loads; one
-  // that prices arithmetic alone chooses the slot model's plans (docs/device-profiles.md) and counts them.
-  std::string slotsProfile;
-  if (!opts.plans.rigPath.empty() && opts.plans.deviceProfilePath.empty()) {
-    slotsProfile = (std::filesystem::temp_directory_path() / fmt::format("shadergen-slots-{}.yaml", ::getpid())).string();
-    std::ofstream(slotsProfile) << "device: instruction slots\nweights:\n  arithmetic: 0.000001\n";
-  }
+  // Generated plans and the floors: bench's programs (each plan validated on the device
+  // before it is timed). Without a profile a generation does not count its plans' buffer and
+  // indexed loads; one that prices arithmetic alone chooses the slot model's plans
+  // (docs/device-profiles.md) and counts them.
+  auto temporaryProfile = [](const std::string& tag, const std::string& yaml) {
+    std::string path = (std::filesystem::temp_directory_path() / fmt::format("shadergen-{}-{}.yaml", tag, ::getpid())).string();
+    std::ofstream(path) << yaml;
+    return path;
+  };
   struct Remove {
-    std::string path;
+    std::vector<std::string> paths;
     ~Remove() {
-      if (!path.empty()) std::filesystem::remove(path);
+      for (const auto& p : paths) std::filesystem::remove(p);
     }
-  } removeSlots{slotsProfile};
-  if (!opts.plans.rigPath.empty())
-    for (const auto& meshName : opts.meshes) {
-      GpuBenchOptions bo;
-      bo.render.gen = opts.plans;
-      if (!slotsProfile.empty()) bo.render.gen.deviceProfilePath = slotsProfile;
-      bo.render.device = opts.device;
-      bo.render.validationLayers = opts.validationLayers;
-      bo.render.mesh = meshName == "small" ? "head" : meshName;
-      bo.floor = false;
-      bo.rasterOff = false;
-      bo.drawsPerFrame = opts.drawsPerFrame;
-      bo.frames = opts.frames;
-      bo.rounds = opts.rounds;
-      for (const auto& row : runGpuBench(bo).rows) {
-        if (!row.hasCost) continue;
-        CalibrationSample s;
-        s.label = "plan: " + row.label;
-        s.mesh = meshName;
-        s.amounts = row.amounts;
-        s.validated = row.validation == "pass";
-        s.failure = s.validated ? "" : row.validation;
-        s.measuredNs = !s.validated ? -1 : hostClock ? row.rasterOnWallNsPerVertex : row.rasterOnNsPerVertex;
-        rep.samples.push_back(std::move(s));
+  } remove;
+  auto benchRigs = [&](const std::string& profilePath, bool fitted, const std::string& prefix) {
+    for (const auto& rig : opts.rigs)
+      for (const auto& meshName : opts.meshes) {
+        GpuBenchOptions bo;
+        bo.render.gen = opts.plans;
+        bo.render.gen.rigPath = rig;
+        bo.render.gen.deviceProfilePath = profilePath;
+        bo.render.device = opts.device;
+        bo.render.validationLayers = opts.validationLayers;
+        bo.render.mesh = meshName == "small" ? "head" : meshName;
+        bo.render.width = opts.width;
+        bo.render.height = opts.height;
+        bo.floor = fitted;  // the floors are the same programs under any profile
+        bo.rasterOff = false;
+        bo.drawsPerFrame = opts.drawsPerFrame;
+        bo.frames = opts.frames;
+        bo.rounds = opts.rounds;
+        GpuBenchReport br = runGpuBench(bo);
+        if (!fitted) {
+          CalibrationCheck c;
+          c.rig = rig;
+          c.mesh = meshName;
+          c.spearman = br.spearmanPredictedOn;
+          c.generatedOverFastest = br.generatedOverFastestOn;
+          for (const auto& row : br.rows) c.plans += row.hasCost && row.validation == "pass";
+          rep.checks.push_back(c);
+        }
+        for (const auto& row : br.rows) {
+          if (!row.hasAmounts) continue;
+          CalibrationSample s;
+          s.label = (row.hasCost ? prefix : "") + row.label;
+          s.mesh = meshName;
+          s.vertices = double(br.vertices);
+          s.rig = std::filesystem::path(rig).filename().string();
+          s.fitted = fitted;
+          s.amounts = row.amounts;
+          s.validated = row.validation == "pass" || (!row.hasCost && row.rasterOnNsPerVertex > 0);
+          s.failure = s.validated ? "" : row.validation;
+          s.measuredNs = !s.validated ? -1 : hostClock ? row.rasterOnWallNsPerVertex : row.rasterOnNsPerVertex;
+          rep.samples.push_back(std::move(s));
+        }
       }
+  };
+  if (!opts.rigs.empty()) {
+    std::string slots = opts.plans.deviceProfilePath;
+    if (slots.empty()) {
+      slots = temporaryProfile("slots", "device: instruction slots\nweights:\n  arithmetic: 0.000001\n");
+      remove.paths.push_back(slots);
     }
-  rep.profile = fitDeviceProfile(rep.samples, opts.meshes.front(), rep.device + " (" + rep.driver + ")");
+    benchRigs(slots, true, "plan: ");
+  }
+  double workload = 0;
+  for (const auto& s : rep.samples)
+    if (s.mesh == opts.meshes.front()) workload = s.vertices;
+  rep.profile = fitDeviceProfile(rep.samples, rep.device + " (" + rep.driver + ")", workload);
+  // The check: each rig's plans under the fitted profile. The plans a profile chooses are
+  // where its errors cost time, so each refit adds them to the fit; the last check's plans
+  // are never fitted.
+  for (uint32_t round = 0; opts.check && !opts.rigs.empty(); ++round) {
+    const std::string fitted = temporaryProfile(fmt::format("fit{}", round + 1), deviceProfileYaml(rep));
+    remove.paths.push_back(fitted);
+    rep.checks.clear();
+    const bool last = round == opts.refits;
+    benchRigs(fitted, false, last ? "checked plan: " : fmt::format("plan under fit {}: ", round + 1));
+    if (last) break;
+    for (auto& s : rep.samples) s.fitted = true;
+    rep.profile = fitDeviceProfile(rep.samples, rep.profile.device, workload);
+  }
   rep.fits = evaluateFit(rep.samples, rep.profile, opts.meshes);
   return rep;
 }
 
+namespace {
+
+std::string weightLines(const DeviceProfile& p) {
+  std::string s = "weights:\n";
+  for (int t = 0; t < kTermCount; ++t) s += fmt::format("  {}: {:.6g}\n", termName(t), p.nanoseconds[size_t(t)]);
+  if (!p.hasDrawWeights()) return s;
+  s += fmt::format("vertices_per_draw: {:g}\ndraw_weights:\n", p.verticesPerDraw);
+  for (int t = 0; t < kTermCount; ++t)
+    if (p.drawNanoseconds[size_t(t)] > 0) s += fmt::format("  {}: {:.6g}\n", termName(t), p.drawNanoseconds[size_t(t)]);
+  return s;
+}
+
+std::string fitLine(const CalibrationFit& f) {
+  std::string s = fmt::format("fit on '{}': {} samples, RMS relative error {:.1f} %, max {:.1f} %, Spearman {:.3f}", f.mesh,
+                              f.samples, 100 * f.rmsRelativeError, 100 * f.maxRelativeError, f.spearman);
+  if (f.allSamples > f.samples)
+    s += fmt::format("; with the check's plans: {} programs, Spearman {:.3f}", f.allSamples, f.spearmanAll);
+  return s;
+}
+
+}  // namespace
+
 std::string formatCalibration(const CalibrationReport& r) {
-  std::string s = fmt::format("device: {} (driver: {}); clock: {}\n\n| mesh | program | ", r.device, r.driver, r.clock);
+  std::string s = fmt::format("device: {} (driver: {}); clock: {}\n\n| mesh | rig | program | ", r.device, r.driver, r.clock);
   for (int t = 0; t < kTermCount; ++t) s += fmt::format("{} | ", termName(t));
-  s += "measured ns/vertex | predicted |\n|---|---|";
+  s += "measured ns/vertex | predicted |\n|---|---|---|";
   for (int t = 0; t < kTermCount; ++t) s += "---:|";
   s += "---:|---:|\n";
   for (const auto& x : r.samples) {
-    s += fmt::format("| {} | {} | ", x.mesh, x.label);
+    s += fmt::format("| {} | {} | {} | ", x.mesh, x.rig.empty() ? "—" : x.rig, x.label);
     for (int t = 0; t < kTermCount; ++t) s += fmt::format("{} | ", x.amounts[size_t(t)]);
     s += x.validated ? fmt::format("{:.4f} | {:.4f} |\n", x.measuredNs, x.predictedNs)
                      : fmt::format("FAILED, not timed: {} | — |\n", x.failure);
   }
-  s += "\nweights (ns per unit per vertex), fitted on mesh '" + (r.fits.empty() ? std::string() : r.fits.front().mesh) + "':\n";
-  for (int t = 0; t < kTermCount; ++t) s += fmt::format("  {}: {:.6g}\n", termName(t), r.profile.nanoseconds[size_t(t)]);
-  for (const auto& f : r.fits)
-    s += fmt::format("fit on '{}': {} samples, RMS relative error {:.1f} %, max {:.1f} %, Spearman {:.3f}\n", f.mesh, f.samples,
-                     100 * f.rmsRelativeError, 100 * f.maxRelativeError, f.spearman);
+  s += "\nfitted (ns per unit per vertex; draw weights: ns per unit per draw):\n" + weightLines(r.profile);
+  for (const auto& f : r.fits) s += fitLine(f) + "\n";
+  for (const auto& c : r.checks)
+    s += fmt::format("check of {} on '{}' under the fitted profile: {} plans, predicted vs measured Spearman {:.3f}; "
+                     "the chosen plan takes {:.3f}x the fastest\n",
+                     c.rig, c.mesh, c.plans, c.spearman, c.generatedOverFastest);
   return s;
 }
 
 std::string deviceProfileYaml(const CalibrationReport& r) {
   std::string s = "# Measured by `shadergen calibrate` (docs/device-profiles.md): ns per vertex per unit of each\n"
-                  "# term, the non-negative least-squares fit of every validated probe's and plan's time.\n";
+                  "# term (and, under draw_weights, ns per draw), the non-negative least-squares fit of every\n"
+                  "# validated probe's, plan's and floor's time.\n";
   s += fmt::format("# clock: {}; driver: {}\n", r.clock, r.driver);
-  for (const auto& f : r.fits)
-    s += fmt::format("# fit on mesh '{}': {} samples, RMS relative error {:.1f} %, max {:.1f} %, Spearman {:.3f}\n", f.mesh, f.samples,
-                     100 * f.rmsRelativeError, 100 * f.maxRelativeError, f.spearman);
-  s += fmt::format("device: \"{}\"\nunit: ns\nweights:\n", r.profile.device);
-  for (int t = 0; t < kTermCount; ++t) s += fmt::format("  {}: {:.6g}\n", termName(t), r.profile.nanoseconds[size_t(t)]);
-  return s;
+  for (const auto& f : r.fits) s += "# " + fitLine(f) + "\n";
+  for (const auto& c : r.checks)
+    s += fmt::format("# check of {} on '{}': {} plans, Spearman {:.3f}, chosen plan {:.3f}x the fastest\n", c.rig, c.mesh, c.plans,
+                     c.spearman, c.generatedOverFastest);
+  s += fmt::format("device: \"{}\"\nunit: ns\n", r.profile.device);
+  return s + weightLines(r.profile);
 }
 
 }  // namespace sg

@@ -7,10 +7,16 @@
 // palette loads indexed per vertex (against the same loads at a uniform index), and output
 // components. Every probe is first run with its outputs captured and compared with the
 // values it must compute (computed here on the CPU from the same data); only a probe that
-// agrees is timed. Generated plans (the rig's plan and its forced alternatives, bench's
-// rows) join the probes as samples. The weights are the non-negative least-squares fit
-// (common/nnls.h) of ns per vertex on the terms' amounts, relative errors weighted equally.
+// agrees is timed. Generated plans (each rig's plan and its forced alternatives, bench's
+// rows) and bench's floors join the probes as samples. The weights are the non-negative
+// least-squares fit (common/nnls.h) of ns per vertex on the terms' amounts, relative errors
+// weighted equally; with meshes of different sizes, each term also gets a per-draw weight
+// (the fit: ns per vertex = sum of (w + d / vertices per draw) x amount). Then each rig's
+// plans under the fitted profile, which join the samples for a refit (the plans a profile
+// chooses are where its errors cost time); the plans under the last profile are the check,
+// timed and compared with its predictions, samples no fit saw.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -27,15 +33,24 @@ struct CalibrationOptions {
   uint32_t drawsPerFrame = 16;
   uint32_t frames = 9;              // + 1 warm-up frame
   uint32_t rounds = 2;              // best round counts
+  uint32_t width = 256, height = 256;  // the target of every draw (bench's default)
   bool probes = true;
-  // The generated plan and every forced alternative of this generation (bench's programs),
-  // when gen.rigPath is set.
+  // For each rig: the generated plan and every forced alternative (bench's programs), with
+  // plans' fragment shader, rules and limits, and bench's floors.
+  std::vector<std::string> rigs;
   GenerateOptions plans;
+  bool check = true;  // then the same rigs' plans under the fitted profile
+  // Refits: each adds the plans the profile chose to the samples and fits again; the last
+  // profile's plans are the check, which no fit saw.
+  uint32_t refits = 1;
 };
 
 struct CalibrationSample {
   std::string label;  // "locations 8 (float32x4)", "plan: generated", ...
   std::string mesh;
+  double vertices = 0;  // per draw (the mesh's)
+  std::string rig;      // the rig of a plan or floor ("" for a probe)
+  bool fitted = true;   // false: a plan of the check, which the fit did not see
   TermAmounts amounts{};
   bool validated = false;
   std::string failure;      // why it was not timed (its outputs disagreed, or it did not run)
@@ -45,9 +60,19 @@ struct CalibrationSample {
 
 struct CalibrationFit {
   std::string mesh;
-  size_t samples = 0;
+  size_t samples = 0;  // fitted ones
   double rmsRelativeError = 0, maxRelativeError = 0;
-  double spearman = 0;  // predicted against measured
+  double spearman = 0;  // predicted against measured, fitted samples (within 0.5 %: ties)
+  size_t allSamples = 0;  // with the check's
+  double spearmanAll = NAN;
+};
+
+// The check of one rig on one mesh: its plans under the fitted profile.
+struct CalibrationCheck {
+  std::string rig, mesh;
+  size_t plans = 0;
+  double spearman = NAN;            // predicted against measured over its plans
+  double generatedOverFastest = NAN;  // the chosen plan's time over the fastest plan's
 };
 
 struct CalibrationReport {
@@ -55,15 +80,18 @@ struct CalibrationReport {
   std::string clock;  // what measured the samples: GPU timestamps, or host time on a CPU device
   std::vector<CalibrationSample> samples;
   DeviceProfile profile;
-  std::vector<CalibrationFit> fits;  // one per mesh, under the profile fitted on the first
+  std::vector<CalibrationFit> fits;  // one per mesh
+  std::vector<CalibrationCheck> checks;
 };
 
 CalibrationReport calibrateDevice(const CalibrationOptions& opts);
 
 // The fit alone (exposed for tests): weights >= 0 minimising the relative error of
-// predicted against measured ns per vertex over the validated samples of `mesh`.
-DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, const std::string& mesh,
-                               const std::string& deviceName);
+// predicted against measured ns per vertex over the validated, fitted samples; per-draw
+// weights too when the samples' meshes differ in size. The profile prices draws of
+// `workloadVertices`.
+DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
+                               double workloadVertices);
 // Fills predictedNs of every sample and the fit statistics per mesh.
 std::vector<CalibrationFit> evaluateFit(std::vector<CalibrationSample>& samples, const DeviceProfile& profile,
                                         const std::vector<std::string>& meshes);

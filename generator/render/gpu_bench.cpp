@@ -9,6 +9,8 @@
 #include <regex>
 #include <set>
 
+#include "analysis/cost.h"
+#include "common/glsl_compile.h"
 #include "common/input_file.h"
 #include "runtime/procedural.h"
 #include "runtime/vk_render.h"
@@ -92,6 +94,22 @@ std::string floorShader(const GenerateResult& g, bool capture, bool allInputs) {
     body += fmt::format("  {} = {}(0);\n", o.name, glslName(o.type));
   }
   return text + "void main() {\n" + body + "}\n";
+}
+
+// What a floor pays per term: its arithmetic measured on its optimised SPIR-V (as cost: auto
+// and the calibration's probes are), each input it reads (a location and its format's bytes),
+// and the generated program's outputs. It reads no buffer and no uniform.
+TermAmounts floorAmounts(const GenerateResult& floor, const Problem& generated, TargetEnv env) {
+  TermAmounts a{};
+  a[kTermArithmetic] = measureSpirv(optimizeSpirv(floor.spirv.words, env)).total;
+  for (const auto& in : floor.glsl.inputs) {
+    const RigAttribute& ra = floor.in.rig.attributes[static_cast<size_t>(in.attribute)];
+    a[kTermLocations] += vertexInputLocations(ra.shaderType);
+    a[kTermAttributeBytes] += formatBytes(ra.format);
+  }
+  a[kTermOutputs] = generated.fixedTerms[kTermOutputs];
+  a[kTermVertices] = 1;
+  return a;
 }
 
 }  // namespace
@@ -207,8 +225,15 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   const std::string limits = applyDeviceLimits(gen, opts.render.limits, validator.harness());
   gen.capture = false;
   LoadedInputs in = loadInputs(gen);
+  RenderScene scene = renderScene(in.rig, opts.render);
+  // As validate does: the buffer forms must fit this mesh (+1: the capture draws an even
+  // count), and a device profile's per-draw weights are spread over its vertices.
+  if (gen.maxVertices == 0) {
+    gen.maxVertices = static_cast<int64_t>(scene.mesh.vertexCount) + 1;
+    in = loadInputs(gen);
+    scene = renderScene(in.rig, opts.render);
+  }
   const Rig& rig = in.rig;
-  RenderScene scene = renderScene(rig, opts.render);
   FragmentProgram frag = compileFragmentFile(gen.fragmentPath, env);
   std::vector<rt::Texture> textures = texturesFor(frag, opts.render.lighting);
 
@@ -225,7 +250,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     for (const auto& q : programs)
       if (q.row.hasCost && q.row.rules == p.row.rules) return false;  // the same plan again
     p.capture = generateFrom(in, capture);
-    p.row.hasCost = true;
+    p.row.hasCost = p.row.hasAmounts = true;
     p.row.planCost = p.render.plan.cost;
     p.row.amounts = planTermAmounts(p.render.plan, p.render.in.problem);
     if (p.render.in.profile)
@@ -272,6 +297,10 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     p.render = handWrittenProgram(floorShader(chosen, false, allInputs), "floor.vert", chosen, env);
     p.capture = handWrittenProgram(floorShader(chosenCapture, true, allInputs), "floor.vert", chosenCapture, env);
     p.row.spirvInstructions = countInstructions(p.render.spirv.words);
+    p.row.hasAmounts = true;
+    p.row.amounts = floorAmounts(p.render, chosen.in.problem, env);
+    if (chosen.in.profile)
+      p.row.predictedNsPerVertex = chosen.in.profile->predictNanoseconds(p.row.amounts, chosen.in.profile->verticesPerDraw);
     p.validate = false;
     programs.push_back(std::move(p));
   }
@@ -386,8 +415,8 @@ std::string formatGpuBench(const GpuBenchReport& r) {
   for (const auto& row : r.rows)
     s += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", row.label, row.validation.empty() ? "—" : row.validation,
                      row.hasCost ? std::to_string(row.planCost) : "—",
-                     row.hasCost ? std::to_string(row.amounts[kTermLocations]) : "—",
-                     row.hasCost ? std::to_string(row.amounts[kTermAttributeBytes] + row.amounts[kTermBufferBytes]) : "—",
+                     row.hasAmounts ? std::to_string(row.amounts[kTermLocations]) : "—",
+                     row.hasAmounts ? std::to_string(row.amounts[kTermAttributeBytes] + row.amounts[kTermBufferBytes]) : "—",
                      row.predictedNsPerVertex >= 0 ? fmt::format("{:.4f}", row.predictedNsPerVertex) : "—",
                      row.spirvInstructions, cell(row.rasterOnNsPerVertex, gen ? gen->rasterOnNsPerVertex : -1),
                      cell(row.rasterOffNsPerVertex, gen ? gen->rasterOffNsPerVertex : -1),

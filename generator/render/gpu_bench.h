@@ -32,7 +32,8 @@ struct GpuBenchOptions {
 struct GpuBenchRow {
   std::string label;               // "generated", "forced <rule> for <fact>", "hand port", "floor"
   std::vector<std::string> rules;  // plan rules (generated programs)
-  bool hasCost = false;
+  bool hasCost = false;            // a plan of the search (planCost)
+  bool hasAmounts = false;         // amounts known: the plans and the floors
   int64_t planCost = 0;
   size_t spirvInstructions = 0;    // of the render build
   // Validation on the device before timing: "pass", "FAIL: <output ...>" (then not timed),

@@ -80,6 +80,7 @@ TEST(Calibrate, TheFitRecoversKnownNonNegativeWeights) {
       CalibrationSample s;
       s.label = fmt::format("l{} a{}", locations, slots);
       s.mesh = "m";
+      s.vertices = 1000;
       s.validated = true;
       s.amounts[kTermLocations] = locations;
       s.amounts[kTermAttributeBytes] = 16 * locations;
@@ -95,7 +96,9 @@ TEST(Calibrate, TheFitRecoversKnownNonNegativeWeights) {
   bad.validated = false;
   bad.measuredNs = 1e6;
   samples.push_back(bad);
-  DeviceProfile p = fitDeviceProfile(samples, "m", "linear device");
+  DeviceProfile p = fitDeviceProfile(samples, "linear device", 1000);
+  // One mesh size cannot tell a per-draw cost from a per-vertex one: none is fitted.
+  EXPECT_FALSE(p.hasDrawWeights());
   // Bytes are 16 x locations here: only their sum is determined, so check predictions and
   // the terms the samples separate.
   std::vector<CalibrationFit> fits = evaluateFit(samples, p, {"m"});
@@ -106,6 +109,56 @@ TEST(Calibrate, TheFitRecoversKnownNonNegativeWeights) {
   EXPECT_NEAR(p.nanoseconds[kTermLocations] + 16 * p.nanoseconds[kTermAttributeBytes], 0.5, 1e-9);
   EXPECT_NEAR(p.nanoseconds[kTermVertices] + 8 * p.nanoseconds[kTermOutputs], 2.0, 1e-9);
   EXPECT_DOUBLE_EQ(fits[0].spearman, 1.0);
+}
+
+TEST(Calibrate, TwoMeshSizesSeparatePerDrawFromPerVertexCosts) {
+  // A device with a fixed 700 ns per draw and 150 ns per output component per draw (the
+  // pixels a draw covers), beside per-vertex costs: on 2,000 vertices per draw those add
+  // 0.35 + 0.075 x outputs ns per vertex, on 180,000 almost nothing. The fit must find both
+  // parts, state the profile's workload, price each mesh at its own size, and read back.
+  const double perVertex[kTermCount] = {0.002, 0.45, 0, 0, 0.13, 0, 0.07, 0};
+  const double perDraw[kTermCount] = {0, 0, 0, 0, 0, 0, 150, 700};
+  std::vector<CalibrationSample> samples;
+  for (double vertices : {180000.0, 2000.0})
+    for (int locations = 1; locations <= 16; locations += 5)
+      for (int outputs : {8, 24, 64})
+        for (int loads : {0, 8})
+          for (int slots : {20, 200}) {
+            CalibrationSample s;
+            s.label = fmt::format("l{} o{} b{} a{}", locations, outputs, loads, slots);
+            s.mesh = vertices > 10000 ? "big" : "small";
+            s.vertices = vertices;
+            s.validated = true;
+            s.amounts[kTermArithmetic] = slots;
+            s.amounts[kTermLocations] = locations;
+            s.amounts[kTermBufferLoads] = loads;
+            s.amounts[kTermOutputs] = outputs;
+            s.amounts[kTermVertices] = 1;
+            s.measuredNs = 0;
+            for (int t = 0; t < kTermCount; ++t)
+              s.measuredNs += (perVertex[t] + perDraw[t] / vertices) * double(s.amounts[size_t(t)]);
+            samples.push_back(s);
+          }
+  DeviceProfile p = fitDeviceProfile(samples, "two-size device", 180000);
+  ASSERT_TRUE(p.hasDrawWeights());
+  EXPECT_EQ(p.verticesPerDraw, 180000);
+  for (int t = 0; t < kTermCount; ++t) {
+    EXPECT_NEAR(p.nanoseconds[size_t(t)], perVertex[t], 1e-6) << termName(t);
+    EXPECT_NEAR(p.drawNanoseconds[size_t(t)], perDraw[t], 1e-3) << termName(t);
+  }
+  std::vector<CalibrationFit> fits = evaluateFit(samples, p, {"big", "small"});
+  ASSERT_EQ(fits.size(), 2u);
+  for (const auto& f : fits) EXPECT_LT(f.rmsRelativeError, 1e-6) << f.mesh;
+  // The search's weights price the profile's workload: per-vertex + per-draw / 180,000.
+  const TermWeights w = profileWeights(p);
+  EXPECT_EQ(w[kTermOutputs], std::llround((0.07 + 150.0 / 180000) * kFemtosecondsPerNanosecond));
+  // Written and read back, draw weights and workload included.
+  CalibrationReport r;
+  r.profile = p;
+  DeviceProfile back = parseDeviceProfile(deviceProfileYaml(r), "calibrated.yaml");
+  EXPECT_EQ(back.verticesPerDraw, 180000);
+  for (int t = 0; t < kTermCount; ++t)
+    EXPECT_NEAR(back.drawNanoseconds[size_t(t)], p.drawNanoseconds[size_t(t)], 1e-5 * (1 + p.drawNanoseconds[size_t(t)]));
 }
 
 TEST(Calibrate, SpearmanTreatsTimesWithinTheSpreadAsTies) {
