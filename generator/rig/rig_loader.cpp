@@ -136,7 +136,7 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
           e && (!encodingMaxError(*e, a.format) ||
                 (p.swizzle.empty() ? n : static_cast<int>(p.swizzle.size())) != e->components))
         y.fail(swzNode ? *swzNode : body["format"],
-               fmt::format("'{}' ({} {}) must be stored in {}, not {}{}", p.semantic, e->name, e->source,
+               fmt::format("'{}' ({} {}) must be stored in {}, not {}{}", p.semantic, e->name, e->decodesText(),
                            encodingFormats(*e), formatName(a.format), p.swizzle.empty() ? "" : " ." + p.swizzle));
       a.provides.push_back(p);
     };
@@ -187,7 +187,7 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
           if (!providedSemantics.count(u))
             throw InputError(a.loc, fmt::format("'{}' ({} {}) is decoded with the uniform '{}', which the rig does not "
                                                 "declare (docs/rig-format.md, \"Encodings\")", p.semantic, e->name,
-                                                e->source, u));
+                                                e->decodesText(), u));
   checkRig(rig);
   return rig;
 }

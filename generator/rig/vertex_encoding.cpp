@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <glm/gtc/quaternion.hpp>
+
 #include <algorithm>
 #include <cmath>
 
@@ -11,12 +13,25 @@ namespace sg {
 
 const std::vector<VertexEncoding>& vertexEncodings() {
   static const std::vector<VertexEncoding> all = {
-      {"vertex.normal_octahedral", "vertex.normal", "octahedral", "deg", 2, {}},
-      {"vertex.tangent_octahedral", "vertex.tangent", "octahedral", "deg", 2, {}},
-      {"vertex.position_in_bounds", "vertex.position", "bounds", "of the bounds diagonal", 3,
+      {"vertex.normal_octahedral", {"vertex.normal"}, {}, "octahedral", "deg", 2, {}},
+      {"vertex.tangent_octahedral", {"vertex.tangent"}, {}, "octahedral", "deg", 2, {}},
+      {"vertex.position_in_bounds", {"vertex.position"}, {}, "bounds", "of the bounds diagonal", 3,
        {"mesh.bounds_min", "mesh.bounds_extent"}},
+      {"vertex.qtangent", {"vertex.normal", "vertex.tangent"}, {"vertex.handedness"}, "qtangent", "deg", 4, {}},
   };
   return all;
+}
+
+std::vector<std::string> VertexEncoding::decodes() const {
+  std::vector<std::string> out = sources;
+  out.insert(out.end(), exact.begin(), exact.end());
+  return out;
+}
+
+std::string VertexEncoding::decodesText() const {
+  std::string out;
+  for (const std::string& s : decodes()) out += (out.empty() ? "" : ", ") + s;
+  return out;
 }
 
 const VertexEncoding* encodingOf(const std::string& encodedSemantic) {
@@ -28,7 +43,7 @@ const VertexEncoding* encodingOf(const std::string& encodedSemantic) {
 std::vector<const VertexEncoding*> encodingsOf(const std::string& sourceSemantic) {
   std::vector<const VertexEncoding*> out;
   for (const auto& e : vertexEncodings())
-    if (e.source == sourceSemantic) out.push_back(&e);
+    if (std::find(e.sources.begin(), e.sources.end(), sourceSemantic) != e.sources.end()) out.push_back(&e);
   return out;
 }
 
@@ -48,6 +63,44 @@ glm::dvec3 octahedralDecode(const glm::dvec2& e) {
   glm::dvec3 p(e.x, e.y, 1 - std::abs(e.x) - std::abs(e.y));
   if (p.z < 0) p = glm::dvec3((1 - std::abs(e.y)) * signNotZero(e.x), (1 - std::abs(e.x)) * signNotZero(e.y), p.z);
   return glm::normalize(p);
+}
+
+glm::dvec4 qtangentEncode(const glm::dvec3& normal, const glm::dvec3& tangent, double handedness, double bias) {
+  glm::dvec3 n = normal;
+  const double nn = glm::dot(n, n);
+  n = nn > 0 && std::isfinite(nn) ? n / std::sqrt(nn) : glm::dvec3(0, 0, 1);
+  const glm::dvec3 g = tangent - glm::dot(tangent, n) * n;
+  glm::dvec3 t;
+  if (glm::dot(g, g) > 1e-6 * glm::dot(tangent, tangent)) {  // false for a zero or non-finite tangent
+    t = glm::normalize(g);
+  } else {  // object.tangent's fallback: Duff et al. 2017
+    const double s = n.z >= 0 ? 1.0 : -1.0, a = -1 / (s + n.z);
+    t = glm::dvec3(1 + s * n.x * n.x * a, s * n.x * n.y * a, -s * n.x);
+  }
+  glm::dquat q = glm::normalize(glm::quat_cast(glm::dmat3(t, glm::cross(n, t), n)));
+  if ((q.w < 0) != (handedness < 0)) q = -q;  // w carries the handedness
+  const double sign = handedness < 0 ? -1.0 : 1.0;
+  if (std::abs(q.w) < bias) {  // raise |w| to the bias, xyz scaled to stay a unit quaternion
+    const glm::dvec3 v(q.x, q.y, q.z);
+    const glm::dvec3 scaled = v * (std::sqrt(1 - bias * bias) / glm::length(v));
+    return glm::dvec4(scaled, sign * bias);
+  }
+  return glm::dvec4(q.x, q.y, q.z, q.w);
+}
+
+QTangentFrame qtangentDecode(const glm::dvec4& code) {
+  const glm::dvec4 u = glm::normalize(code);
+  const glm::dquat q(u.w, u.x, u.y, u.z);
+  return QTangentFrame{q * glm::dvec3(0, 0, 1), q * glm::dvec3(1, 0, 0), code.w < 0 ? -1.0 : 1.0};
+}
+
+double qtangentBias(VertexFormat f) {
+  switch (f) {
+    case VertexFormat::Snorm8x4: return 1.0 / 127;
+    case VertexFormat::Snorm16x4: return 1.0 / 32767;
+    case VertexFormat::Float16x4: return std::ldexp(1.0, -14);
+    default: return std::ldexp(1.0, -126);  // float32
+  }
 }
 
 PositionBounds positionBounds(const std::vector<glm::vec4>& positions) {
@@ -90,6 +143,19 @@ std::optional<double> encodingMaxError(const VertexEncoding& e, VertexFormat f) 
     }
     return perComponent + std::ldexp(1.0, -24);
   }
+  if (e.name == "qtangent") {
+    double perComponent = 0;
+    switch (f) {
+      case VertexFormat::Snorm8x4: perComponent = 0.5 / 127; break;
+      case VertexFormat::Snorm16x4: perComponent = 0.5 / 32767; break;
+      case VertexFormat::Float16x4: perComponent = std::ldexp(1.0, -12); break;
+      case VertexFormat::Float32x4: perComponent = 0; break;
+      default: return std::nullopt;
+    }
+    const double err = perComponent + std::ldexp(1.0, -24), b = qtangentBias(f);
+    const double c = std::max(2 * err, std::hypot(std::sqrt(3.0) * err + b * b, b));  // see the header
+    return glm::degrees(2 * std::asin(c));
+  }
   if (e.name != "octahedral") return std::nullopt;
   double perComponent = 0;
   switch (f) {
@@ -115,7 +181,8 @@ namespace {
 std::string noEncodingStores(const std::string& semantic) {
   std::string sources;
   for (const auto& e : vertexEncodings())
-    if (sources.find(e.source) == std::string::npos) sources += (sources.empty() ? "" : ", ") + e.source;
+    for (const std::string& s : e.sources)
+      if (sources.find(s) == std::string::npos) sources += (sources.empty() ? "" : ", ") + s;
   return fmt::format("no encoding stores '{}' (budgets apply to {})", semantic, sources);
 }
 }  // namespace
@@ -155,15 +222,19 @@ Rig withinErrorBudgets(const Rig& rig, const std::map<std::string, double>& budg
   for (const RigAttribute& a : rig.attributes)
     for (const auto& p : a.provides) {
       const VertexEncoding* e = encodingOf(p.semantic);
-      auto budget = e ? budgets.find(e->source) : budgets.end();
       const std::optional<double> err = e ? encodingMaxError(*e, a.format) : std::nullopt;
-      if (budget == budgets.end() || !err || *err <= budget->second) continue;
-      over.insert(p.semantic);
-      notes.push_back(Diagnostic{Severity::Note, a.loc,
-                                 fmt::format("{} (attribute '{}', {}) is not offered to the search: it errs up to {:.3g} {}, "
-                                             "over the budget of {:.3g} {} for {} (--max-error)",
-                                             p.semantic, a.name, formatName(a.format), *err, e->unit, budget->second,
-                                             e->unit, e->source)});
+      if (!err) continue;
+      for (const std::string& source : e->sources) {  // the first budget it breaks removes it
+        auto budget = budgets.find(source);
+        if (budget == budgets.end() || *err <= budget->second) continue;
+        over.insert(p.semantic);
+        notes.push_back(Diagnostic{Severity::Note, a.loc,
+                                   fmt::format("{} (attribute '{}', {}) is not offered to the search: it errs up to {:.3g} {}, "
+                                               "over the budget of {:.3g} {} for {} (--max-error)",
+                                               p.semantic, a.name, formatName(a.format), *err, e->unit, budget->second,
+                                               e->unit, source)});
+        break;
+      }
     }
   return withoutProvided(rig, over);
 }

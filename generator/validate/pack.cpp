@@ -25,7 +25,7 @@ PackedVertices packVertices(const GenerateResult& r, const rt::Mesh& mesh) {
                              {"components", p.swizzle.empty() ? std::string("xyzw").substr(0, formatComponents(a.format))
                                                               : p.swizzle}};
       if (const VertexEncoding* e = encodingOf(p.semantic)) {
-        part["encodes"] = e->source;
+        part["encodes"] = e->decodes();
         part["encoding"] = e->name;
         if (e->angular()) {
           part["max_error_deg"] = *encodingMaxError(*e, a.format);

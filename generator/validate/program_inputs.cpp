@@ -80,12 +80,16 @@ void renormaliseWeights(const Rig& rig, rt::Mesh& m) {
   }
 }
 
-// The encoded semantics the rig stores (rig/vertex_encoding.h).
-std::vector<const VertexEncoding*> storedEncodings(const Rig& rig) {
-  std::vector<const VertexEncoding*> out;
+// The encoded semantics the rig stores (rig/vertex_encoding.h), with their formats.
+struct StoredEncoding {
+  const VertexEncoding* e;
+  VertexFormat format;
+};
+std::vector<StoredEncoding> storedEncodings(const Rig& rig) {
+  std::vector<StoredEncoding> out;
   for (const auto& a : rig.attributes)
     for (const auto& p : a.provides)
-      if (const VertexEncoding* e = encodingOf(p.semantic); e && !a.perMorphTarget) out.push_back(e);
+      if (const VertexEncoding* e = encodingOf(p.semantic); e && !a.perMorphTarget) out.push_back({e, a.format});
   return out;
 }
 
@@ -114,14 +118,47 @@ PositionBounds boundsFor(const VertexEncoding& e, const rt::Mesh& m) {
   return b;
 }
 
-glm::vec4 encodeValue(const VertexEncoding& e, const PositionBounds& bounds, const glm::vec4& v) {
-  if (e.name == "bounds") return glm::vec4(glm::vec3(boundsEncode(bounds, glm::dvec3(v))), 0);
-  return glm::vec4(glm::vec2(octahedralEncode(glm::dvec3(v))), 0, 0);
+// Every vertex's code from the mesh's float values (each one the encoding decodes).
+std::vector<glm::vec4> encodeFrom(const StoredEncoding& se, const PositionBounds& bounds, const rt::Mesh& m) {
+  const VertexEncoding& e = *se.e;
+  std::vector<const std::vector<glm::vec4>*> in;
+  for (const std::string& sem : e.decodes()) in.push_back(&m.at(sem));
+  std::vector<glm::vec4> code(m.vertexCount, glm::vec4(0));
+  for (size_t v = 0; v < m.vertexCount; ++v) {
+    const glm::dvec3 first((*in[0])[v]);
+    if (e.name == "bounds")
+      code[v] = glm::vec4(glm::vec3(boundsEncode(bounds, first)), 0);
+    else if (e.name == "qtangent")  // normal, tangent, handedness
+      code[v] = glm::vec4(qtangentEncode(first, glm::dvec3((*in[1])[v]), (*in[2])[v].x, qtangentBias(se.format)));
+    else
+      code[v] = glm::vec4(glm::vec2(octahedralEncode(first)), 0, 0);
+  }
+  return code;
 }
 
-glm::vec3 decodeValue(const VertexEncoding& e, const PositionBounds& bounds, const glm::vec4& code) {
-  if (e.name == "bounds") return glm::vec3(boundsDecode(bounds, glm::dvec3(code)));
-  return glm::vec3(octahedralDecode(glm::dvec2(code)));
+// The decode of every vertex's code written over the values it encodes, in their first
+// components (the streams looked up once, not per vertex).
+void decodeInto(const VertexEncoding& e, const PositionBounds& bounds, const std::vector<glm::vec4>& code, rt::Mesh& m) {
+  std::vector<std::vector<glm::vec4>*> out;
+  for (const std::string& sem : e.decodes()) {
+    out.push_back(&m.streams[sem]);
+    out.back()->resize(m.vertexCount, glm::vec4(0));
+  }
+  auto put = [](glm::vec4& dst, const glm::dvec3& x, int n) {
+    for (int k = 0; k < n; ++k) dst[k] = static_cast<float>(x[k]);
+  };
+  for (size_t v = 0; v < m.vertexCount; ++v) {
+    if (e.name == "bounds") {
+      put((*out[0])[v], boundsDecode(bounds, glm::dvec3(code[v])), 3);
+    } else if (e.name == "qtangent") {  // normal, tangent, handedness
+      const QTangentFrame f = qtangentDecode(glm::dvec4(code[v]));
+      put((*out[0])[v], f.normal, 3);
+      put((*out[1])[v], f.tangent, 3);
+      put((*out[2])[v], glm::dvec3(f.handedness), 1);
+    } else {
+      put((*out[0])[v], octahedralDecode(glm::dvec2(code[v])), 3);
+    }
+  }
 }
 
 rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
@@ -133,24 +170,20 @@ rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
   // carry one value, and a decode rule is checked exactly (its rounding is the budget's
   // business, not validation's).
   const auto encodings = storedEncodings(rig);
-  for (const VertexEncoding* e : encodings) {
-    auto src = m.streams.find(e->source);
-    if (m.has(e->encoded) || src == m.streams.end()) continue;
-    const PositionBounds bounds = boundsFor(*e, m);
-    std::vector<glm::vec4> code(m.vertexCount, glm::vec4(0));
-    for (size_t v = 0; v < m.vertexCount && v < src->second.size(); ++v) code[v] = encodeValue(*e, bounds, src->second[v]);
-    m.streams[e->encoded] = std::move(code);
+  for (const StoredEncoding& se : encodings) {
+    const std::vector<std::string> values = se.e->decodes();
+    if (m.has(se.e->encoded) || !std::all_of(values.begin(), values.end(), [&](const auto& s) {
+          return m.has(s) && m.at(s).size() >= m.vertexCount;
+        }))
+      continue;
+    m.streams[se.e->encoded] = encodeFrom(se, boundsFor(*se.e, m), m);
   }
   renormaliseWeights(rig, m);
   quantizeStreams(rig, m);
   if (encodings.empty()) return m;
-  for (const VertexEncoding* e : encodings) {
-    if (!m.has(e->encoded)) continue;
-    const auto& code = m.at(e->encoded);
-    auto& src = m.streams[e->source];
-    const PositionBounds bounds = boundsFor(*e, m);
-    src.resize(m.vertexCount, glm::vec4(0));
-    for (size_t v = 0; v < m.vertexCount; ++v) src[v] = glm::vec4(decodeValue(*e, bounds, code[v]), src[v].w);
+  for (const StoredEncoding& se : encodings) {
+    if (!m.has(se.e->encoded)) continue;
+    decodeInto(*se.e, boundsFor(*se.e, m), m.at(se.e->encoded), m);
   }
   quantizeStreams(rig, m);  // a source the rig stores too, in a rounded format
   return m;
