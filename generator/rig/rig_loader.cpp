@@ -138,6 +138,10 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
         y.fail(swzNode ? *swzNode : body["format"],
                fmt::format("'{}' ({} {}) must be stored in {}, not {}{}", p.semantic, e->name, e->decodesText(),
                            encodingFormats(*e), formatName(a.format), p.swizzle.empty() ? "" : " ." + p.swizzle));
+      if (const VertexEncoding* e = encodingOf(p.semantic); e && e->perTarget != a.perMorphTarget)
+        y.fail(semNode, fmt::format("'{}' ({} {}) is {}stored per morph target: its attribute needs 'per_target: {}'",
+                                    p.semantic, e->name, e->decodesText(), e->perTarget ? "" : "not ",
+                                    e->perTarget ? "true" : "false"));
       a.provides.push_back(p);
     };
     if (prov.IsScalar()) {

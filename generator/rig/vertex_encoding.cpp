@@ -18,6 +18,7 @@ const std::vector<VertexEncoding>& vertexEncodings() {
       {"vertex.position_in_bounds", {"vertex.position"}, {}, "bounds", "of the bounds diagonal", 3,
        {"mesh.bounds_min", "mesh.bounds_extent"}},
       {"vertex.qtangent", {"vertex.normal", "vertex.tangent"}, {"vertex.handedness"}, "qtangent", "deg", 4, {}},
+      {"morph.position_scaled", {"morph.position"}, {}, "scaled", "of the target's scale", 3, {"morph.position_scale"}, true},
   };
   return all;
 }
@@ -64,6 +65,25 @@ glm::dvec3 octahedralDecode(const glm::dvec2& e) {
   if (p.z < 0) p = glm::dvec3((1 - std::abs(e.y)) * signNotZero(e.x), (1 - std::abs(e.x)) * signNotZero(e.y), p.z);
   return glm::normalize(p);
 }
+
+float deltaScale(const std::vector<glm::vec4>& deltas) {
+  double largest = 0;
+  for (const glm::vec4& d : deltas)
+    for (int k = 0; k < 3; ++k)
+      if (std::isfinite(d[k])) largest = std::max(largest, std::abs(double(d[k])));
+  float scale = static_cast<float>(largest);
+  if (double(scale) < largest) scale = std::nextafter(scale, INFINITY);
+  return scale;
+}
+
+glm::dvec3 scaledEncode(float scale, const glm::dvec3& delta) {
+  glm::dvec3 code(0);
+  for (int k = 0; k < 3; ++k)
+    if (scale > 0 && std::isfinite(delta[k])) code[k] = std::clamp(delta[k] / scale, -1.0, 1.0);
+  return code;
+}
+
+glm::dvec3 scaledDecode(float scale, const glm::dvec3& code) { return code * double(scale); }
 
 glm::dvec4 qtangentEncode(const glm::dvec3& normal, const glm::dvec3& tangent, double handedness, double bias) {
   glm::dvec3 n = normal;
@@ -143,6 +163,18 @@ std::optional<double> encodingMaxError(const VertexEncoding& e, VertexFormat f) 
     }
     return perComponent + std::ldexp(1.0, -24);
   }
+  if (e.name == "scaled") {
+    double perComponent = 0;
+    switch (f) {
+      case VertexFormat::Snorm8x4: perComponent = 0.5 / 127; break;
+      case VertexFormat::Snorm10_10_10_2: perComponent = 0.5 / 511; break;
+      case VertexFormat::Snorm16x4: perComponent = 0.5 / 32767; break;
+      case VertexFormat::Float16x4: perComponent = std::ldexp(1.0, -12); break;  // codes in [-1, 1]: steps <= 2^-11
+      case VertexFormat::Float32x3: case VertexFormat::Float32x4: perComponent = 0; break;
+      default: return std::nullopt;
+    }
+    return std::sqrt(3.0) * (perComponent + std::ldexp(1.0, -24));
+  }
   if (e.name == "qtangent") {
     double perComponent = 0;
     switch (f) {
@@ -205,7 +237,7 @@ std::optional<double> parseErrorBudget(const std::string& semantic, const std::s
     used = 0;
   }
   const std::string expected = angle ? fmt::format("a positive angle in deg or rad ({}=0.1deg)", semantic)
-                                     : fmt::format("a positive fraction of the bounds diagonal ({}=1e-4)", semantic);
+                                     : fmt::format("a positive fraction {} ({}=1e-4)", encodings.front()->unit, semantic);
   if (number.empty() || used != number.size() || !std::isfinite(value) || value <= 0 || (angle != (deg || rad))) {
     why = fmt::format("expected {}, got '{}'", expected, text);
     return std::nullopt;
@@ -228,11 +260,19 @@ Rig withinErrorBudgets(const Rig& rig, const std::map<std::string, double>& budg
         auto budget = budgets.find(source);
         if (budget == budgets.end() || *err <= budget->second) continue;
         over.insert(p.semantic);
-        notes.push_back(Diagnostic{Severity::Note, a.loc,
-                                   fmt::format("{} (attribute '{}', {}) is not offered to the search: it errs up to {:.3g} {}, "
-                                               "over the budget of {:.3g} {} for {} (--max-error)",
-                                               p.semantic, a.name, formatName(a.format), *err, e->unit, budget->second,
-                                               e->unit, source)});
+        const std::string why = fmt::format("{} (attribute '{}', {}) is not offered to the search: it errs up to {:.3g} {}, "
+                                            "over the budget of {:.3g} {} for {} (--max-error)",
+                                            p.semantic, a.name, formatName(a.format), *err, e->unit, budget->second,
+                                            e->unit, source);
+        // Without its deltas a morph target would silently stop moving the value (the
+        // unmorphed rules apply): no plan meets the budget, unless the rig stores them plainly too.
+        if (e->perTarget && !std::any_of(rig.attributes.begin(), rig.attributes.end(), [&](const RigAttribute& b) {
+              return b.perMorphTarget && std::any_of(b.provides.begin(), b.provides.end(),
+                                                     [&](const ProvidedPart& q) { return q.semantic == source; });
+            }))
+          throw InputError(a.loc, why + fmt::format("; the rig stores no other {} deltas, and its morph targets must move it",
+                                                    source));
+        notes.push_back(Diagnostic{Severity::Note, a.loc, why});
         break;
       }
     }

@@ -23,10 +23,13 @@ struct VertexEncoding {
   std::vector<std::string> sources;  // what it encodes, each within its stated error: {"vertex.normal"}
   std::vector<std::string> exact;    // what it encodes exactly besides (a QTangent's vertex.handedness)
   std::string name;                  // "octahedral", "bounds", "qtangent"
-  std::string unit;  // the unit of its error: "deg" (an angle), "of the bounds diagonal" (a fraction)
+  // The unit of its error: "deg" (an angle), "of the bounds diagonal", "of the target's scale" (fractions).
+  std::string unit;
   int components = 2;  // of the stored code
-  // Uniforms its decode reads, which the host derives from the mesh (bounds: min, extent).
+  // Uniforms its decode reads, which the host derives from the mesh (bounds: min, extent;
+  // per-target scales: one value per morph target).
   std::vector<std::string> uniforms;
+  bool perTarget = false;  // a code per morph target, stored by a per_target attribute
   bool angular() const { return unit == "deg"; }
   // Every value its decode gives: sources, then exact.
   std::vector<std::string> decodes() const;
@@ -59,6 +62,17 @@ struct PositionBounds {
 PositionBounds positionBounds(const std::vector<glm::vec4>& positions);
 glm::dvec3 boundsEncode(const PositionBounds& b, const glm::dvec3& p);
 glm::dvec3 boundsDecode(const PositionBounds& b, const glm::dvec3& code);
+
+// Morph deltas relative to their target's scale (as Godot and gltfpack quantise them): the
+// code of target i's delta d is d / scale_i in [-1, 1]^3, which a snorm format holds;
+// the decode multiplies by scale_i, a uniform array over the targets
+// (morph.position_scale), which the morph sum folds into the target's weight. scale_i is
+// the largest |component| of the target's finite deltas, as a float32 rounded up so no
+// code exceeds 1; a target that moves nothing has scale 0 and codes 0, and a non-finite
+// component encodes as 0.
+float deltaScale(const std::vector<glm::vec4>& deltas);
+glm::dvec3 scaledEncode(float scale, const glm::dvec3& delta);
+glm::dvec3 scaledDecode(float scale, const glm::dvec3& code);
 
 // QTangents (Frey and Herzog, "Spherical Skinning with Dual-Quaternions and QTangents",
 // SIGGRAPH 2011): the tangent frame as the unit quaternion q = (x, y, z, w) of the rotation
@@ -110,6 +124,11 @@ double qtangentBias(VertexFormat f);
 // the rounding only moves xyz: c <= sqrt((sqrt(3) e + b^2)^2 + b^2). The larger of the two:
 // snorm8 1.20 deg, snorm16 0.0046 deg, float16 0.056 deg, float32 1.4e-5 deg. The
 // handedness is exact (|w| >= b reads back with its sign).
+// Scaled morph deltas, three components of snorm8x4 / snorm10-10-10-2 / snorm16x4 /
+// float16x4 / float32x3/x4: a code off by e per component (half a step of the format, plus
+// the code's float32 rounding; float16 as for QTangents) moves the delta by e of the
+// target's scale per component, so by at most sqrt(3) e of it: snorm8 6.8e-3, 10-bit
+// 1.7e-3, snorm16 2.65e-5, float16 4.2e-4 of the target's largest |component|.
 // std::nullopt: the format cannot hold the encoding.
 std::optional<double> encodingMaxError(const VertexEncoding& e, VertexFormat f);
 // The formats it may be stored in, for messages: "snorm8x2, snorm8x4, ... (2 components)".
@@ -132,7 +151,8 @@ std::vector<const VertexEncoding*> encodingsOf(const std::string& sourceSemantic
 // encoding's source is an InputError.
 Rig withinErrorBudgets(const Rig& rig, const std::map<std::string, double>& budgets, std::vector<Diagnostic>& notes);
 // A budget as written after "SEMANTIC=": an angle with "deg" or "rad" for a direction, a
-// plain fraction for a position ("1e-4"); the value in the encodings' unit, or std::nullopt
+// plain fraction for a position ("1e-4", of the bounds diagonal) or a morph delta (of its
+// target's scale); the value in the encodings' unit, or std::nullopt
 // with `why` set (also when the semantic has no encoding).
 std::optional<double> parseErrorBudget(const std::string& semantic, const std::string& text, std::string& why);
 

@@ -29,6 +29,9 @@ PackedVertices packVertices(const GenerateResult& r, const rt::Mesh& mesh) {
         part["encoding"] = e->name;
         if (e->angular()) {
           part["max_error_deg"] = *encodingMaxError(*e, a.format);
+        } else if (e->perTarget) {  // scaled deltas: delta = code * scale, the target's own
+          part["max_error_of_target_scale"] = *encodingMaxError(*e, a.format);
+          part["scale"] = quantized.uniforms.at(e->uniforms.at(0)).at(static_cast<size_t>(in.target));
         } else {  // bounds: source = bias + code * scale, the code as the format reads it
           part["max_error_of_bounds_diagonal"] = *encodingMaxError(*e, a.format);
           part["bias"] = quantized.uniforms.at(e->uniforms.at(0));

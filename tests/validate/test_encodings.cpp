@@ -453,6 +453,94 @@ TEST(QTangent, ABudgetTighterThanTheEncodingRemovesIt) {
   EXPECT_NE(why.find("no encoding stores 'vertex.handedness'"), std::string::npos) << why;
 }
 
+// Morph deltas relative to their target's scale, checked from the definition: the scale is
+// the target's largest |component| (rounded up by at most one float step), every code lies
+// in [-1, 1], and a delta read back through each format errs by at most the stated fraction
+// of its target's scale, and for 8 bits nearly that much. Targets of very different sizes,
+// one that moves nothing, and non-finite components (left out, encoded as 0).
+TEST(ScaledDeltas, CodesLieInTheUnitCubeAndDecodeWithinTheStatedError) {
+  const sg::VertexEncoding& scaled = *sg::encodingOf("morph.position_scaled");
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (const double size : {1e-4, 1.0, 300.0, 0.0}) {
+    std::vector<glm::vec4> deltas;
+    for (int i = 0; i < 100000; ++i) deltas.emplace_back(glm::vec3(size * glm::dvec3(u(rng), 0.5 * u(rng), u(rng))), 0);
+    deltas.emplace_back(NAN, INFINITY, -INFINITY, 0);
+    const float scale = sg::deltaScale(deltas);
+    double largest = 0;
+    for (size_t i = 0; i + 1 < deltas.size(); ++i)
+      for (int k = 0; k < 3; ++k) largest = std::max(largest, std::abs(double(deltas[i][k])));
+    EXPECT_GE(double(scale), largest);
+    EXPECT_LE(double(scale), largest * (1 + std::ldexp(1.0, -23)));
+    EXPECT_EQ(sg::scaledEncode(scale, glm::dvec3(deltas.back())), glm::dvec3(0));
+    for (sg::VertexFormat f : {sg::VertexFormat::Snorm8x4, sg::VertexFormat::Snorm10_10_10_2, sg::VertexFormat::Snorm16x4,
+                               sg::VertexFormat::Float16x4}) {
+      const double bound = *sg::encodingMaxError(scaled, f);
+      double worst = 0;
+      for (size_t i = 0; i + 1 < deltas.size(); ++i) {
+        const glm::vec3 code(sg::scaledEncode(scale, glm::dvec3(deltas[i])));  // stored from float data
+        ASSERT_TRUE(glm::all(glm::lessThanEqual(glm::abs(code), glm::vec3(1))));
+        glm::dvec3 read;
+        for (int k = 0; k < 3; ++k) read[k] = sg::storedValue(f, k, code[k]);
+        const double err = glm::length(sg::scaledDecode(scale, read) - glm::dvec3(deltas[i]));
+        if (size == 0) ASSERT_EQ(err, 0.0);
+        else worst = std::max(worst, err / scale);
+      }
+      if (size == 0) continue;
+      std::cout << sg::formatName(f) << " (size " << size << "): worst " << worst << " of the scale, stated " << bound << "\n";
+      EXPECT_LE(worst, bound) << sg::formatName(f);
+      if (f == sg::VertexFormat::Snorm8x4) EXPECT_GE(worst, 0.8 * bound);
+    }
+  }
+  EXPECT_NEAR(*sg::encodingMaxError(scaled, sg::VertexFormat::Snorm16x4), 2.653e-5, 0.001e-5);  // sqrt(3) (0.5/32767 + 2^-24)
+  EXPECT_FALSE(sg::encodingMaxError(scaled, sg::VertexFormat::Unorm16x4));  // deltas are signed
+}
+
+sg::ValidateReport validateScaled(const std::string& rules, std::map<std::string, double> budgets = {}) {
+  return validateWith("morph_scaled.rig.yaml", rules, std::move(budgets));
+}
+
+// Four targets' position deltas as snorm16 codes and a scale each: the plan sums them with
+// the scale folded into the weight, and the device agrees with the reference everywhere.
+TEST(ScaledDeltas, MorphedLimbValidatesOnTheDevice) {
+  sg::ValidateReport rep = validateScaled(sourcePath("rules/standard.yaml"));
+  EXPECT_TRUE(rep.pass);
+  ASSERT_FALSE(rep.runs.empty());
+  EXPECT_TRUE(sgtest::planHas(rep.runs[0], "object_position_morphed_scaled"));
+}
+
+// A sum that forgets the scale moves every vertex by the codes themselves: validation fails
+// the outputs that depend on the position, and only those.
+TEST(ScaledDeltas, PlantedMissingScaleFailsValidation) {
+  sgtest::RulesCopy rules("scaled_missing_scale");
+  ASSERT_TRUE(rules.edit("morph.yaml", "(${morph.weights}[${i}] * ${morph.position_scale}[${i}])", "${morph.weights}[${i}]"));
+  sg::ValidateReport broken = validateScaled(rules.rulesFile("standard.yaml").string());
+  EXPECT_FALSE(broken.pass);
+  const std::set<std::string> failed = sgtest::failingOutputs(broken.runs.at(0));
+  EXPECT_TRUE(failed.count("world_position")) << ::testing::PrintToString(failed);
+  EXPECT_TRUE(failed.count("gl_Position")) << ::testing::PrintToString(failed);
+  EXPECT_FALSE(failed.count("world_normal"));
+}
+
+// A delta budget below snorm16's 2.65e-5 of the scale would remove the codes, and with
+// them the targets' movement (the unmorphed rule would apply): refused at the attribute.
+// A budget above it changes nothing.
+TEST(ScaledDeltas, ABudgetTighterThanTheEncodingIsRefused) {
+  try {
+    validateScaled(sourcePath("rules/standard.yaml"), {{"morph.position", 1e-6}});
+    FAIL() << "expected the budget to be refused";
+  } catch (const sg::InputError& e) {
+    const std::string all = sg::formatDiagnostic(e.diagnostic());
+    EXPECT_NE(all.find("morph_scaled.rig.yaml:15:3: error: morph.position_scaled (attribute 'position_morph', snorm16x4) "
+                       "is not offered to the search: it errs up to 2.65e-05 of the target's scale, over the budget of "
+                       "1e-06 of the target's scale for morph.position (--max-error); the rig stores no other "
+                       "morph.position deltas"),
+              std::string::npos)
+        << all;
+  }
+  EXPECT_TRUE(validateScaled(sourcePath("rules/standard.yaml"), {{"morph.position", 1e-4}}).pass);
+}
+
 }  // namespace
 
 namespace {
