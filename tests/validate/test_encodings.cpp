@@ -691,6 +691,97 @@ TEST(Pack, RealModelsFrameReadBackFromTheLayoutWithinTheStatedError) {
   EXPECT_GT(worstPosition, 0.0);
 }
 
+// The same model with its whole frame as one snorm16x4 QTangent and its position deltas as
+// snorm16 codes with a scale per target: it validates on the device against the reference
+// on what the device reads, and the packed bytes, read back by the layout alone (the
+// quaternion rotated with the test's own product, each delta as code * the part's scale),
+// give the model's own normals, tangents (orthonormalised), handedness and deltas within
+// the stated errors.
+TEST(Pack, RealModelsQTangentsAndScaledDeltasReadBackFromTheLayout) {
+  const std::string model = std::string(SG_SHARED_DIR) + "/models/AnimatedMorphSphere/AnimatedMorphSphere.gltf#0/0";
+  if (!std::filesystem::exists(std::string(SG_SHARED_DIR) + "/models/AnimatedMorphSphere")) GTEST_SKIP() << "no ../shared";
+  sg::Rig rig = sg::importGltf(model.substr(0, model.find('#'))).rig;
+  std::erase_if(rig.attributes, [](const sg::RigAttribute& a) { return a.name == "tangent"; });
+  for (auto& a : rig.attributes) {
+    if (a.name == "normal") {
+      a.format = sg::VertexFormat::Snorm16x4;
+      a.provides = {{"vertex.qtangent", ""}};
+    } else if (a.name == "position_morph") {
+      a.format = sg::VertexFormat::Snorm16x4;
+      a.provides = {{"morph.position_scaled", "xyz"}};
+    }
+  }
+  rig.uniforms.push_back({"morph_scale", "morph.position_scale", sg::Type::Float, "morph_targets", 2, {}});
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("sg_pack_qt_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string rigPath = (dir / "sphere.rig.yaml").string();
+  sgtest::writeText(rigPath, sg::rigToYaml(rig));
+
+  sg::ValidateOptions vo;
+  vo.gen.rigPath = rigPath;
+  vo.gen.fragmentPath = sourcePath("tests/gltf/data/frame.frag");
+  vo.gen.rulesPaths = {sourcePath("rules/standard.yaml")};
+  const sg::ValidationScene scene = sg::gltfScene(model, sg::GltfSceneOptions{});
+  sg::Validator validator(vo);
+  const sg::ValidateReport rep = validator.run(scene);
+  std::cout << sg::formatReport(rep);
+  EXPECT_TRUE(rep.pass);
+  ASSERT_FALSE(rep.runs.empty());
+  EXPECT_TRUE(sgtest::planHas(rep.runs[0], "vertex_normal_from_qtangent"));
+  EXPECT_TRUE(sgtest::planHas(rep.runs[0], "object_position_morphed_scaled"));
+
+  const sg::GenerateResult r = sg::generate(vo.gen);
+  const sg::PackedVertices packed = sg::packVertices(r, scene.mesh);
+  std::filesystem::remove_all(dir);
+  const nlohmann::json layout = nlohmann::json::parse(packed.layoutJson);
+  auto snorm16 = [&](const nlohmann::json& s, size_t v, int c) {
+    int16_t raw;
+    std::memcpy(&raw, packed.bytes.data() + s["offset"].get<size_t>() + v * s["stride"].get<size_t>() + 2 * c, 2);
+    return std::max(raw / 32767.0, -1.0);
+  };
+  const auto& n = scene.mesh.at("vertex.normal");
+  const auto& t = scene.mesh.at("vertex.tangent");
+  const auto& w = scene.mesh.at("vertex.handedness");
+  int targetsRead = 0;
+  for (const auto& s : layout["streams"]) {
+    const nlohmann::json& part = s["provides"][0];
+    if (s["attribute"] == "normal") {
+      ASSERT_EQ(part["encodes"], nlohmann::json::array({"vertex.normal", "vertex.tangent", "vertex.handedness"}));
+      const double bound = part["max_error_deg"];
+      double worst = 0;
+      size_t handednessWrong = 0;
+      for (size_t v = 0; v < scene.mesh.vertexCount; ++v) {
+        const glm::dvec4 q(snorm16(s, v, 0), snorm16(s, v, 1), snorm16(s, v, 2), snorm16(s, v, 3));
+        const Frame f{glm::dvec3(n[v]), glm::dvec3(t[v]), w[v].x};
+        worst = std::max(worst, angleDegrees(rotate(q, {0, 0, 1}), f.normal));
+        if (const auto want = expectedTangent(f)) worst = std::max(worst, angleDegrees(rotate(q, {1, 0, 0}), *want));
+        handednessWrong += (q.w < 0) != (f.handedness < 0);
+      }
+      std::cout << "QTangents: worst " << worst << " deg (stated " << bound << ")\n";
+      EXPECT_LE(worst, bound);
+      EXPECT_GT(worst, 0.0);
+      EXPECT_EQ(handednessWrong, 0u);
+    }
+    if (s["attribute"] == "position_morph") {
+      const int target = s["target"];
+      const double scale = part["scale"], bound = part["max_error_of_target_scale"];
+      EXPECT_EQ(layout["uniforms"]["morph.position_scale"][target], part["scale"]);
+      const auto& d = scene.mesh.at("morph.position[" + std::to_string(target) + "]");
+      double worst = 0;
+      for (size_t v = 0; v < scene.mesh.vertexCount; ++v) {
+        const glm::dvec3 read(snorm16(s, v, 0) * scale, snorm16(s, v, 1) * scale, snorm16(s, v, 2) * scale);
+        worst = std::max(worst, glm::length(read - glm::dvec3(d[v])) / scale);
+      }
+      std::cout << "target " << target << " (scale " << scale << "): worst " << worst << " of the scale (stated " << bound
+                << ")\n";
+      EXPECT_LE(worst, bound);
+      EXPECT_GT(worst, 0.0);
+      ++targetsRead;
+    }
+  }
+  EXPECT_EQ(targetsRead, 2);
+}
+
 }  // namespace
 
 namespace {
