@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 
 #include "common/diagnostics.h"
 
@@ -150,55 +151,53 @@ glm::dvec3 boundsDecode(const PositionBounds& b, const glm::dvec3& code) {
   return glm::dvec3(b.min) + code * glm::dvec3(b.extent);
 }
 
+namespace {
+// How far a code component in [-1, 1] can be from what the device reads of it in f: half a
+// step of a normalized format, 2^-12 for float16 (its steps are <= 2^-11 below 1), plus the
+// float32 rounding of the code before it is stored (2^-24).
+double codeRounding(VertexFormat f) {
+  double half = 0;
+  switch (f) {
+    case VertexFormat::Snorm8x2: case VertexFormat::Snorm8x4: half = 0.5 / 127; break;
+    case VertexFormat::Snorm10_10_10_2: half = 0.5 / 511; break;
+    case VertexFormat::Snorm16x2: case VertexFormat::Snorm16x4: half = 0.5 / 32767; break;
+    case VertexFormat::Unorm8x2: case VertexFormat::Unorm8x4: half = 0.5 / 255; break;
+    case VertexFormat::Unorm10_10_10_2: half = 0.5 / 1023; break;
+    case VertexFormat::Unorm16x2: case VertexFormat::Unorm16x4: half = 0.5 / 65535; break;
+    case VertexFormat::Float16x2: case VertexFormat::Float16x4: half = std::ldexp(1.0, -12); break;
+    default: break;  // float32: the code itself
+  }
+  return half + std::ldexp(1.0, -24);
+}
+
+bool oneOf(VertexFormat f, std::initializer_list<VertexFormat> formats) {
+  return std::find(formats.begin(), formats.end(), f) != formats.end();
+}
+}  // namespace
+
 std::optional<double> encodingMaxError(const VertexEncoding& e, VertexFormat f) {
-  if (e.name == "bounds") {
-    double perComponent = 0;
-    switch (f) {
-      case VertexFormat::Unorm8x4: perComponent = 0.5 / 255; break;
-      case VertexFormat::Unorm10_10_10_2: perComponent = 0.5 / 1023; break;
-      case VertexFormat::Unorm16x4: perComponent = 0.5 / 65535; break;
-      case VertexFormat::Float16x4: perComponent = std::ldexp(1.0, -12); break;  // codes in [0, 1]: steps <= 2^-11
-      case VertexFormat::Float32x3: case VertexFormat::Float32x4: perComponent = 0; break;
-      default: return std::nullopt;
-    }
-    return perComponent + std::ldexp(1.0, -24);
+  using F = VertexFormat;
+  if (e.name == "bounds") {  // codes in [0, 1]
+    if (!oneOf(f, {F::Unorm8x4, F::Unorm10_10_10_2, F::Unorm16x4, F::Float16x4, F::Float32x3, F::Float32x4})) return std::nullopt;
+    return codeRounding(f);
   }
   if (e.name == "scaled") {
-    double perComponent = 0;
-    switch (f) {
-      case VertexFormat::Snorm8x4: perComponent = 0.5 / 127; break;
-      case VertexFormat::Snorm10_10_10_2: perComponent = 0.5 / 511; break;
-      case VertexFormat::Snorm16x4: perComponent = 0.5 / 32767; break;
-      case VertexFormat::Float16x4: perComponent = std::ldexp(1.0, -12); break;  // codes in [-1, 1]: steps <= 2^-11
-      case VertexFormat::Float32x3: case VertexFormat::Float32x4: perComponent = 0; break;
-      default: return std::nullopt;
-    }
-    return std::sqrt(3.0) * (perComponent + std::ldexp(1.0, -24));
+    if (!oneOf(f, {F::Snorm8x4, F::Snorm10_10_10_2, F::Snorm16x4, F::Float16x4, F::Float32x3, F::Float32x4})) return std::nullopt;
+    return std::sqrt(3.0) * codeRounding(f);
   }
   if (e.name == "qtangent") {
-    double perComponent = 0;
-    switch (f) {
-      case VertexFormat::Snorm8x4: perComponent = 0.5 / 127; break;
-      case VertexFormat::Snorm16x4: perComponent = 0.5 / 32767; break;
-      case VertexFormat::Float16x4: perComponent = std::ldexp(1.0, -12); break;
-      case VertexFormat::Float32x4: perComponent = 0; break;
-      default: return std::nullopt;
-    }
-    const double err = perComponent + std::ldexp(1.0, -24), b = qtangentBias(f);
+    if (!oneOf(f, {F::Snorm8x4, F::Snorm16x4, F::Float16x4, F::Float32x4})) return std::nullopt;
+    const double err = codeRounding(f), b = qtangentBias(f);
     const double c = std::max(2 * err, std::hypot(std::sqrt(3.0) * err + b * b, b));  // see the header
     return glm::degrees(2 * std::asin(c));
   }
   if (e.name != "octahedral") return std::nullopt;
-  double perComponent = 0;
-  switch (f) {
-    case VertexFormat::Snorm8x2: case VertexFormat::Snorm8x4: perComponent = 0.5 / 127; break;
-    case VertexFormat::Snorm16x2: case VertexFormat::Snorm16x4: perComponent = 0.5 / 32767; break;
-    case VertexFormat::Float16x2: case VertexFormat::Float16x4: perComponent = std::ldexp(1.0, -11); break;
-    case VertexFormat::Float32x2: case VertexFormat::Float32x4: perComponent = 0; break;
-    default: return std::nullopt;
-  }
-  perComponent += std::ldexp(1.0, -24);
-  return glm::degrees(std::sqrt(18.0) * perComponent);
+  if (!oneOf(f, {F::Snorm8x2, F::Snorm8x4, F::Snorm16x2, F::Snorm16x4, F::Float16x2, F::Float16x4, F::Float32x2,
+                 F::Float32x4}))
+    return std::nullopt;
+  // float16 as first stated, a whole step (half of one, codeRounding, would do too)
+  const bool float16 = f == F::Float16x2 || f == F::Float16x4;
+  return glm::degrees(std::sqrt(18.0) * (float16 ? std::ldexp(1.0, -11) + std::ldexp(1.0, -24) : codeRounding(f)));
 }
 
 std::string encodingFormats(const VertexEncoding& e) {
