@@ -146,9 +146,10 @@ std::vector<const VertexEncoding*> encodingsOf(const std::string& sourceSemantic
 
 // Error budgets (--max-error): the worst error allowed per source semantic, in its
 // encodings' unit (degrees for a direction, a fraction of the bounds diagonal for a
-// position). The rig without the encoded parts over budget (an attribute left with no part
-// goes too), so the search is never offered them; one note per removal. A budget naming no
-// encoding's source is an InputError.
+// position, of the target's scale for a morph delta). The rig without the encoded parts over
+// budget (an attribute left with no part goes too), so the search is never offered them; one
+// note per removal. A budget naming no encoding's source is an InputError, and so is one
+// that removes a morph delta's only stored form (its targets would silently stop moving it).
 Rig withinErrorBudgets(const Rig& rig, const std::map<std::string, double>& budgets, std::vector<Diagnostic>& notes);
 // A budget as written after "SEMANTIC=": an angle with "deg" or "rad" for a direction, a
 // plain fraction for a position ("1e-4", of the bounds diagonal) or a morph delta (of its
