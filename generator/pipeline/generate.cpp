@@ -289,11 +289,12 @@ LoadedInputs cheapestStoredForms(const Rig& rig, const RuleSet& rules, const Fra
   if (!best) return instantiateAndPrice(rig, rules, fragment, opts, profile);  // the full rig's own error
   for (size_t i = 0; i < twice.size(); ++i) {
     const VertexEncoding* e = twice[i];
-    const std::string plainForm = plain(*e).front();
+    const std::vector<std::string> plainForm = plain(*e);
+    const std::string plainText = fmt::format("{}", fmt::join(plainForm, ", "));
     const bool encoded = (bestMask >> i) & 1;
-    const std::string& used = encoded ? e->encoded : plainForm;
-    const std::string& other = encoded ? plainForm : e->encoded;
-    notes.push_back(Diagnostic{Severity::Note, attributeProviding(rig, used)->loc,
+    const std::string& used = encoded ? e->encoded : plainText;
+    const std::string& other = encoded ? plainText : e->encoded;
+    notes.push_back(Diagnostic{Severity::Note, attributeProviding(rig, encoded ? e->encoded : plainForm.front())->loc,
                                fmt::format("{}: the plan reads {}; the rig also stores {}, which would not make it "
                                            "cheaper", e->decodesText(), used, other)});
   }

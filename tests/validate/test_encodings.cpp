@@ -583,6 +583,31 @@ TEST(Octahedral, TheSearchChoosesTheStoredFormPerDevice) {
   }
 }
 
+
+// The same choice for a QTangent against the float frame (normal, and tangent with its
+// handedness in w: two locations, 28 bytes): slots and lavapipe keep the floats, the H200
+// profile reads the one snorm16x4 location and decodes the three values from it. Every
+// plan validates on the device; the note lists the whole plain form.
+TEST(QTangent, TheSearchChoosesTheStoredFormPerDevice) {
+  for (const std::string profile : {"", "nvidia-h200.yaml", "llvmpipe-2core.yaml"}) {
+    const bool h200 = profile == "nvidia-h200.yaml";
+    SCOPED_TRACE(profile.empty() ? "instruction slots" : profile);
+    sg::GenerateOptions gen;
+    if (!profile.empty()) gen.deviceProfilePath = sourcePath("devices/" + profile);
+    sg::ValidateReport rep = validateOnLimb(gen, "qtangent_or_float.rig.yaml");
+    EXPECT_TRUE(rep.pass);
+    ASSERT_FALSE(rep.runs.empty());
+    EXPECT_EQ(sgtest::planHas(rep.runs[0], "vertex_normal_from_qtangent"), h200);
+    EXPECT_EQ(sgtest::planHas(rep.runs[0], "vertex_handedness_from_qtangent"), h200);
+    ASSERT_EQ(rep.notes.size(), 1u);
+    EXPECT_NE(rep.notes[0].message.find(h200 ? "the plan reads vertex.qtangent; the rig also stores vertex.normal, "
+                                               "vertex.tangent, vertex.handedness"
+                                             : "the plan reads vertex.normal, vertex.tangent, vertex.handedness; the "
+                                               "rig also stores vertex.qtangent"),
+              std::string::npos)
+        << rep.notes[0].message;
+  }
+}
 }  // namespace
 
 namespace {
