@@ -22,7 +22,8 @@ struct Mesh {
   // Unused components are 0. Scalars live in .x.
   std::map<std::string, std::vector<glm::vec4>> streams;
   // Uniform values that belong to the mesh, not to a pose, by semantic: the bounds of its
-  // bounds-relative positions (mesh.bounds_min, mesh.bounds_extent), derived with them.
+  // bounds-relative positions (mesh.bounds_min, mesh.bounds_extent) and the scales of
+  // scaled morph deltas (morph.position_scale, one per target), derived with them.
   std::map<std::string, std::vector<double>> uniforms;
 
   bool has(const std::string& semantic) const { return streams.count(semantic) != 0; }

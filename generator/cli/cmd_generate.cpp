@@ -60,7 +60,8 @@ void GenerateArgs::add(CLI::App& cmd) {
   cmd.add_option("--set", sets, "Set a rig deformer parameter: NAME=VALUE (level-of-detail rigs: morph_targets=2)");
   cmd.add_option("--max-error", maxErrors,
                  "Error budget of an encoded vertex semantic: SEMANTIC=ERROR, an angle in deg or rad for a direction "
-                 "(vertex.normal=0.1deg), a fraction of the bounds diagonal for a position (vertex.position=1e-4). Stored encodings that can err more are not offered to the search "
+                 "(vertex.normal=0.1deg), a fraction of the bounds diagonal for a position (vertex.position=1e-4), of the "
+                 "target's scale for a morph delta (morph.position=1e-4). Stored encodings that can err more are not offered to the search "
                  "(docs/rig-format.md, \"Encodings\")");
 }
 

@@ -248,39 +248,55 @@ LoadedInputs instantiateAndPrice(Rig rig, const RuleSet& rules, const FragmentIn
 
 // A rig that stores a value both as itself and encoded (docs/rig-format.md, "Encodings")
 // offers a choice the planning model cannot state: a provided value is true from the
-// start, so its decode rule would never be used. Each combination of one form per value
-// is instantiated and searched, and the cheapest plan's inputs kept (ties: the plain form).
-// At most three values have an encoding, so at most eight searches.
+// start, so its decode rule would never be used. Each combination of one form per
+// encoding is instantiated and searched (the plain form: every value the encoding decodes
+// that the rig stores plainly), and the cheapest plan's inputs kept (ties: the plain form).
+// At most four encodings, so at most sixteen searches.
 LoadedInputs cheapestStoredForms(const Rig& rig, const RuleSet& rules, const FragmentInterface& fragment,
                                  const GenerateOptions& opts, const std::optional<DeviceProfile>& profile,
                                  std::vector<Diagnostic>& notes) {
+  auto plain = [&](const VertexEncoding& e) {
+    std::vector<std::string> out;
+    for (const std::string& s : e.decodes())
+      if (attributeProviding(rig, s)) out.push_back(s);
+    return out;
+  };
   std::vector<const VertexEncoding*> twice;
   for (const auto& e : vertexEncodings())
-    if (attributeProviding(rig, e.source) && attributeProviding(rig, e.encoded)) twice.push_back(&e);
+    if (attributeProviding(rig, e.encoded) && !plain(e).empty()) twice.push_back(&e);
   if (twice.empty()) return instantiateAndPrice(rig, rules, fragment, opts, profile);
   std::optional<LoadedInputs> best;
   int64_t bestCost = 0;
-  std::set<std::string> bestDropped;
+  uint32_t bestMask = 0;
   for (uint32_t mask = 0; mask < (1u << twice.size()); ++mask) {
     std::set<std::string> dropped;
-    for (size_t i = 0; i < twice.size(); ++i) dropped.insert((mask >> i) & 1 ? twice[i]->source : twice[i]->encoded);
+    for (size_t i = 0; i < twice.size(); ++i) {
+      if ((mask >> i) & 1) {
+        for (const std::string& s : plain(*twice[i])) dropped.insert(s);
+      } else {
+        dropped.insert(twice[i]->encoded);
+      }
+    }
     try {
       LoadedInputs cand = instantiateAndPrice(withoutProvided(rig, dropped), rules, fragment, opts, profile);
       LoadedInputs searched = cand;
       const int64_t cost = searchUnderOptions(searched, opts, nullptr).cost;
-      if (!best || cost < bestCost) best = std::move(cand), bestCost = cost, bestDropped = dropped;
+      if (!best || cost < bestCost) best = std::move(cand), bestCost = cost, bestMask = mask;
     } catch (const InputError&) {
       continue;  // this combination cannot serve the request; another may
     }
   }
   if (!best) return instantiateAndPrice(rig, rules, fragment, opts, profile);  // the full rig's own error
-  for (const VertexEncoding* e : twice) {
-    const bool encoded = bestDropped.count(e->source) != 0;
-    const std::string& used = encoded ? e->encoded : e->source;
-    const std::string& other = encoded ? e->source : e->encoded;
-    notes.push_back(Diagnostic{Severity::Note, attributeProviding(rig, used)->loc,
+  for (size_t i = 0; i < twice.size(); ++i) {
+    const VertexEncoding* e = twice[i];
+    const std::vector<std::string> plainForm = plain(*e);
+    const std::string plainText = fmt::format("{}", fmt::join(plainForm, ", "));
+    const bool encoded = (bestMask >> i) & 1;
+    const std::string& used = encoded ? e->encoded : plainText;
+    const std::string& other = encoded ? plainText : e->encoded;
+    notes.push_back(Diagnostic{Severity::Note, attributeProviding(rig, encoded ? e->encoded : plainForm.front())->loc,
                                fmt::format("{}: the plan reads {}; the rig also stores {}, which would not make it "
-                                           "cheaper", e->source, used, other)});
+                                           "cheaper", e->decodesText(), used, other)});
   }
   return std::move(*best);
 }

@@ -136,8 +136,12 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
           e && (!encodingMaxError(*e, a.format) ||
                 (p.swizzle.empty() ? n : static_cast<int>(p.swizzle.size())) != e->components))
         y.fail(swzNode ? *swzNode : body["format"],
-               fmt::format("'{}' ({} {}) must be stored in {}, not {}{}", p.semantic, e->name, e->source,
+               fmt::format("'{}' ({} {}) must be stored in {}, not {}{}", p.semantic, e->name, e->decodesText(),
                            encodingFormats(*e), formatName(a.format), p.swizzle.empty() ? "" : " ." + p.swizzle));
+      if (const VertexEncoding* e = encodingOf(p.semantic); e && e->perTarget != a.perMorphTarget)
+        y.fail(semNode, fmt::format("'{}' ({} {}) is {}stored per morph target: its attribute needs 'per_target: {}'",
+                                    p.semantic, e->name, e->decodesText(), e->perTarget ? "" : "not ",
+                                    e->perTarget ? "true" : "false"));
       a.provides.push_back(p);
     };
     if (prov.IsScalar()) {
@@ -187,7 +191,7 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
           if (!providedSemantics.count(u))
             throw InputError(a.loc, fmt::format("'{}' ({} {}) is decoded with the uniform '{}', which the rig does not "
                                                 "declare (docs/rig-format.md, \"Encodings\")", p.semantic, e->name,
-                                                e->source, u));
+                                                e->decodesText(), u));
   checkRig(rig);
   return rig;
 }

@@ -25,10 +25,13 @@ PackedVertices packVertices(const GenerateResult& r, const rt::Mesh& mesh) {
                              {"components", p.swizzle.empty() ? std::string("xyzw").substr(0, formatComponents(a.format))
                                                               : p.swizzle}};
       if (const VertexEncoding* e = encodingOf(p.semantic)) {
-        part["encodes"] = e->source;
+        part["encodes"] = e->decodes();
         part["encoding"] = e->name;
         if (e->angular()) {
           part["max_error_deg"] = *encodingMaxError(*e, a.format);
+        } else if (e->perTarget) {  // scaled deltas: delta = code * scale, the target's own
+          part["max_error_of_target_scale"] = *encodingMaxError(*e, a.format);
+          part["scale"] = quantized.uniforms.at(e->uniforms.at(0)).at(static_cast<size_t>(in.target));
         } else {  // bounds: source = bias + code * scale, the code as the format reads it
           part["max_error_of_bounds_diagonal"] = *encodingMaxError(*e, a.format);
           part["bias"] = quantized.uniforms.at(e->uniforms.at(0));

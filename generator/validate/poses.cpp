@@ -22,7 +22,7 @@ const std::set<std::string>& standardUniforms() {
                                               // derived from morph.weights (docs/buffers.md)
                                               "morph.active_targets", "morph.active_count",
                                               // derived from the mesh (rig/vertex_encoding.h)
-                                              "mesh.bounds_min", "mesh.bounds_extent"};
+                                              "mesh.bounds_min", "mesh.bounds_extent", "morph.position_scale"};
   return names;
 }
 

@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "rig/vertex_encoding.h"
+#include "rules/instantiate.h"
 #include "validate/poses.h"
 
 namespace sg {
@@ -80,12 +81,26 @@ void renormaliseWeights(const Rig& rig, rt::Mesh& m) {
   }
 }
 
-// The encoded semantics the rig stores (rig/vertex_encoding.h).
-std::vector<const VertexEncoding*> storedEncodings(const Rig& rig) {
-  std::vector<const VertexEncoding*> out;
+// The encoded semantics the rig stores (rig/vertex_encoding.h), with their formats: one
+// per morph target for a per-target attribute.
+struct StoredEncoding {
+  const VertexEncoding* e;
+  VertexFormat format;
+  int target;  // -1: not per target
+  std::string name(const std::string& semantic) const { return target < 0 ? semantic : indexedName(semantic, target); }
+  std::vector<std::string> values() const {
+    std::vector<std::string> out;
+    for (const std::string& v : e->decodes()) out.push_back(name(v));
+    return out;
+  }
+};
+std::vector<StoredEncoding> storedEncodings(const Rig& rig) {
+  std::vector<StoredEncoding> out;
   for (const auto& a : rig.attributes)
     for (const auto& p : a.provides)
-      if (const VertexEncoding* e = encodingOf(p.semantic); e && !a.perMorphTarget) out.push_back(e);
+      if (const VertexEncoding* e = encodingOf(p.semantic); e && e->perTarget == a.perMorphTarget)
+        for (int t = a.perMorphTarget ? 0 : -1; t < (a.perMorphTarget ? rig.morphTargets() : 0); ++t)
+          out.push_back({e, a.format, t});
   return out;
 }
 
@@ -104,7 +119,7 @@ void addBounds(const Rig& rig, rt::Mesh& m) {
   m.uniforms["mesh.bounds_extent"] = {b.extent.x, b.extent.y, b.extent.z};
 }
 
-// The bounds `addBounds` put in the mesh; none for an encoding that reads no bounds.
+// The bounds `addBounds` put in the mesh.
 PositionBounds boundsFor(const VertexEncoding& e, const rt::Mesh& m) {
   if (e.uniforms.empty()) return {};
   const auto& lo = m.uniforms.at("mesh.bounds_min");
@@ -114,44 +129,105 @@ PositionBounds boundsFor(const VertexEncoding& e, const rt::Mesh& m) {
   return b;
 }
 
-glm::vec4 encodeValue(const VertexEncoding& e, const PositionBounds& bounds, const glm::vec4& v) {
-  if (e.name == "bounds") return glm::vec4(glm::vec3(boundsEncode(bounds, glm::dvec3(v))), 0);
-  return glm::vec4(glm::vec2(octahedralEncode(glm::dvec3(v))), 0, 0);
+// Each target's delta scale as a uniform array, from its float deltas, for a rig that reads
+// them (a target without deltas: 0).
+void addDeltaScales(const Rig& rig, rt::Mesh& m) {
+  for (const auto& e : vertexEncodings()) {
+    if (e.name != "scaled" || !declaresUniform(rig, e.uniforms[0]) || m.uniforms.count(e.uniforms[0])) continue;
+    std::vector<double> scales;
+    for (int t = 0; t < rig.morphTargets(); ++t) {
+      const std::string source = indexedName(e.sources[0], t);
+      scales.push_back(m.has(source) ? deltaScale(m.at(source)) : 0.0f);
+    }
+    m.uniforms[e.uniforms[0]] = std::move(scales);
+  }
 }
 
-glm::vec3 decodeValue(const VertexEncoding& e, const PositionBounds& bounds, const glm::vec4& code) {
-  if (e.name == "bounds") return glm::vec3(boundsDecode(bounds, glm::dvec3(code)));
-  return glm::vec3(octahedralDecode(glm::dvec2(code)));
+// The uniforms an encoding's decode reads, as the mesh has them: the bounds `addBounds`
+// put there, a target's scale `addDeltaScales` did.
+struct DecodeUniforms {
+  PositionBounds bounds;
+  float scale = 0;
+};
+DecodeUniforms decodeUniformsFor(const StoredEncoding& se, const rt::Mesh& m) {
+  const VertexEncoding& e = *se.e;
+  DecodeUniforms out;
+  if (e.name == "scaled") out.scale = static_cast<float>(m.uniforms.at(e.uniforms[0]).at(static_cast<size_t>(se.target)));
+  if (e.name == "bounds") out.bounds = boundsFor(e, m);
+  return out;
+}
+
+// Every vertex's code from the mesh's float values (each one the encoding decodes).
+std::vector<glm::vec4> encodeFrom(const StoredEncoding& se, const DecodeUniforms& u, const rt::Mesh& m) {
+  const VertexEncoding& e = *se.e;
+  std::vector<const std::vector<glm::vec4>*> in;
+  for (const std::string& sem : se.values()) in.push_back(&m.at(sem));
+  std::vector<glm::vec4> code(m.vertexCount, glm::vec4(0));
+  for (size_t v = 0; v < m.vertexCount; ++v) {
+    const glm::dvec3 first((*in[0])[v]);
+    if (e.name == "bounds")
+      code[v] = glm::vec4(glm::vec3(boundsEncode(u.bounds, first)), 0);
+    else if (e.name == "scaled")
+      code[v] = glm::vec4(glm::vec3(scaledEncode(u.scale, first)), 0);
+    else if (e.name == "qtangent")  // normal, tangent, handedness
+      code[v] = glm::vec4(qtangentEncode(first, glm::dvec3((*in[1])[v]), (*in[2])[v].x, qtangentBias(se.format)));
+    else
+      code[v] = glm::vec4(glm::vec2(octahedralEncode(first)), 0, 0);
+  }
+  return code;
+}
+
+// The decode of every vertex's code written over the values it encodes, in their first
+// components (the streams looked up once, not per vertex).
+void decodeInto(const StoredEncoding& se, const DecodeUniforms& u, const std::vector<glm::vec4>& code, rt::Mesh& m) {
+  const VertexEncoding& e = *se.e;
+  std::vector<std::vector<glm::vec4>*> out;
+  for (const std::string& sem : se.values()) {
+    out.push_back(&m.streams[sem]);
+    out.back()->resize(m.vertexCount, glm::vec4(0));
+  }
+  auto put = [](glm::vec4& dst, const glm::dvec3& x, int n) {
+    for (int k = 0; k < n; ++k) dst[k] = static_cast<float>(x[k]);
+  };
+  for (size_t v = 0; v < m.vertexCount; ++v) {
+    if (e.name == "bounds") {
+      put((*out[0])[v], boundsDecode(u.bounds, glm::dvec3(code[v])), 3);
+    } else if (e.name == "scaled") {
+      put((*out[0])[v], scaledDecode(u.scale, glm::dvec3(code[v])), 3);
+    } else if (e.name == "qtangent") {  // normal, tangent, handedness
+      const QTangentFrame f = qtangentDecode(glm::dvec4(code[v]));
+      put((*out[0])[v], f.normal, 3);
+      put((*out[1])[v], f.tangent, 3);
+      put((*out[2])[v], glm::dvec3(f.handedness), 1);
+    } else {
+      put((*out[0])[v], octahedralDecode(glm::dvec2(code[v])), 3);
+    }
+  }
 }
 
 rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
   rt::Mesh m = mesh;
   addBounds(rig, m);
+  addDeltaScales(rig, m);
   // An encoded stream the mesh lacks is encoded from its float source; after rounding to
   // the stored format, the source becomes the decode of what the device reads. So the
   // reference, the GPU's decode and a float attribute the rig offers beside the code all
   // carry one value, and a decode rule is checked exactly (its rounding is the budget's
   // business, not validation's).
   const auto encodings = storedEncodings(rig);
-  for (const VertexEncoding* e : encodings) {
-    auto src = m.streams.find(e->source);
-    if (m.has(e->encoded) || src == m.streams.end()) continue;
-    const PositionBounds bounds = boundsFor(*e, m);
-    std::vector<glm::vec4> code(m.vertexCount, glm::vec4(0));
-    for (size_t v = 0; v < m.vertexCount && v < src->second.size(); ++v) code[v] = encodeValue(*e, bounds, src->second[v]);
-    m.streams[e->encoded] = std::move(code);
+  for (const StoredEncoding& se : encodings) {
+    const std::vector<std::string> values = se.values();
+    if (m.has(se.name(se.e->encoded)) || !std::all_of(values.begin(), values.end(), [&](const auto& s) {
+          return m.has(s) && m.at(s).size() >= m.vertexCount;
+        }))
+      continue;
+    m.streams[se.name(se.e->encoded)] = encodeFrom(se, decodeUniformsFor(se, m), m);
   }
   renormaliseWeights(rig, m);
   quantizeStreams(rig, m);
   if (encodings.empty()) return m;
-  for (const VertexEncoding* e : encodings) {
-    if (!m.has(e->encoded)) continue;
-    const auto& code = m.at(e->encoded);
-    auto& src = m.streams[e->source];
-    const PositionBounds bounds = boundsFor(*e, m);
-    src.resize(m.vertexCount, glm::vec4(0));
-    for (size_t v = 0; v < m.vertexCount; ++v) src[v] = glm::vec4(decodeValue(*e, bounds, code[v]), src[v].w);
-  }
+  for (const StoredEncoding& se : encodings)
+    if (m.has(se.name(se.e->encoded))) decodeInto(se, decodeUniformsFor(se, m), m.at(se.name(se.e->encoded)), m);
   quantizeStreams(rig, m);  // a source the rig stores too, in a rounded format
   return m;
 }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <random>
 
 #include <nlohmann/json.hpp>
@@ -268,6 +269,278 @@ TEST(Bounds, ABudgetTighterThanTheEncodingRemovesIt) {
   EXPECT_TRUE(validateBounds(sourcePath("rules/standard.yaml"), {{"vertex.position", 1e-4}}).pass);
 }
 
+// QTangents, checked against the geometry of rotations, not through the library's decoder:
+// the test rotates with its own Hamilton product, v' = q v q*.
+glm::dvec4 hamilton(const glm::dvec4& a, const glm::dvec4& b) {  // (x, y, z, w)
+  const glm::dvec3 u(a), v(b);
+  return glm::dvec4(a.w * v + b.w * u + glm::cross(u, v), a.w * b.w - glm::dot(u, v));
+}
+glm::dvec3 rotate(const glm::dvec4& q, const glm::dvec3& v) {
+  const glm::dvec4 r = hamilton(hamilton(q, glm::dvec4(v, 0)), glm::dvec4(-glm::dvec3(q), q.w));
+  return glm::dvec3(r) / glm::dot(q, q);
+}
+
+struct Frame {
+  glm::dvec3 normal, tangent;  // as stored: the tangent need not be perpendicular, nor either unit
+  double handedness;
+};
+
+// 1e5 random frames (normal and tangent independent, lengths 0.5..2, both handedness
+// signs), frames whose quaternion has w = 0 or nearly (rotations by about half a turn,
+// where the bias must keep w's sign), and degenerate ones: zero and parallel tangents.
+std::vector<Frame> frames(size_t n, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g(0, 1);
+  std::uniform_real_distribution<double> len(0.5, 2);
+  auto unit = [&] {
+    glm::dvec3 v(g(rng), g(rng), g(rng));
+    return glm::normalize(v);
+  };
+  std::vector<Frame> out;
+  for (size_t i = 0; i < n; ++i) out.push_back({len(rng) * unit(), len(rng) * unit(), i % 2 ? -1.0 : 1.0});
+  for (size_t i = 0; i < n / 4; ++i) {
+    const double w = std::vector<double>{0, 1e-9, 1e-5, 3e-5, 1e-3, 8e-3}[i % 6];
+    const glm::dvec4 q(std::sqrt(1 - w * w) * unit(), w);
+    out.push_back({rotate(q, {0, 0, 1}), rotate(q, {1, 0, 0}), i % 4 < 2 ? -1.0 : 1.0});
+  }
+  for (double h : {-1.0, 1.0})
+    for (int i = 0; i < 100; ++i) {
+      const glm::dvec3 nrm = unit();
+      out.push_back({nrm, glm::dvec3(0), h});
+      out.push_back({nrm, 3.0 * nrm, h});
+      out.push_back({nrm, -nrm + 1e-5 * unit(), h});
+    }
+  for (double h : {-1.0, 1.0}) out.push_back({{0, 0, 1}, {1, 0, 0}, h});  // the identity: w = +-1
+  return out;
+}
+
+// The frame an encoder must store: the normal normalised, the tangent made perpendicular
+// to it, or nothing (zero or parallel: the encoder's documented fallback applies).
+std::optional<glm::dvec3> expectedTangent(const Frame& f) {
+  const glm::dvec3 n = glm::normalize(f.normal);
+  const glm::dvec3 g = f.tangent - glm::dot(f.tangent, n) * n;
+  if (glm::length(g) <= 1e-3 * glm::length(f.tangent) || glm::length(f.tangent) == 0) return std::nullopt;
+  return glm::normalize(g);
+}
+
+// The code is the unit quaternion of the orthonormalised frame's rotation: it takes +z to
+// the normal and +x to the tangent, its w has the handedness's sign and at least the bias.
+// A degenerate tangent gets one deterministic tangent per normal, perpendicular to it,
+// the same for a zero and a parallel tangent.
+TEST(QTangent, CodeIsTheRotationOfTheOrthonormalisedFrame) {
+  const double bias = sg::qtangentBias(sg::VertexFormat::Snorm16x4);
+  EXPECT_EQ(bias, 1.0 / 32767);
+  size_t degenerate = 0;
+  for (const Frame& f : frames(100000, 4)) {
+    const glm::dvec4 q = sg::qtangentEncode(f.normal, f.tangent, f.handedness, bias);
+    ASSERT_NEAR(glm::length(q), 1.0, 1e-12);
+    ASSERT_EQ(q.w < 0, f.handedness < 0);
+    ASSERT_GE(std::abs(q.w), bias * (1 - 1e-12));
+    const glm::dvec3 n = rotate(q, {0, 0, 1}), t = rotate(q, {1, 0, 0});
+    // The bias may turn the frame by up to 2 asin(bias).
+    const double slack = glm::degrees(2 * std::asin(bias)) * 1.0001 + 1e-9;
+    ASSERT_LE(angleDegrees(n, f.normal), slack);
+    ASSERT_NEAR(glm::dot(n, t), 0.0, 1e-12);
+    if (const auto want = expectedTangent(f)) {
+      ASSERT_LE(angleDegrees(t, *want), slack);
+    } else {
+      ++degenerate;
+      const glm::dvec4 zero = sg::qtangentEncode(f.normal, glm::dvec3(0), f.handedness, bias);
+      ASSERT_EQ(sg::qtangentEncode(f.normal, 2.0 * f.normal, f.handedness, bias), zero);
+      ASSERT_EQ(sg::qtangentEncode(f.normal, glm::dvec3(NAN), f.handedness, bias), zero);
+    }
+  }
+  EXPECT_GE(degenerate, 400u);
+  // A zero normal is +z; a handedness of 0 or NaN is +1.
+  const glm::dvec4 q = sg::qtangentEncode(glm::dvec3(0), {1, 0, 0}, 0.0, bias);
+  EXPECT_LT(angleDegrees(rotate(q, {0, 0, 1}), {0, 0, 1}), 1e-9);
+  EXPECT_GT(q.w, 0);
+  EXPECT_GT(sg::qtangentEncode({0, 0, 1}, {1, 0, 0}, NAN, bias).w, 0);
+}
+
+// Rounded to each format as the device reads it, every frame decodes to an orthonormal one
+// with the exact handedness and its normal and tangent within the stated angle, and the
+// statement is not loose: the sample reaches most of it for 8 bits.
+TEST(QTangent, StoredErrorStaysWithinTheStatedBoundAndNearIt) {
+  const sg::VertexEncoding& qt = *sg::encodingOf("vertex.qtangent");
+  const std::vector<Frame> all = frames(100000, 5);
+  for (sg::VertexFormat f : {sg::VertexFormat::Snorm8x4, sg::VertexFormat::Snorm16x4, sg::VertexFormat::Float16x4,
+                             sg::VertexFormat::Float32x4}) {
+    const double bound = *sg::encodingMaxError(qt, f);
+    double worst = 0;
+    size_t handednessWrong = 0;
+    for (const Frame& fr : all) {
+      const glm::vec4 code(sg::qtangentEncode(fr.normal, fr.tangent, fr.handedness, sg::qtangentBias(f)));
+      glm::dvec4 read;
+      for (int c = 0; c < 4; ++c) read[c] = sg::storedValue(f, c, code[c]);
+      const sg::QTangentFrame d = sg::qtangentDecode(read);
+      ASSERT_NEAR(glm::length(d.normal), 1.0, 1e-12);
+      ASSERT_NEAR(glm::length(d.tangent), 1.0, 1e-12);
+      ASSERT_NEAR(glm::dot(d.normal, d.tangent), 0.0, 1e-12);
+      handednessWrong += d.handedness != (fr.handedness < 0 ? -1.0 : 1.0);
+      worst = std::max(worst, angleDegrees(d.normal, fr.normal));
+      if (const auto want = expectedTangent(fr)) worst = std::max(worst, angleDegrees(d.tangent, *want));
+    }
+    std::cout << sg::formatName(f) << ": worst " << worst << " deg of stated " << bound << "\n";
+    EXPECT_EQ(handednessWrong, 0u) << sg::formatName(f);
+    EXPECT_LE(worst, bound) << sg::formatName(f);
+    if (f == sg::VertexFormat::Snorm8x4 || f == sg::VertexFormat::Snorm16x4) EXPECT_GE(worst, 0.9 * bound);
+  }
+  EXPECT_NEAR(*sg::encodingMaxError(qt, sg::VertexFormat::Snorm16x4), 0.00463, 0.00001);
+  EXPECT_FALSE(sg::encodingMaxError(qt, sg::VertexFormat::Unorm16x4));  // no negative components
+  EXPECT_FALSE(sg::encodingMaxError(qt, sg::VertexFormat::Snorm16x2));  // four components
+}
+
+sg::ValidateReport validateQTangent(const std::string& rules, std::map<std::string, double> budgets = {}) {
+  return validateWith("qtangent.rig.yaml", rules, std::move(budgets));
+}
+
+// The whole frame in one snorm16x4 location: the plan decodes the normal, the tangent and
+// the handedness from it, and the device agrees with the reference on every output.
+TEST(QTangent, StoredFrameValidatesOnTheDevice) {
+  sg::ValidateReport rep = validateQTangent(sourcePath("rules/standard.yaml"));
+  EXPECT_TRUE(rep.pass);
+  ASSERT_FALSE(rep.runs.empty());
+  EXPECT_TRUE(sgtest::planHas(rep.runs[0], "vertex_normal_from_qtangent"));
+  EXPECT_TRUE(sgtest::planHas(rep.runs[0], "vertex_tangent_from_qtangent"));
+  EXPECT_TRUE(sgtest::planHas(rep.runs[0], "vertex_handedness_from_qtangent"));
+}
+
+// Planted wrong decodes: the handedness's sign flipped fails the binormal (the limb's
+// mirrored half and the rest alike) and nothing else; two quaternion components swapped
+// in the normal's column fails the normal and what follows from it, not the position.
+TEST(QTangent, PlantedWrongDecodesFailValidation) {
+  {
+    sgtest::RulesCopy rules("qtangent_handedness_flip");
+    ASSERT_TRUE(rules.edit("encodings.yaml", "${vertex.qtangent}.w < 0.0 ? -1.0 : 1.0", "${vertex.qtangent}.w < 0.0 ? 1.0 : -1.0"));
+    sg::ValidateReport broken = validateQTangent(rules.rulesFile("standard.yaml").string());
+    EXPECT_FALSE(broken.pass);
+    const std::set<std::string> failed = sgtest::failingOutputs(broken.runs.at(0));
+    EXPECT_TRUE(failed.count("world_binormal")) << ::testing::PrintToString(failed);
+    EXPECT_FALSE(failed.count("world_normal"));
+    EXPECT_FALSE(failed.count("world_tangent"));
+    EXPECT_FALSE(failed.count("world_position"));
+  }
+  {
+    sgtest::RulesCopy rules("qtangent_swapped_component");
+    ASSERT_TRUE(rules.edit("encodings.yaml", "vec3(a_.x * q_.z + a_.y * q_.w,", "vec3(a_.x * q_.w + a_.y * q_.z,"));
+    sg::ValidateReport broken = validateQTangent(rules.rulesFile("standard.yaml").string());
+    EXPECT_FALSE(broken.pass);
+    const std::set<std::string> failed = sgtest::failingOutputs(broken.runs.at(0));
+    EXPECT_TRUE(failed.count("world_normal")) << ::testing::PrintToString(failed);
+    EXPECT_FALSE(failed.count("world_position"));
+  }
+}
+
+// A tangent budget below snorm16's 0.0046 deg removes the code (the rig has no other
+// frame), and the note names the budget it broke; one above it changes nothing. The
+// handedness is exact: no budget applies to it.
+TEST(QTangent, ABudgetTighterThanTheEncodingRemovesIt) {
+  try {
+    validateQTangent(sourcePath("rules/standard.yaml"), {{"vertex.tangent", 0.001}});
+    FAIL() << "expected the request to fail";
+  } catch (const sg::InputError& e) {
+    std::string all = sg::formatDiagnostic(e.diagnostic());
+    for (const auto& d : e.related) all += "\n" + sg::formatDiagnostic(d);
+    EXPECT_NE(all.find("qtangent.rig.yaml:12:3: note: vertex.qtangent (attribute 'frame', snorm16x4) is not offered to "
+                       "the search: it errs up to 0.00463 deg, over the budget of 0.001 deg for vertex.tangent"),
+              std::string::npos)
+        << all;
+  }
+  EXPECT_TRUE(validateQTangent(sourcePath("rules/standard.yaml"), {{"vertex.normal", 0.005}, {"vertex.tangent", 0.005}}).pass);
+  std::string why;
+  EXPECT_FALSE(sg::parseErrorBudget("vertex.handedness", "0.1deg", why));
+  EXPECT_NE(why.find("no encoding stores 'vertex.handedness'"), std::string::npos) << why;
+}
+
+// Morph deltas relative to their target's scale, checked from the definition: the scale is
+// the target's largest |component| (rounded up by at most one float step), every code lies
+// in [-1, 1], and a delta read back through each format errs by at most the stated fraction
+// of its target's scale, and for 8 bits nearly that much. Targets of very different sizes,
+// one that moves nothing, and non-finite components (left out, encoded as 0).
+TEST(ScaledDeltas, CodesLieInTheUnitCubeAndDecodeWithinTheStatedError) {
+  const sg::VertexEncoding& scaled = *sg::encodingOf("morph.position_scaled");
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (const double size : {1e-4, 1.0, 300.0, 0.0}) {
+    std::vector<glm::vec4> deltas;
+    for (int i = 0; i < 100000; ++i) deltas.emplace_back(glm::vec3(size * glm::dvec3(u(rng), 0.5 * u(rng), u(rng))), 0);
+    deltas.emplace_back(NAN, INFINITY, -INFINITY, 0);
+    const float scale = sg::deltaScale(deltas);
+    double largest = 0;
+    for (size_t i = 0; i + 1 < deltas.size(); ++i)
+      for (int k = 0; k < 3; ++k) largest = std::max(largest, std::abs(double(deltas[i][k])));
+    EXPECT_GE(double(scale), largest);
+    EXPECT_LE(double(scale), largest * (1 + std::ldexp(1.0, -23)));
+    EXPECT_EQ(sg::scaledEncode(scale, glm::dvec3(deltas.back())), glm::dvec3(0));
+    for (sg::VertexFormat f : {sg::VertexFormat::Snorm8x4, sg::VertexFormat::Snorm10_10_10_2, sg::VertexFormat::Snorm16x4,
+                               sg::VertexFormat::Float16x4}) {
+      const double bound = *sg::encodingMaxError(scaled, f);
+      double worst = 0;
+      for (size_t i = 0; i + 1 < deltas.size(); ++i) {
+        const glm::vec3 code(sg::scaledEncode(scale, glm::dvec3(deltas[i])));  // stored from float data
+        ASSERT_TRUE(glm::all(glm::lessThanEqual(glm::abs(code), glm::vec3(1))));
+        glm::dvec3 read;
+        for (int k = 0; k < 3; ++k) read[k] = sg::storedValue(f, k, code[k]);
+        const double err = glm::length(sg::scaledDecode(scale, read) - glm::dvec3(deltas[i]));
+        if (size == 0) ASSERT_EQ(err, 0.0);
+        else worst = std::max(worst, err / scale);
+      }
+      if (size == 0) continue;
+      std::cout << sg::formatName(f) << " (size " << size << "): worst " << worst << " of the scale, stated " << bound << "\n";
+      EXPECT_LE(worst, bound) << sg::formatName(f);
+      if (f == sg::VertexFormat::Snorm8x4) EXPECT_GE(worst, 0.8 * bound);
+    }
+  }
+  EXPECT_NEAR(*sg::encodingMaxError(scaled, sg::VertexFormat::Snorm16x4), 2.653e-5, 0.001e-5);  // sqrt(3) (0.5/32767 + 2^-24)
+  EXPECT_FALSE(sg::encodingMaxError(scaled, sg::VertexFormat::Unorm16x4));  // deltas are signed
+}
+
+sg::ValidateReport validateScaled(const std::string& rules, std::map<std::string, double> budgets = {}) {
+  return validateWith("morph_scaled.rig.yaml", rules, std::move(budgets));
+}
+
+// Four targets' position deltas as snorm16 codes and a scale each: the plan sums them with
+// the scale folded into the weight, and the device agrees with the reference everywhere.
+TEST(ScaledDeltas, MorphedLimbValidatesOnTheDevice) {
+  sg::ValidateReport rep = validateScaled(sourcePath("rules/standard.yaml"));
+  EXPECT_TRUE(rep.pass);
+  ASSERT_FALSE(rep.runs.empty());
+  EXPECT_TRUE(sgtest::planHas(rep.runs[0], "object_position_morphed_scaled"));
+}
+
+// A sum that forgets the scale moves every vertex by the codes themselves: validation fails
+// the outputs that depend on the position, and only those.
+TEST(ScaledDeltas, PlantedMissingScaleFailsValidation) {
+  sgtest::RulesCopy rules("scaled_missing_scale");
+  ASSERT_TRUE(rules.edit("morph.yaml", "(${morph.weights}[${i}] * ${morph.position_scale}[${i}])", "${morph.weights}[${i}]"));
+  sg::ValidateReport broken = validateScaled(rules.rulesFile("standard.yaml").string());
+  EXPECT_FALSE(broken.pass);
+  const std::set<std::string> failed = sgtest::failingOutputs(broken.runs.at(0));
+  EXPECT_TRUE(failed.count("world_position")) << ::testing::PrintToString(failed);
+  EXPECT_TRUE(failed.count("gl_Position")) << ::testing::PrintToString(failed);
+  EXPECT_FALSE(failed.count("world_normal"));
+}
+
+// A delta budget below snorm16's 2.65e-5 of the scale would remove the codes, and with
+// them the targets' movement (the unmorphed rule would apply): refused at the attribute.
+// A budget above it changes nothing.
+TEST(ScaledDeltas, ABudgetTighterThanTheEncodingIsRefused) {
+  try {
+    validateScaled(sourcePath("rules/standard.yaml"), {{"morph.position", 1e-6}});
+    FAIL() << "expected the budget to be refused";
+  } catch (const sg::InputError& e) {
+    const std::string all = sg::formatDiagnostic(e.diagnostic());
+    EXPECT_NE(all.find("morph_scaled.rig.yaml:15:3: error: morph.position_scaled (attribute 'position_morph', snorm16x4) "
+                       "is not offered to the search: it errs up to 2.65e-05 of the target's scale, over the budget of "
+                       "1e-06 of the target's scale for morph.position (--max-error); the rig stores no other "
+                       "morph.position deltas"),
+              std::string::npos)
+        << all;
+  }
+  EXPECT_TRUE(validateScaled(sourcePath("rules/standard.yaml"), {{"morph.position", 1e-4}}).pass);
+}
+
 }  // namespace
 
 namespace {
@@ -310,6 +583,31 @@ TEST(Octahedral, TheSearchChoosesTheStoredFormPerDevice) {
   }
 }
 
+
+// The same choice for a QTangent against the float frame (normal, and tangent with its
+// handedness in w: two locations, 28 bytes): slots and lavapipe keep the floats, the H200
+// profile reads the one snorm16x4 location and decodes the three values from it. Every
+// plan validates on the device; the note lists the whole plain form.
+TEST(QTangent, TheSearchChoosesTheStoredFormPerDevice) {
+  for (const std::string profile : {"", "nvidia-h200.yaml", "llvmpipe-2core.yaml"}) {
+    const bool h200 = profile == "nvidia-h200.yaml";
+    SCOPED_TRACE(profile.empty() ? "instruction slots" : profile);
+    sg::GenerateOptions gen;
+    if (!profile.empty()) gen.deviceProfilePath = sourcePath("devices/" + profile);
+    sg::ValidateReport rep = validateOnLimb(gen, "qtangent_or_float.rig.yaml");
+    EXPECT_TRUE(rep.pass);
+    ASSERT_FALSE(rep.runs.empty());
+    EXPECT_EQ(sgtest::planHas(rep.runs[0], "vertex_normal_from_qtangent"), h200);
+    EXPECT_EQ(sgtest::planHas(rep.runs[0], "vertex_handedness_from_qtangent"), h200);
+    ASSERT_EQ(rep.notes.size(), 1u);
+    EXPECT_NE(rep.notes[0].message.find(h200 ? "the plan reads vertex.qtangent; the rig also stores vertex.normal, "
+                                               "vertex.tangent, vertex.handedness"
+                                             : "the plan reads vertex.normal, vertex.tangent, vertex.handedness; the "
+                                               "rig also stores vertex.qtangent"),
+              std::string::npos)
+        << rep.notes[0].message;
+  }
+}
 }  // namespace
 
 namespace {
@@ -397,7 +695,7 @@ TEST(Pack, RealModelsFrameReadBackFromTheLayoutWithinTheStatedError) {
   const nlohmann::json position = streamOf("position");
   ASSERT_EQ(position["format"], "unorm16x4");
   const nlohmann::json& part = position["provides"][0];
-  ASSERT_EQ(part["encodes"], "vertex.position");
+  ASSERT_EQ(part["encodes"], nlohmann::json::array({"vertex.position"}));
   const double positionBound = part["max_error_of_bounds_diagonal"];
   EXPECT_EQ(layout["uniforms"]["mesh.bounds_min"], part["bias"]);
   const auto& p = scene.mesh.at("vertex.position");
@@ -416,6 +714,97 @@ TEST(Pack, RealModelsFrameReadBackFromTheLayoutWithinTheStatedError) {
   std::cout << "worst position " << worstPosition << " of the bounds diagonal (stated " << positionBound << ")\n";
   EXPECT_LE(worstPosition, positionBound);
   EXPECT_GT(worstPosition, 0.0);
+}
+
+// The same model with its whole frame as one snorm16x4 QTangent and its position deltas as
+// snorm16 codes with a scale per target: it validates on the device against the reference
+// on what the device reads, and the packed bytes, read back by the layout alone (the
+// quaternion rotated with the test's own product, each delta as code * the part's scale),
+// give the model's own normals, tangents (orthonormalised), handedness and deltas within
+// the stated errors.
+TEST(Pack, RealModelsQTangentsAndScaledDeltasReadBackFromTheLayout) {
+  const std::string model = std::string(SG_SHARED_DIR) + "/models/AnimatedMorphSphere/AnimatedMorphSphere.gltf#0/0";
+  if (!std::filesystem::exists(std::string(SG_SHARED_DIR) + "/models/AnimatedMorphSphere")) GTEST_SKIP() << "no ../shared";
+  sg::Rig rig = sg::importGltf(model.substr(0, model.find('#'))).rig;
+  std::erase_if(rig.attributes, [](const sg::RigAttribute& a) { return a.name == "tangent"; });
+  for (auto& a : rig.attributes) {
+    if (a.name == "normal") {
+      a.format = sg::VertexFormat::Snorm16x4;
+      a.provides = {{"vertex.qtangent", ""}};
+    } else if (a.name == "position_morph") {
+      a.format = sg::VertexFormat::Snorm16x4;
+      a.provides = {{"morph.position_scaled", "xyz"}};
+    }
+  }
+  rig.uniforms.push_back({"morph_scale", "morph.position_scale", sg::Type::Float, "morph_targets", 2, {}});
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("sg_pack_qt_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string rigPath = (dir / "sphere.rig.yaml").string();
+  sgtest::writeText(rigPath, sg::rigToYaml(rig));
+
+  sg::ValidateOptions vo;
+  vo.gen.rigPath = rigPath;
+  vo.gen.fragmentPath = sourcePath("tests/gltf/data/frame.frag");
+  vo.gen.rulesPaths = {sourcePath("rules/standard.yaml")};
+  const sg::ValidationScene scene = sg::gltfScene(model, sg::GltfSceneOptions{});
+  sg::Validator validator(vo);
+  const sg::ValidateReport rep = validator.run(scene);
+  std::cout << sg::formatReport(rep);
+  EXPECT_TRUE(rep.pass);
+  ASSERT_FALSE(rep.runs.empty());
+  EXPECT_TRUE(sgtest::planHas(rep.runs[0], "vertex_normal_from_qtangent"));
+  EXPECT_TRUE(sgtest::planHas(rep.runs[0], "object_position_morphed_scaled"));
+
+  const sg::GenerateResult r = sg::generate(vo.gen);
+  const sg::PackedVertices packed = sg::packVertices(r, scene.mesh);
+  std::filesystem::remove_all(dir);
+  const nlohmann::json layout = nlohmann::json::parse(packed.layoutJson);
+  auto snorm16 = [&](const nlohmann::json& s, size_t v, int c) {
+    int16_t raw;
+    std::memcpy(&raw, packed.bytes.data() + s["offset"].get<size_t>() + v * s["stride"].get<size_t>() + 2 * c, 2);
+    return std::max(raw / 32767.0, -1.0);
+  };
+  const auto& n = scene.mesh.at("vertex.normal");
+  const auto& t = scene.mesh.at("vertex.tangent");
+  const auto& w = scene.mesh.at("vertex.handedness");
+  int targetsRead = 0;
+  for (const auto& s : layout["streams"]) {
+    const nlohmann::json& part = s["provides"][0];
+    if (s["attribute"] == "normal") {
+      ASSERT_EQ(part["encodes"], nlohmann::json::array({"vertex.normal", "vertex.tangent", "vertex.handedness"}));
+      const double bound = part["max_error_deg"];
+      double worst = 0;
+      size_t handednessWrong = 0;
+      for (size_t v = 0; v < scene.mesh.vertexCount; ++v) {
+        const glm::dvec4 q(snorm16(s, v, 0), snorm16(s, v, 1), snorm16(s, v, 2), snorm16(s, v, 3));
+        const Frame f{glm::dvec3(n[v]), glm::dvec3(t[v]), w[v].x};
+        worst = std::max(worst, angleDegrees(rotate(q, {0, 0, 1}), f.normal));
+        if (const auto want = expectedTangent(f)) worst = std::max(worst, angleDegrees(rotate(q, {1, 0, 0}), *want));
+        handednessWrong += (q.w < 0) != (f.handedness < 0);
+      }
+      std::cout << "QTangents: worst " << worst << " deg (stated " << bound << ")\n";
+      EXPECT_LE(worst, bound);
+      EXPECT_GT(worst, 0.0);
+      EXPECT_EQ(handednessWrong, 0u);
+    }
+    if (s["attribute"] == "position_morph") {
+      const int target = s["target"];
+      const double scale = part["scale"], bound = part["max_error_of_target_scale"];
+      EXPECT_EQ(layout["uniforms"]["morph.position_scale"][target], part["scale"]);
+      const auto& d = scene.mesh.at("morph.position[" + std::to_string(target) + "]");
+      double worst = 0;
+      for (size_t v = 0; v < scene.mesh.vertexCount; ++v) {
+        const glm::dvec3 read(snorm16(s, v, 0) * scale, snorm16(s, v, 1) * scale, snorm16(s, v, 2) * scale);
+        worst = std::max(worst, glm::length(read - glm::dvec3(d[v])) / scale);
+      }
+      std::cout << "target " << target << " (scale " << scale << "): worst " << worst << " of the scale (stated " << bound
+                << ")\n";
+      EXPECT_LE(worst, bound);
+      EXPECT_GT(worst, 0.0);
+      ++targetsRead;
+    }
+  }
+  EXPECT_EQ(targetsRead, 2);
 }
 
 }  // namespace

@@ -89,6 +89,7 @@ TEST(RuleCheck, StandardLibraryOverSeveralRigsChecksEveryRule) {
       dataPath("limb8_palette300.rig.yaml"),             dataPath("rigid1.rig.yaml"),
       dataPath("unskinned_model.rig.yaml"),              dataPath("unskinned_identity.rig.yaml"),
       sourcePath("tests/examples/data/binormal.rig.yaml"), dataPath("bounds.rig.yaml"),  // encoded position and frame
+      dataPath("qtangent.rig.yaml"), dataPath("morph_scaled.rig.yaml"),  // the frame as a QTangent, scaled deltas
       std::string(SG_SHARED_DIR) + "/models/SimpleSkin/SimpleSkin.gltf#0/0"};
   std::map<std::string, Status> best;  // Agrees < Disagrees < Unchecked < NotApplicable
   for (const auto& rig : rigs) {
