@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 
+#include "rig/vertex_encoding.h"
 #include "search/search.h"
 
 namespace sg {
@@ -214,10 +215,16 @@ std::vector<UnreachableGoal> analyzeUnreachable(const Problem& p, const RuleSet&
     }
     return out;
   };
+  // A value an encoding stores (vertex.tangent from a QTangent) is still an input a rig may
+  // provide as it is, though decode rules produce it too: it stays a set of its own.
+  std::set<std::string> plainInputs;
+  for (const auto& e : vertexEncodings())
+    for (const auto& s : e.decodes()) plainInputs.insert(s);
+  auto family = [](const std::string& name) { return name.substr(0, name.find('[')); };
   std::vector<Sets> opts(n);
   for (size_t f = 0; f < n; ++f) {
     if (isInit[f]) opts[f] = {{}};
-    else if (!producible[f]) opts[f] = {{static_cast<int>(f)}};
+    else if (!producible[f] || plainInputs.count(family(p.facts[f].name))) opts[f] = {{static_cast<int>(f)}};
   }
   for (int iter = 0; iter < 200; ++iter) {
     bool changed = false;
