@@ -60,7 +60,9 @@ std::string floorShader(const GenerateResult& g, bool capture, bool allInputs) {
   int location = -1;
   for (const auto& in : g.glsl.inputs)
     for (const auto& part : g.in.rig.attributes[in.attribute].provides)
-      if (part.semantic == "vertex.position" && location < 0) {
+      // The stored position in whichever form the rig keeps it (a bounds-relative code is a
+      // position too, for a floor): without it the floor would read no input at all.
+      if ((part.semantic == "vertex.position" || part.semantic == "vertex.position_in_bounds") && location < 0) {
         location = in.location;
         pos = in.name + (componentCount(in.type) > 3 ? ".xyz" : "");
         if (componentCount(in.type) < 3) pos = "";

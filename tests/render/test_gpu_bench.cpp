@@ -100,6 +100,34 @@ TEST(GpuBench, AProgramThatFailsOnTheDeviceIsReportedAndNotTimed) {
   EXPECT_NE(sg::formatGpuBench(rep).find("| generated | FAIL"), std::string::npos);
 }
 
+TEST(GpuBench, FloorsReadThePositionInEitherLayoutAndArePredicted) {
+  // The pass-through floor reads the stored position, float or bounds-relative (it once read
+  // nothing for the packed face); the other floor reads every input of the generated plan.
+  // Under a profile both are predicted from their amounts, at the bench mesh's vertex count.
+  for (const char* rig : {"examples/dawn/face.rig.yaml", "examples/dawn/face-packed.rig.yaml"}) {
+    sg::GpuBenchOptions b = quickBench(sourcePath("examples/dawn/rules.yaml"));
+    b.render.gen.rigPath = sourcePath(rig);
+    b.render.gen.deviceProfilePath = sourcePath("devices/nvidia-h200.yaml");
+    b.alternatives = false;
+    b.floor = true;
+    b.rasterOff = false;
+    sg::GpuBenchReport rep = sg::runGpuBench(b);
+    ASSERT_EQ(rep.rows.size(), 3u) << rig;
+    const sg::GpuBenchRow &gen = rep.rows[0], &pass = rep.rows[1], &all = rep.rows[2];
+    ASSERT_TRUE(pass.hasAmounts && all.hasAmounts) << rig;
+    EXPECT_FALSE(pass.hasCost) << rig;
+    EXPECT_EQ(pass.amounts[sg::kTermLocations], 1) << rig;
+    EXPECT_EQ(all.amounts[sg::kTermLocations], gen.amounts[sg::kTermLocations]) << rig;
+    EXPECT_EQ(all.amounts[sg::kTermAttributeBytes], gen.amounts[sg::kTermAttributeBytes]) << rig;
+    EXPECT_EQ(pass.amounts[sg::kTermOutputs], gen.amounts[sg::kTermOutputs]) << rig;
+    EXPECT_GT(all.amounts[sg::kTermArithmetic], pass.amounts[sg::kTermArithmetic]) << rig;
+    // Predicted with the profile's weights at the head's 2,009 vertices (+1), not at its 180,000.
+    sg::DeviceProfile prof = sg::loadDeviceProfile(sourcePath("devices/nvidia-h200.yaml"));
+    EXPECT_NEAR(pass.predictedNsPerVertex, prof.predictNanoseconds(pass.amounts, double(rep.vertices + 1)), 1e-9) << rig;
+    EXPECT_GT(pass.predictedNsPerVertex, prof.predictNanoseconds(pass.amounts, prof.verticesPerDraw)) << rig;
+  }
+}
+
 TEST(GpuBench, HandPortOfListing33ComputesWhatTheGeneratedShaderComputes) {
   sg::GenerateOptions g;
   g.rigPath = sourcePath("examples/dawn/face.rig.yaml");
