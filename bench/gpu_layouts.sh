@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Runs on the GPU machine, from the unpacked bundle of bench/gpu_bundle.sh: the Dawn face's
-# vertex layouts timed at Dawn scale (docs/performance.md, "Layouts"). The float layout
-# (face.rig.yaml, 220 B in 16 locations) and the packed one (face-packed.rig.yaml, 116 B in
-# 16 locations: bounds-relative unorm16 positions, octahedral frame, halves, bytes), each
-# planned by instruction slots and under the H200 profile; every program validated on the
-# device before it is timed, the hand port of listing 3-3 and the floors beside them.
+# vertex layouts timed at Dawn scale (docs/performance.md, "Vertex layouts on the H200"). The
+# float layout (face.rig.yaml, 220 B in 16 locations) and the packed one (face-packed.rig.yaml,
+# 112 B in 15 locations: bounds-relative unorm16 positions, the frame as a QTangent, halves,
+# bytes), each planned by instruction slots and under the H200 profile; every program
+# validated on the device before it is timed (and both layouts' plans under the profile with
+# --cross-check first), the hand port of listing 3-3 and the floors beside them.
 # Usage: bash gpu_layouts.sh [DEVICE=NVIDIA]   (SG_MESH, SG_DRAWS, SG_FRAMES: a quick local try)
 set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -13,8 +14,13 @@ mesh=${SG_MESH:-dawn}
 draws=${SG_DRAWS:-64}
 frames=${SG_FRAMES:-11}
 source "$here/gpu_env.sh"
-common=(-f "$here/examples/dawn/face.frag" -r "$here/examples/dawn/rules.yaml" --templates "$here/templates"
-        --device "$device" --no-validation-layers --mesh "$mesh" --raster on --draws "$draws" --frames "$frames" --rounds 2)
+face=(-f "$here/examples/dawn/face.frag" -r "$here/examples/dawn/rules.yaml" --templates "$here/templates")
+for rig in face face-packed; do
+  echo "== validate $rig.rig.yaml under the H200 profile, $mesh mesh, cross-check"
+  "$sg" validate --rig "$here/examples/dawn/$rig.rig.yaml" "${face[@]}" --device-profile "$here/devices/nvidia-h200.yaml" \
+    --device "$device" --no-validation-layers --mesh "$mesh" --cross-check | grep -E '^(PASS|FAIL)|: PASS|: FAIL'
+done
+common=("${face[@]}" --device "$device" --no-validation-layers --mesh "$mesh" --raster on --draws "$draws" --frames "$frames" --rounds 2)
 for rig in face face-packed; do
   # The hand port reads the float layout's attributes as they are: only that layout has it.
   hand=()

@@ -277,11 +277,10 @@ EOF
   cat >>other.cpp <<'EOF'
 #include "packed.spv.h"
 #include <vulkan/vulkan_core.h>
-static_assert(PACKED_INPUT_COUNT == 16u, "16 inputs");
+static_assert(PACKED_INPUT_COUNT == 15u, "15 inputs");
 static_assert(PACKED_A_COORD_LOCATION == 0u && PACKED_A_COORD_FORMAT == VK_FORMAT_R16G16B16A16_UNORM, "coord");
 static_assert(PACKED_A_COORD_STRIDE == 8u, "coord stride");
-static_assert(PACKED_A_FRAME_FORMAT == VK_FORMAT_R16G16B16A16_SNORM && PACKED_A_FRAME_STRIDE == 8u, "frame");
-static_assert(PACKED_A_HANDEDNESS_FORMAT == VK_FORMAT_R8G8B8A8_SNORM && PACKED_A_HANDEDNESS_STRIDE == 4u, "handedness");
+static_assert(PACKED_A_FRAME_FORMAT == VK_FORMAT_R16G16B16A16_SNORM && PACKED_A_FRAME_STRIDE == 8u, "frame (a QTangent)");
 static_assert(PACKED_A_BONE_WEIGHT_FORMAT == VK_FORMAT_R8G8B8A8_UNORM, "weights");
 static_assert(PACKED_A_SKIN_UVST_FORMAT == VK_FORMAT_R16G16B16A16_SFLOAT, "uvst");
 EOF
