@@ -13,6 +13,7 @@
 #include <set>
 
 #include "runtime/procedural.h"
+#include "validate/float_check.h"
 #include "validate/interpreter.h"
 #include "validate/poses.h"
 
@@ -158,6 +159,8 @@ struct PoseReference {
   UniformValues uniforms;  // what they were computed with
   std::map<std::string, std::vector<double>> values;
   std::map<std::string, std::string> unchecked;  // why a semantic cannot be evaluated ("" if it can)
+  // The reference on the float data and its tolerances (float_check.h), for the second check.
+  std::map<std::string, std::vector<double>> floatValues, floatTolerance;
 };
 
 struct Validator::ReferenceCache {
@@ -177,8 +180,9 @@ struct Validator::ReferenceCache {
   void trim(size_t i) {
     size_t bytes = 0;
     for (const auto& p : poses)
-      for (const auto& [sem, v] : p.values) bytes += v.size() * sizeof(double);
-    if (bytes > kMaxBytes) poses[i].values.clear();
+      for (const auto* m : {&p.values, &p.floatValues, &p.floatTolerance})
+        for (const auto& [sem, v] : *m) bytes += v.size() * sizeof(double);
+    if (bytes > kMaxBytes) poses[i].values.clear(), poses[i].floatValues.clear(), poses[i].floatTolerance.clear();
   }
 };
 
@@ -229,7 +233,6 @@ RunReport Validator::runOne(const GenerateResult& r, const ValidationScene& scen
 
 RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh, const ValidationScene& scene,
                                   const std::vector<rt::Pose>& poses, const std::string& label, ReferenceCache* cache) {
-  (void)scene;
   RunReport rep;
   rep.label = label;
   rep.planCost = r.plan.cost;
@@ -252,6 +255,15 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
   size_t before = reportedMessages_;
   const RigShape shape = shapeOfRig(rig, r.in.rules);
   const RuleSet& rules = r.in.rules;
+  // The second check: the original float data where the scene has it, what the device reads
+  // elsewhere (codes given without their source, the mesh's bounds).
+  const std::vector<InputErrorBound> bounds =
+      opts_.checkFloatData ? quantizationErrorBounds(rig, scene.mesh) : std::vector<InputErrorBound>{};
+  rt::Mesh floatMesh;
+  if (!bounds.empty()) {
+    floatMesh = mesh;
+    for (const auto& [sem, stream] : scene.mesh.streams) floatMesh.streams[sem] = stream;
+  }
   for (size_t pi = 0; pi < poses.size(); ++pi) {
     const rt::Pose& pose = poses[pi];
     // The pose's uniforms (and those defined over them, as floats) and palettes; the
@@ -310,6 +322,24 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
       for (size_t k = 0; k < missing.size(); ++k) pr.values[missing[k]] = std::move(values[k]);
     }
     rep.referenceMs += msSince(t0);
+    if (!bounds.empty()) {
+      auto tf = Clock::now();
+      std::vector<std::string> floatMissing;
+      for (size_t oi = 0; oi < r.glsl.outputs.size(); ++oi)
+        if (!rep.outputs[oi].unchecked)
+          for (const auto& sem : r.glsl.outputs[oi].semantics)
+            if (!pr.floatValues.count(sem) &&
+                std::find(floatMissing.begin(), floatMissing.end(), sem) == floatMissing.end())
+              floatMissing.push_back(sem);
+      if (!floatMissing.empty()) {
+        FloatReference f = floatReference(rules, shape, floatMesh, pr.uniforms, bounds, floatMissing);
+        for (size_t k = 0; k < floatMissing.size(); ++k) {
+          pr.floatValues[floatMissing[k]] = std::move(f.values[k]);
+          pr.floatTolerance[floatMissing[k]] = std::move(f.tolerance[k]);
+        }
+      }
+      rep.floatCheckMs += msSince(tf);
+    }
     // Compare vertex by vertex, every output of a captured record together (one pass over
     // the capture). Matrices: columns in order; arrays: elements in order (both as their
     // semantics list them).
@@ -318,6 +348,7 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
       OutputReport* out;
       std::vector<std::pair<const double*, size_t>> refs;  // values, components
       size_t comps;
+      std::vector<std::pair<const double*, const double*>> floatRefs;  // float values and tolerances, as refs
     };
     std::vector<Compared> compared;
     size_t widest = 0;
@@ -325,12 +356,15 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
       if (rep.outputs[oi].unchecked) continue;
       const EmittedOutput& o = r.glsl.outputs[oi];
       Compared c{&o, &rep.outputs[oi], {}, static_cast<size_t>(componentCount(o.type) * std::max(1, o.arraySize))};
-      for (const auto& sem : o.semantics)
+      for (const auto& sem : o.semantics) {
         c.refs.emplace_back(pr.values.at(sem).data(), static_cast<size_t>(reference.components(sem)));
+        if (!bounds.empty()) c.floatRefs.emplace_back(pr.floatValues.at(sem).data(), pr.floatTolerance.at(sem).data());
+      }
+      rep.outputs[oi].floatCheck.ran = !bounds.empty();
       widest = std::max(widest, c.comps);
       compared.push_back(std::move(c));
     }
-    std::vector<double> ref(widest), gpu(widest);
+    std::vector<double> ref(widest), gpu(widest), floatRef(widest), floatTol(widest);
     for (size_t v = 0; v < mesh.vertexCount; ++v) {
       const uint8_t* record = res.captured.data() + v * r.glsl.captureStride;
       for (Compared& cmp : compared) {
@@ -340,6 +374,14 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
         size_t k = 0;
         for (const auto& [values, width] : cmp.refs)
           for (size_t c = 0; c < width && k < comps; ++c) ref[k++] = values[v * width + c];
+        k = 0;
+        for (size_t si = 0; si < cmp.floatRefs.size(); ++si) {
+          const size_t width = cmp.refs[si].second;
+          for (size_t c = 0; c < width && k < comps; ++c, ++k) {
+            floatRef[k] = cmp.floatRefs[si].first[v * width + c];
+            floatTol[k] = cmp.floatRefs[si].second[v * width + c];
+          }
+        }
         const uint8_t* rec = record + o.captureOffset;
         const ScalarKind kind = scalarKind(o.type);
         double scale = 1.0;
@@ -374,6 +416,31 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
           out.maxRelError = std::max(out.maxRelError, rel);
           if (err > opts_.tolerance.abs + opts_.tolerance.rel * scale) out.pass = false;
         }
+        if (cmp.floatRefs.empty()) continue;
+        // Second check: the float tolerance (at the float reference's scale) plus the derived
+        // bound of what storing the inputs changes.
+        double floatScale = 1.0;
+        for (size_t c = 0; c < comps; ++c)
+          if (std::isfinite(floatRef[c])) floatScale = std::max(floatScale, std::abs(floatRef[c]));
+        OutputReport::FloatCheck& fc = out.floatCheck;
+        for (size_t c = 0; c < comps; ++c) {
+          if (!std::isfinite(floatRef[c]) || !std::isfinite(floatTol[c])) {
+            ++fc.notCompared;
+            continue;
+          }
+          const double dev = std::isfinite(gpu[c]) ? std::abs(gpu[c] - floatRef[c]) : INFINITY;
+          const double tol = opts_.tolerance.abs + opts_.tolerance.rel * floatScale + floatTol[c];
+          const double ratio = tol / dev;
+          if (ratio < fc.ratio) {
+            fc.ratio = ratio;
+            fc.tolerance = tol;
+            fc.deviation = dev;
+            fc.worstVertex = v;
+            fc.worstComponent = static_cast<int>(c);
+          }
+          fc.maxDeviation = std::max(fc.maxDeviation, dev);
+          if (!(dev <= tol)) fc.pass = false;
+        }
       }
     }
     if (cache) cache->trim(pi);
@@ -382,8 +449,10 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
   rep.validationMessages.assign(msgs.begin() + static_cast<long>(before), msgs.end());
   reportedMessages_ = msgs.size();
   rep.pass = rep.validationMessages.empty();
-  for (auto& o : rep.outputs)
+  for (auto& o : rep.outputs) {
     if (o.unchecked && opts_.strict) o.pass = false;
+    o.pass = o.pass && o.floatCheck.pass;
+  }
   for (const auto& o : rep.outputs) rep.pass = rep.pass && o.pass;
   return rep;
 }
@@ -479,12 +548,22 @@ std::string formatReport(const ValidateReport& report) {
       s += fmt::format("  {:<4} {:<20} max abs {:.3e}  max rel {:.3e}  worst vertex {} [{}]  ({})\n",
                        o.pass ? "ok" : "FAIL", o.name, o.maxAbsError, o.maxRelError, o.worstVertex, o.worstComponent, sems);
       if (!o.nonFinite.empty()) s += "       " + o.nonFinite + "\n";
+      if (const auto& f = o.floatCheck; f.ran) {
+        s += fmt::format("  {:<4} {:<20} vs float data: max dev {:.3e}  tolerance/observed {:.3g} at vertex {} [{}] "
+                         "(tolerance {:.3e}, dev {:.3e})",
+                         f.pass ? "ok" : "FAIL", "", f.maxDeviation, f.ratio, f.worstVertex, f.worstComponent,
+                         f.tolerance, f.deviation);
+        s += f.notCompared ? fmt::format(", {} component(s) not compared: not finite\n", f.notCompared) : "\n";
+      }
     }
     for (const auto& m : run.validationMessages) s += "  validation layer: " + m + "\n";
     s += fmt::format("  time: generate {:.1f} ms, setup {:.1f} ms, upload {:.1f} ms, run {:.1f} ms, readback {:.1f} ms, "
-                     "reference {:.1f} ms\n",
+                     "reference {:.1f} ms",
                      run.generateMs, run.timings.setupMs, run.timings.uploadMs, run.timings.runMs,
                      run.timings.readbackMs, run.referenceMs);
+    bool floatChecked = false;
+    for (const auto& o : run.outputs) floatChecked = floatChecked || o.floatCheck.ran;
+    s += floatChecked ? fmt::format(", float check {:.1f} ms\n", run.floatCheckMs) : "\n";
   }
   s += fmt::format("{}: {} run(s)\n", report.pass ? "PASS" : "FAIL", report.runs.size());
   return s;

@@ -2,6 +2,7 @@
 // mesh in given poses and compare every output with the GLM reference of its
 // semantics. Tolerances and their justification: docs/validation.md.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -40,6 +41,19 @@ struct OutputReport {
   std::string uncheckedReason;
   // The first NaN or infinity seen, on which side, where, and the inputs that produced it.
   std::string nonFinite;
+  // The second check, for a rig that stores encoded or quantized streams: the device against
+  // the reference on the original float data, within the float tolerance plus the derived
+  // bound of what storing the inputs may change (validate/float_check.h).
+  struct FloatCheck {
+    bool ran = false;
+    bool pass = true;
+    double maxDeviation = 0;  // max |gpu - float reference|
+    double ratio = INFINITY;  // the smallest tolerance / |gpu - float reference| (< 1 fails)
+    double tolerance = 0, deviation = 0;  // where the ratio is smallest
+    size_t worstVertex = 0;
+    int worstComponent = 0;
+    size_t notCompared = 0;  // components whose float reference or tolerance is not finite
+  } floatCheck;
 };
 
 struct RunReport {
@@ -51,6 +65,7 @@ struct RunReport {
   std::vector<std::string> validationMessages;
   rt::RunTimings timings;
   double referenceMs = 0;
+  double floatCheckMs = 0;  // the float reference and its tolerances
   double generateMs = 0;
   bool pass = true;
 };
@@ -108,6 +123,9 @@ struct ValidateOptions {
   std::string device;       // "" = lavapipe
   bool validationLayers = true;
   bool strict = false;  // an unchecked output (no definition) fails the run
+  // Also check against the original float data (OutputReport::FloatCheck) when the rig
+  // stores encoded or quantized streams.
+  bool checkFloatData = true;
 };
 
 class Validator {

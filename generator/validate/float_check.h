@@ -1,0 +1,31 @@
+// The second check of a rig that stores encoded or quantized streams (issue 22): the device's
+// outputs against the reference on the original float data, within tolerances derived from
+// the stated worst errors of the formats and encodings by first-order error propagation
+// through the reference, plus a second-order term. Derivation: docs/validation.md, "Against
+// the float data".
+#pragma once
+#include <string>
+#include <vector>
+
+#include "runtime/mesh.h"
+#include "validate/interpreter.h"
+#include "validate/program_inputs.h"
+
+namespace sg {
+
+struct FloatReference {
+  // Per requested semantic, values[s][v * n + c] as Interpreter::evaluate lays them out.
+  std::vector<std::vector<double>> values;     // the reference on the float data
+  std::vector<std::vector<double>> tolerance;  // how far storing the inputs may move each value
+};
+
+// The reference of `semantics` on `floatMesh` and, per value, the bound
+//   sum over bounded streams of |d value / d input| . bound  (a ball: its Euclidean norm)
+//   + (sum over inputs of sqrt(|d2 value / d input2|) . bound)^2
+// with both derivatives from central differences of the reference (two evaluations per
+// bounded input component). `floatMesh` is perturbed and restored in place.
+FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::Mesh& floatMesh,
+                              const UniformValues& uniforms, const std::vector<InputErrorBound>& bounds,
+                              const std::vector<std::string>& semantics);
+
+}  // namespace sg
