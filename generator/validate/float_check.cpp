@@ -54,14 +54,15 @@ FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::M
         if (b.ball && ballSquares[s].empty()) ballSquares[s].assign(f0[s].size(), 0.0);
         for (size_t v = 0; v < n; ++v) {
           if (bound[v] == 0) continue;
+          // Slope (f+ - f-) / (a + c) and curvature 2 (c f+ + a f- - (a + c) f0) / (a c (a + c))
+          // for steps a up and c down, both times the bound (the curvature's square root).
           const double a = up[v], c = down[v];
+          const double slopeScale = bound[v] / (a + c), curvatureScale = 2 * bound[v] * bound[v] / (a * c * (a + c));
           for (size_t i = v * w; i < (v + 1) * w; ++i) {
-            const double slope = (fp[s][i] - fm[s][i]) / (a + c);
-            const double curvature = 2 * (c * fp[s][i] + a * fm[s][i] - (a + c) * f0[s][i]) / (a * c * (a + c));
-            const double linear = std::abs(slope) * bound[v];
+            const double linear = std::abs(fp[s][i] - fm[s][i]) * slopeScale;
             if (b.ball) ballSquares[s][i] += linear * linear;
             else first[s][i] += linear;
-            second[s][i] += std::sqrt(std::abs(curvature)) * bound[v];
+            second[s][i] += std::sqrt(std::abs(c * fp[s][i] + a * fm[s][i] - (a + c) * f0[s][i]) * curvatureScale);
           }
         }
       }

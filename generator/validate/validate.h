@@ -66,6 +66,7 @@ struct RunReport {
   rt::RunTimings timings;
   double referenceMs = 0;
   double floatCheckMs = 0;  // the float reference and its tolerances
+  size_t floatCheckStride = 1;  // the second check compared every this-th vertex
   double generateMs = 0;
   bool pass = true;
 };
@@ -126,6 +127,8 @@ struct ValidateOptions {
   // Also check against the original float data (OutputReport::FloatCheck) when the rig
   // stores encoded or quantized streams.
   bool checkFloatData = true;
+  // At most this many vertices (every k-th) in the second check; 0: all.
+  size_t floatCheckVertices = 20000;
 };
 
 class Validator {
