@@ -200,15 +200,18 @@ std::vector<InputErrorBound> errorBounds(const Rig& rig, const rt::Mesh& mesh) {
         if (e && e->angular()) {
           // Within the stated angle of the data's direction: at most its chord 2 sin(angle / 2)
           // from the unit vector, which is | |x| - 1 | from x.
+          // The decode is rounded to float: sqrt(3) 2^-24 more.
           b.ball = true;
-          const double chord = 2 * std::sin(glm::radians(*encodingMaxError(*e, a.format)) / 2);
+          const double chord = 2 * std::sin(glm::radians(*encodingMaxError(*e, a.format)) / 2) + std::sqrt(3.0) * std::ldexp(1.0, -24);
           for (size_t v = 0; v < mesh.vertexCount && v < x.size(); ++v)
             b.bound[v] = glm::dvec4(chord + std::abs(glm::length(glm::dvec3(x[v])) - 1));
         } else if (e) {
-          // Each coordinate within the stated fraction of its axis's extent.
+          // Each coordinate within the stated fraction of its axis's extent, and the float
+          // rounding of the decoded coordinate (2^-24 of it).
           const PositionBounds box = meshBounds(mesh);
           const double f = *encodingMaxError(*e, a.format);
-          for (auto& bv : b.bound) bv = glm::dvec4(f * glm::dvec3(box.extent), 0);
+          for (size_t v = 0; v < mesh.vertexCount && v < x.size(); ++v)
+            b.bound[v] = glm::dvec4(f * glm::dvec3(box.extent) + glm::abs(glm::dvec3(x[v])) * std::ldexp(1.0, -24), 0);
         } else {
           const bool renormalised = std::count(weights.sets.begin(), weights.sets.end(), p.semantic) != 0;
           const double step = 1 / (std::ldexp(1.0, weights.bits) - 1);
