@@ -79,14 +79,14 @@ FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::M
       for (size_t v = 0; v < n; ++v) {
         if (a.bound[v] == 0) continue;
         // Slope (f+ - f-) / (u + d) and curvature 2 (d f+ + u f- - (u + d) f0) / (u d (u + d))
-        // for steps u up and d down, times the bound (the curvature's square root).
+        // for steps u up and d down, times the bound (its square for the curvature).
         const double u = up[v], d = down[v];
         const double slopeScale = a.bound[v] / (u + d), curvatureScale = 2 * a.bound[v] * a.bound[v] / (u * d * (u + d));
         for (size_t i = v * w; i < (v + 1) * w; ++i) {
           const double linear = (fp[s][i] - fm[s][i]) * slopeScale;
           a.linear[s][i] = static_cast<float>(linear);
           if (!a.group->ball) first[s][i] += std::abs(linear);
-          second[s][i] += std::sqrt(std::abs(d * fp[s][i] + u * fm[s][i] - (u + d) * f0[s][i]) * curvatureScale);
+          second[s][i] += std::abs(d * fp[s][i] + u * fm[s][i] - (u + d) * f0[s][i]) * curvatureScale;
         }
       }
     }
@@ -164,7 +164,7 @@ FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::M
   for (size_t s = 0; s < f0.size(); ++s) {
     const size_t w = widths[s];
     for (size_t i = 0; i < f0[s].size(); ++i)
-      out.tolerance[s][i] = unbounded[i / w] ? INFINITY : out.tolerance[s][i] + second[s][i] * second[s][i] + corner[s][i];
+      out.tolerance[s][i] = unbounded[i / w] ? INFINITY : out.tolerance[s][i] + second[s][i] + corner[s][i];
   }
   return out;
 }

@@ -19,11 +19,14 @@ struct FloatReference {
   std::vector<std::vector<double>> tolerance;  // how far storing the inputs may move each value
 };
 
-// The reference of `semantics` on `floatMesh` and, per value, the bound
-//   sum over bounded streams of |d value / d input| . bound  (a ball: its Euclidean norm)
-//   + (sum over inputs of sqrt(|d2 value / d input2|) . bound)^2
-// with both derivatives from central differences of the reference (two evaluations per
-// bounded input component). `floatMesh` is perturbed and restored in place.
+// The reference of `semantics` on `floatMesh` and, per value, the tolerance
+//   sum over bounded inputs of |d value / d input| . bound  (a direction: |gradient| . radius)
+//   + sum over inputs of |d2 value / d input2| . bound^2
+//   + |f(x + c) + f(x - c) - 2 f(x)|, c the corner of the bounds where the first-order
+//     change of that value is largest (the cross terms along it)
+// with the derivatives from central differences of the reference: two evaluations per
+// bounded input component, and two per component of each semantic. `floatMesh` is
+// perturbed and restored in place.
 FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::Mesh& floatMesh,
                               const UniformValues& uniforms, const std::vector<InputErrorBound>& bounds,
                               const std::vector<std::string>& semantics);
