@@ -1,6 +1,8 @@
 #include "validate/float_check.h"
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 
 namespace sg {
@@ -20,15 +22,16 @@ struct Axis {
 FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::Mesh& floatMesh,
                               const UniformValues& uniforms, const std::vector<InputErrorBound>& bounds,
                               const std::vector<std::string>& semantics) {
-  auto evaluate = [&](const std::vector<std::string>& which) {
-    return Interpreter(rules, shape, floatMesh, uniforms).evaluate(which);
-  };
+  // Compiled once per semantic set: the perturbations change stream values in place.
+  Interpreter reference(rules, shape, floatMesh, uniforms);
+  const auto evaluateAll = reference.evaluator(semantics);
+  std::vector<std::function<std::vector<std::vector<double>>()>> evaluateOne;
+  for (const auto& s : semantics) evaluateOne.push_back(reference.evaluator({s}));
   FloatReference out;
-  out.values = evaluate(semantics);
+  out.values = evaluateAll();
   const std::vector<std::vector<double>>& f0 = out.values;
   std::vector<size_t> widths;
-  Interpreter probe(rules, shape, floatMesh, uniforms);
-  for (const auto& s : semantics) widths.push_back(static_cast<size_t>(probe.components(s)));
+  for (const auto& s : semantics) widths.push_back(static_cast<size_t>(reference.components(s)));
   const size_t n = floatMesh.vertexCount;
   std::vector<bool> unbounded(n, false);  // an input's bound is infinite (a value its format cannot hold)
   std::map<std::string, std::vector<glm::vec4>> saved;  // the streams as given, restored after each evaluation
@@ -68,10 +71,10 @@ FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::M
       }
     };
     step(1, up);
-    const auto fp = evaluate(semantics);
+    const auto fp = evaluateAll();
     step(-1, down);
-    const auto fm = evaluate(semantics);
-    stream = given;
+    const auto fm = evaluateAll();
+    std::copy(given.begin(), given.end(), stream.begin());
     a.linear.resize(f0.size());
     for (size_t s = 0; s < f0.size(); ++s) {
       const size_t w = widths[s];
@@ -147,15 +150,18 @@ FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::M
         for (const auto& [sem, m] : moves) {
           std::vector<glm::vec4>& stream = floatMesh.streams.at(sem);
           const std::vector<glm::vec4>& given = saved.at(sem);
-          for (size_t v = 0; v < n; ++v) {
+          for (size_t v = 0; v < n && v < stream.size(); ++v) {
             stream[v] = glm::vec4(glm::dvec4(given[v]) + sign * m.step[v]);
             both[v] -= glm::dot(m.slope[v], glm::dvec4(stream[v]) - glm::dvec4(given[v]));
           }
         }
-        const auto f = evaluate({semantics[s]});
+        const auto f = evaluateOne[s]();
         for (size_t v = 0; v < n; ++v) both[v] += f[0][v * w + c];
       }
-      for (const auto& [sem, m] : moves) floatMesh.streams.at(sem) = saved.at(sem);
+      for (const auto& [sem, m] : moves) {
+        const std::vector<glm::vec4>& given = saved.at(sem);
+        std::copy(given.begin(), given.end(), floatMesh.streams.at(sem).begin());
+      }
       for (size_t v = 0; v < n; ++v) corner[s][v * w + c] = std::abs(both[v] - 2 * f0[s][v * w + c]);
     }
   }
