@@ -4,6 +4,8 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <optional>
+#include <set>
 
 namespace sg {
 namespace {
@@ -17,18 +19,52 @@ struct Axis {
   std::vector<std::vector<float>> linear;  // [semantic][value]
 };
 
+// The semantics `semantic`'s definition may read, directly or through other definitions, on
+// any branch (families by their name); nullopt if it is not declared.
+std::optional<std::set<std::string>> readsOf(const RuleSet& rules, const std::string& semantic) {
+  const SemanticDecl* d = rules.findSemantic(semantic);
+  if (!d) return std::nullopt;
+  std::set<std::string> seen;
+  std::vector<const SemanticDecl*> todo{d};
+  while (!todo.empty()) {
+    const SemanticDecl* x = todo.back();
+    todo.pop_back();
+    if (!seen.insert(x->name).second || !x->definition) continue;
+    for (int r : definitionReads(*x->definition)) todo.push_back(&rules.semantics[static_cast<size_t>(r)]);
+  }
+  return seen;
+}
+
 }  // namespace
 
 FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::Mesh& floatMesh,
                               const UniformValues& uniforms, const std::vector<InputErrorBound>& bounds,
                               const std::vector<std::string>& semantics) {
-  // Compiled once per semantic set: the perturbations change stream values in place.
+  // Compiled once per set of semantics: the perturbations change stream values in place. An
+  // input is perturbed only for the semantics that can read it.
   Interpreter reference(rules, shape, floatMesh, uniforms);
-  const auto evaluateAll = reference.evaluator(semantics);
-  std::vector<std::function<std::vector<std::vector<double>>()>> evaluateOne;
-  for (const auto& s : semantics) evaluateOne.push_back(reference.evaluator({s}));
+  using Evaluator = std::function<std::vector<std::vector<double>>()>;
+  std::map<std::vector<size_t>, Evaluator> evaluators;
+  auto evaluator = [&](const std::vector<size_t>& which) -> Evaluator& {
+    auto it = evaluators.find(which);
+    if (it != evaluators.end()) return it->second;
+    std::vector<std::string> names;
+    for (size_t s : which) names.push_back(semantics[s]);
+    return evaluators.emplace(which, reference.evaluator(names)).first->second;
+  };
+  std::vector<std::optional<std::set<std::string>>> reads;
+  for (const auto& s : semantics) reads.push_back(readsOf(rules, s));
+  auto readers = [&](const std::string& stream) {
+    const std::string family = stream.substr(0, stream.find('['));
+    std::vector<size_t> which;
+    for (size_t s = 0; s < semantics.size(); ++s)
+      if (!reads[s] || reads[s]->count(family)) which.push_back(s);
+    return which;
+  };
+  std::vector<size_t> all(semantics.size());
+  for (size_t s = 0; s < all.size(); ++s) all[s] = s;
   FloatReference out;
-  out.values = evaluateAll();
+  out.values = evaluator(all)();
   const std::vector<std::vector<double>>& f0 = out.values;
   std::vector<size_t> widths;
   for (const auto& s : semantics) widths.push_back(static_cast<size_t>(reference.components(s)));
@@ -70,13 +106,16 @@ FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::M
         taken[v] = std::abs(double(stream[v][k]) - x);
       }
     };
+    a.linear.resize(f0.size());  // empty for a semantic that cannot read the input: J = 0
+    const std::vector<size_t> which = readers(a.group->semantic);
+    if (which.empty()) continue;
     step(1, up);
-    const auto fp = evaluateAll();
+    const auto fp = evaluator(which)();
     step(-1, down);
-    const auto fm = evaluateAll();
+    const auto fm = evaluator(which)();
     std::copy(given.begin(), given.end(), stream.begin());
-    a.linear.resize(f0.size());
-    for (size_t s = 0; s < f0.size(); ++s) {
+    for (size_t j = 0; j < which.size(); ++j) {
+      const size_t s = which[j];
       const size_t w = widths[s];
       a.linear[s].assign(f0[s].size(), 0.0f);
       for (size_t v = 0; v < n; ++v) {
@@ -86,10 +125,10 @@ FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::M
         const double u = up[v], d = down[v];
         const double slopeScale = a.bound[v] / (u + d), curvatureScale = 2 * a.bound[v] * a.bound[v] / (u * d * (u + d));
         for (size_t i = v * w; i < (v + 1) * w; ++i) {
-          const double linear = (fp[s][i] - fm[s][i]) * slopeScale;
+          const double linear = (fp[j][i] - fm[j][i]) * slopeScale;
           a.linear[s][i] = static_cast<float>(linear);
           if (!a.group->ball) first[s][i] += std::abs(linear);
-          second[s][i] += std::abs(d * fp[s][i] + u * fm[s][i] - (u + d) * f0[s][i]) * curvatureScale;
+          second[s][i] += std::abs(d * fp[j][i] + u * fm[j][i] - (u + d) * f0[s][i]) * curvatureScale;
         }
       }
     }
@@ -99,7 +138,7 @@ FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::M
   auto ballNorms = [&](size_t s, size_t w, size_t c) {
     std::map<const InputErrorBound*, std::vector<double>> norms;
     for (const Axis& a : axes) {
-      if (!a.group->ball) continue;
+      if (!a.group->ball || a.linear[s].empty()) continue;
       auto& sq = norms[a.group];
       sq.resize(n, 0.0);
       for (size_t v = 0; v < n; ++v) sq[v] += double(a.linear[s][v * w + c]) * double(a.linear[s][v * w + c]);
@@ -129,6 +168,7 @@ FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::M
       };
       std::map<std::string, Move> moves;
       for (const Axis& a : axes) {
+        if (a.linear[s].empty()) continue;
         Move& m = moves[a.group->semantic];
         m.step.resize(n, glm::dvec4(0));
         m.slope.resize(n, glm::dvec4(0));
@@ -143,6 +183,7 @@ FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::M
           }
         }
       }
+      if (moves.empty()) continue;  // no bounded input reaches this semantic
       // f+ + f- - 2 f0, less the first-order part of the steps' asymmetry (the float data rounds
       // them): J . (up - down).
       std::vector<double> both(n, 0.0);
@@ -155,7 +196,7 @@ FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::M
             both[v] -= glm::dot(m.slope[v], glm::dvec4(stream[v]) - glm::dvec4(given[v]));
           }
         }
-        const auto f = evaluateOne[s]();
+        const auto f = evaluator({s})();
         for (size_t v = 0; v < n; ++v) both[v] += f[0][v * w + c];
       }
       for (const auto& [sem, m] : moves) {
