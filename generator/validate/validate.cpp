@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <optional>
 #include <type_traits>
 #include <random>
 #include <set>
@@ -255,19 +256,18 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
   size_t before = reportedMessages_;
   const RigShape shape = shapeOfRig(rig, r.in.rules);
   const RuleSet& rules = r.in.rules;
-  // The second check: the original float data where the scene has it, what the device reads
-  // elsewhere (codes given without their source, the mesh's bounds), on every floatStride-th
-  // vertex (it costs two reference evaluations per bounded input component).
-  const size_t floatStride = opts_.floatCheckVertices == 0 ? 1 : (mesh.vertexCount - 1) / opts_.floatCheckVertices + 1;
+  // The second check (float_check.h): the reference on the original float data where the
+  // scene has it, on what the device reads elsewhere (codes given without their source, the
+  // mesh's bounds). It costs two reference evaluations per bounded input component, so it
+  // compares every floatStride-th vertex of a large mesh.
+  const size_t cap = opts_.floatCheckVertices;
+  const size_t floatStride = cap == 0 ? 1 : std::max<size_t>(1, (mesh.vertexCount + cap - 1) / cap);
   std::vector<InputErrorBound> bounds;
-  rt::Mesh floatMesh;
-  if (opts_.checkFloatData && mesh.vertexCount > 0) {
-    rt::Mesh original = rt::everyNthVertex(scene.mesh, floatStride);
-    original.uniforms = mesh.uniforms;  // the bounds of the whole mesh
-    bounds = quantizationErrorBounds(rig, original);
-    floatMesh = rt::everyNthVertex(mesh, floatStride);
-    for (auto& [sem, stream] : original.streams) floatMesh.streams[sem] = std::move(stream);
-  }
+  if (opts_.checkFloatData) bounds = quantizationErrorBounds(rig, scene.mesh);
+  for (InputErrorBound& b : bounds)
+    for (size_t v = 0; v < b.bound.size(); v += floatStride) b.bound[v / floatStride] = b.bound[v];
+  for (InputErrorBound& b : bounds) b.bound.resize((b.bound.size() + floatStride - 1) / floatStride);
+  std::optional<rt::Mesh> floatMesh;  // built when a pose first needs it
   rep.floatCheckStride = floatStride;
   for (size_t pi = 0; pi < poses.size(); ++pi) {
     const rt::Pose& pose = poses[pi];
@@ -337,7 +337,11 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
                 std::find(floatMissing.begin(), floatMissing.end(), sem) == floatMissing.end())
               floatMissing.push_back(sem);
       if (!floatMissing.empty()) {
-        FloatReference f = floatReference(rules, shape, floatMesh, pr.uniforms, bounds, floatMissing);
+        if (!floatMesh) {
+          floatMesh = rt::everyNthVertex(mesh, floatStride);
+          for (auto& [sem, stream] : rt::everyNthVertex(scene.mesh, floatStride).streams) floatMesh->streams[sem] = std::move(stream);
+        }
+        FloatReference f = floatReference(rules, shape, *floatMesh, pr.uniforms, bounds, floatMissing);
         for (size_t k = 0; k < floatMissing.size(); ++k) {
           pr.floatValues[floatMissing[k]] = std::move(f.values[k]);
           pr.floatTolerance[floatMissing[k]] = std::move(f.tolerance[k]);
