@@ -23,10 +23,7 @@ namespace fs = std::filesystem;
 using sgtest::dataPath;
 using sgtest::sourcePath;
 
-const sg::RuleSet& standardRules() {
-  static const sg::RuleSet rules = sg::loadRules({sourcePath("rules/standard.yaml")});
-  return rules;
-}
+using sgtest::standardRules;
 
 // quantizeForRig moves no stream further than quantizationErrorBounds says, and for the
 // rounded formats (not the values they hold exactly) nearly that far.

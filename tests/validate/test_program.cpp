@@ -28,10 +28,7 @@ namespace rt = sg::rt;
 using sgtest::rigFor;
 using sgtest::sourcePath;
 
-const sg::RuleSet& standardRules() {
-  static const sg::RuleSet rules = sg::loadRules({sourcePath("rules/standard.yaml")});
-  return rules;
-}
+using sgtest::standardRules;
 
 // What one evaluation gives: values, or the error it threw.
 struct Outcome {
