@@ -1,7 +1,7 @@
 // The second check of a rig that stores encoded or quantized streams (issue 22): the device's
 // outputs against the reference on the original float data, within tolerances derived from
 // the stated worst errors of the formats and encodings by first-order error propagation
-// through the reference, plus a second-order term. Derivation: docs/validation.md, "Against
+// through the reference, plus second-order terms. Derivation: docs/validation.md, "Against
 // the float data".
 #pragma once
 #include <string>

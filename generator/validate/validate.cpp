@@ -458,9 +458,7 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
   rep.validationMessages.assign(msgs.begin() + static_cast<long>(before), msgs.end());
   reportedMessages_ = msgs.size();
   rep.pass = rep.validationMessages.empty();
-  for (auto& o : rep.outputs) {
-    o.pass = o.storedPass && o.floatCheck.pass && !(o.unchecked && opts_.strict);
-  }
+  for (auto& o : rep.outputs) o.pass = o.storedPass && o.floatCheck.pass && !(o.unchecked && opts_.strict);
   for (const auto& o : rep.outputs) rep.pass = rep.pass && o.pass;
   return rep;
 }
