@@ -211,6 +211,10 @@ TEST(FloatCheck, LargeMeshesAreSampled) {
   EXPECT_TRUE(rep.pass);
   EXPECT_EQ(rep.runs.at(0).floatCheckStride, 5u);  // 2009 vertices
   EXPECT_NE(sg::formatReport(rep).find("(1 vertex in 5)"), std::string::npos);
+  for (const auto& o : rep.runs.at(0).outputs) {
+    EXPECT_TRUE(o.floatCheck.ran) << o.name;
+    EXPECT_EQ(o.floatCheck.worstVertex % 5, 0u) << o.name;  // only the sample is compared
+  }
 }
 
 // Off when asked, and off by itself where every stream is stored exactly (float32, integers).
