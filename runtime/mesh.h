@@ -30,6 +30,19 @@ struct Mesh {
   const std::vector<glm::vec4>& at(const std::string& semantic) const { return streams.at(semantic); }
 };
 
+// Vertices 0, n, 2n, ... of `mesh` (n >= 1), with its uniforms: a sample of a large mesh.
+inline Mesh everyNthVertex(const Mesh& mesh, size_t n) {
+  Mesh m;
+  m.name = mesh.name + "/" + std::to_string(n);
+  m.vertexCount = (mesh.vertexCount + n - 1) / n;
+  for (const auto& [sem, values] : mesh.streams) {
+    auto& s = m.streams[sem];
+    for (size_t v = 0; v < values.size(); v += n) s.push_back(values[v]);
+  }
+  m.uniforms = mesh.uniforms;
+  return m;
+}
+
 // Uniform values for one frame. Matrices are column-major (GLM / GLSL convention).
 struct Pose {
   std::vector<glm::mat4> bones;       // skin.bones

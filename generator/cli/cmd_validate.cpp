@@ -24,6 +24,7 @@ struct ValidateCommand {
   bool crossCheck = false;
   std::string device;
   bool noLayers = false;
+  bool noFloatCheck = false;
   Tolerance tol;
   std::vector<double> times;  // glTF rigs: animation times
   std::string animation;
@@ -43,6 +44,7 @@ struct ValidateCommand {
     vo.limits = {!device.empty(), args.maxAttributes->count() > 0, args.maxUniformBytes->count() > 0};
     vo.validationLayers = !noLayers;
     vo.tolerance = tol;
+    vo.checkFloatData = !noFloatCheck;
     vo.strict = strict;
     ValidationScene scene;
     std::string what;
@@ -194,6 +196,10 @@ void registerValidate(CLI::App& app, CliState& state) {
       ->check(finiteNonNegative);
   sub->add_option("--tolerance-rel", cmd->tol.rel, "Relative tolerance (see docs/validation.md)")
       ->check(finiteNonNegative);
+  sub->add_flag("--no-float-check", cmd->noFloatCheck,
+                "Skip the second check of a rig that stores encoded or quantized streams: the outputs against the "
+                "reference on the original float data, within tolerances derived from the formats' and encodings' "
+                "stated errors (docs/validation.md, \"Against the float data\")");
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }
 

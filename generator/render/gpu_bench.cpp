@@ -222,6 +222,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   ValidateOptions vo;
   vo.device = opts.render.device;
   vo.validationLayers = opts.render.validationLayers;
+  vo.checkFloatData = false;  // the timed program's correctness is the first check; the second is validate's
   Validator validator(vo);
   GenerateOptions gen = opts.render.gen;
   const std::string limits = applyDeviceLimits(gen, opts.render.limits, validator.harness());

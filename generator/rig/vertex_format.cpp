@@ -108,6 +108,18 @@ float storedValue(VertexFormat f, int c, float v) {
   return v;
 }
 
+double storedValueMaxError(VertexFormat f, int c, double v) {
+  const FormatInfo& i = info(f);
+  const int bits = i.bits[static_cast<size_t>(c)];
+  switch (i.kind) {
+    case Kind::Float16: return std::abs(v) <= 65504 ? std::max(std::ldexp(std::abs(v), -11), std::ldexp(1.0, -25)) : INFINITY;
+    case Kind::Unorm: return 0.5 / (std::ldexp(1.0, bits) - 1) + std::ldexp(1.0, -24);
+    case Kind::Snorm: return 0.5 / (std::ldexp(1.0, bits - 1) - 1) + std::ldexp(1.0, -24);
+    case Kind::Float32: case Kind::Uint: return 0;
+  }
+  return 0;
+}
+
 void encodeElement(VertexFormat f, const float* components, uint8_t* dst) {
   const FormatInfo& i = info(f);
   if (f == VertexFormat::Unorm10_10_10_2 || f == VertexFormat::Snorm10_10_10_2) {

@@ -42,6 +42,12 @@ VulkanFormat vulkanFormat(VertexFormat f);
 // float16 (GLM) nearest, ties away from 0: |e| <= 2^-11 |v| on [2^-14, 65504], above: inf;
 // uint: rounded and clamped to the type. NaN is stored as 0 by the fixed-point formats.
 float storedValue(VertexFormat f, int c, float v);
+// Those bounds as a number: how far storedValue(f, c, v) may be from v, for v inside the
+// format's range (fixed point: half a step plus the float rounding of the read-back, 2^-24;
+// float16: 2^-11 |v|, at least half its smallest step, 2^-25; float32 and the integer
+// formats, which hold integers exactly: 0). Outside the range it is still the in-range
+// bound: a value the format cannot hold is the data's error, not rounding.
+double storedValueMaxError(VertexFormat f, int c, double v);
 // Writes one element of `f` (formatBytes(f) bytes, little-endian) from its components.
 void encodeElement(VertexFormat f, const float* components, uint8_t* dst);
 

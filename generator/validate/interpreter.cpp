@@ -252,19 +252,26 @@ std::string Interpreter::uncheckedReason(const std::string& semantic) {
 void Interpreter::setThreads(unsigned threads) { s_->threads = threads; }
 
 std::vector<std::vector<double>> Interpreter::evaluate(const std::vector<std::string>& semantics) {
+  return evaluator(semantics)();
+}
+
+std::function<std::vector<std::vector<double>>()> Interpreter::evaluator(const std::vector<std::string>& semantics) {
   std::vector<int> idx;
-  std::vector<std::vector<double>> out = s_->outputs(semantics, idx);
-  auto program = DefinitionProgram::compile(s_->rules, s_->shape, s_->mesh, s_->uniforms, idx);
-  if (!program) {
-    s_->walk(idx, out, 0, s_->mesh.vertexCount);
+  std::vector<std::vector<double>> blank = s_->outputs(semantics, idx);
+  std::shared_ptr<DefinitionProgram> program = DefinitionProgram::compile(s_->rules, s_->shape, s_->mesh, s_->uniforms, idx);
+  return [this, idx, blank = std::move(blank), program] {
+    std::vector<std::vector<double>> out = blank;
+    if (!program) {
+      s_->walk(idx, out, 0, s_->mesh.vertexCount);
+      return out;
+    }
+    // Batches where a check failed: the tree walker throws the error it finds there.
+    for (size_t b : program->run(out, s_->threads)) {
+      const size_t first = b * DefinitionProgram::kBatch;
+      s_->walk(idx, out, first, std::min(s_->mesh.vertexCount, first + DefinitionProgram::kBatch));
+    }
     return out;
-  }
-  // Batches where a check failed: the tree walker throws the error it finds there.
-  for (size_t b : program->run(out, s_->threads)) {
-    const size_t first = b * DefinitionProgram::kBatch;
-    s_->walk(idx, out, first, std::min(s_->mesh.vertexCount, first + DefinitionProgram::kBatch));
-  }
-  return out;
+  };
 }
 
 std::vector<std::vector<double>> Interpreter::evaluateByTree(const std::vector<std::string>& semantics) {

@@ -6,7 +6,9 @@
 // (validate/definition_program.h); the tree walker (evaluateByTree) is its oracle and
 // reports errors and the inputs behind a NaN. docs/validation.md, "Definitions".
 #pragma once
+#include <functional>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -42,6 +44,10 @@ class Interpreter {
   // std::invalid_argument (bad data: joint index out of range, missing rig parameter).
   // Semantics the requested ones share are computed once.
   std::vector<std::vector<double>> evaluate(const std::vector<std::string>& semantics);
+  // evaluate(semantics) compiled once, to run again after the mesh's stream values change in
+  // place (same vectors, same sizes): what finite differences of the reference need
+  // (validate/float_check.h). Valid while this interpreter lives.
+  std::function<std::vector<std::vector<double>>()> evaluator(const std::vector<std::string>& semantics);
   // The same, walking the definition trees vertex by vertex (the compiled program's oracle).
   std::vector<std::vector<double>> evaluateByTree(const std::vector<std::string>& semantics);
   // Threads evaluate() uses: 0 (the default) for every core. The values do not depend on it.

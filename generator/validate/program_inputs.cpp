@@ -46,29 +46,47 @@ void quantizeStreams(const Rig& rig, rt::Mesh& m) {
 // 1 by up to half a step per weight, which shrinks or swells the skin. As gltfpack does,
 // the codes of a vertex whose weights sum to 1 are rounded to sum to exactly 2^bits - 1
 // (largest remainders first), across every weight set of the rig (8 influences: 2 sets).
-void renormaliseWeights(const Rig& rig, rt::Mesh& m) {
+// The weight sets renormaliseWeights rounds together and their bits (none: it leaves them).
+struct WeightSets {
   std::vector<std::string> sets;
   int bits = 0;
+};
+WeightSets renormalisedWeights(const Rig& rig, const rt::Mesh& m) {
+  WeightSets out;
   for (const auto& a : rig.attributes)
     for (const auto& p : a.provides) {
       if (p.semantic.rfind("skin.weights[", 0) != 0) continue;
       const int b = a.format == VertexFormat::Unorm8x4 ? 8 : a.format == VertexFormat::Unorm16x4 ? 16 : 0;
-      if (b == 0 || (bits != 0 && b != bits) || (!p.swizzle.empty() && p.swizzle != "xyzw")) return;  // floats, or mixed
-      bits = b;
-      if (!m.has(p.semantic)) return;
-      sets.push_back(p.semantic);
+      if (b == 0 || (out.bits != 0 && b != out.bits) || (!p.swizzle.empty() && p.swizzle != "xyzw")) return {};  // floats, or mixed
+      out.bits = b;
+      if (!m.has(p.semantic)) return {};
+      out.sets.push_back(p.semantic);
     }
+  return out;
+}
+
+// A vertex's weights are renormalised when they sum to one within this: its sum, or NaN.
+double partitionSum(const std::vector<const std::vector<glm::vec4>*>& sets, size_t v) {
+  double sum = 0;
+  for (const auto* s : sets)
+    for (int c = 0; c < 4; ++c) sum += std::max(0.0, double((*s)[v][c]));
+  return std::abs(sum - 1) <= 1e-3 ? sum : NAN;
+}
+
+void renormaliseWeights(const Rig& rig, rt::Mesh& m) {
+  const auto [sets, bits] = renormalisedWeights(rig, m);
   if (sets.empty()) return;
   const double steps = std::ldexp(1.0, bits) - 1;
   std::vector<std::vector<glm::vec4>*> streams;
-  for (const auto& s : sets) streams.push_back(&m.streams.at(s));
+  std::vector<const std::vector<glm::vec4>*> read;
+  for (const auto& s : sets) streams.push_back(&m.streams.at(s)), read.push_back(streams.back());
   std::vector<double> w(sets.size() * 4), q(w.size());
   std::vector<size_t> order(w.size());
   for (size_t v = 0; v < m.vertexCount; ++v) {
-    double sum = 0;
+    const double sum = partitionSum(read, v);
+    if (std::isnan(sum)) continue;  // not a partition of one: rounded as it is
     for (size_t s = 0; s < sets.size(); ++s)
-      for (int c = 0; c < 4; ++c) sum += w[s * 4 + static_cast<size_t>(c)] = std::max(0.0, double((*streams[s])[v][c]));
-    if (!(std::abs(sum - 1) <= 1e-3)) continue;  // not a partition of one: rounded as it is
+      for (int c = 0; c < 4; ++c) w[s * 4 + static_cast<size_t>(c)] = std::max(0.0, double((*streams[s])[v][c]));
     double total = 0;
     for (size_t k = 0; k < w.size(); ++k) total += q[k] = std::floor(w[k] / sum * steps);
     for (size_t k = 0; k < order.size(); ++k) order[k] = k;
@@ -108,26 +126,31 @@ bool declaresUniform(const Rig& rig, const std::string& semantic) {
   return std::any_of(rig.uniforms.begin(), rig.uniforms.end(), [&](const RigUniform& u) { return u.semantic == semantic; });
 }
 
-// The mesh's bounds as uniforms, from its float positions, for a rig that reads them.
-void addBounds(const Rig& rig, rt::Mesh& m) {
-  if (!declaresUniform(rig, "mesh.bounds_min") && !declaresUniform(rig, "mesh.bounds_extent")) return;
-  if (m.uniforms.count("mesh.bounds_min") && m.uniforms.count("mesh.bounds_extent")) return;
-  if (!m.has("vertex.position"))
-    throw InputError(SourceLoc{}, fmt::format("mesh '{}' has no positions to take its bounds from", m.name));
-  const PositionBounds b = positionBounds(m.at("vertex.position"));
-  m.uniforms["mesh.bounds_min"] = {b.min.x, b.min.y, b.min.z};
-  m.uniforms["mesh.bounds_extent"] = {b.extent.x, b.extent.y, b.extent.z};
-}
-
-// The bounds `addBounds` put in the mesh.
-PositionBounds boundsFor(const VertexEncoding& e, const rt::Mesh& m) {
-  if (e.uniforms.empty()) return {};
+// The mesh's bounds: those `addBounds` put in it, else from its positions.
+PositionBounds meshBounds(const rt::Mesh& m) {
+  if (!m.uniforms.count("mesh.bounds_min") || !m.uniforms.count("mesh.bounds_extent")) {
+    if (!m.has("vertex.position"))
+      throw InputError(SourceLoc{}, fmt::format("mesh '{}' has no positions to take its bounds from", m.name));
+    return positionBounds(m.at("vertex.position"));
+  }
   const auto& lo = m.uniforms.at("mesh.bounds_min");
   const auto& ext = m.uniforms.at("mesh.bounds_extent");
   PositionBounds b;
   for (int k = 0; k < 3; ++k) b.min[k] = static_cast<float>(lo[static_cast<size_t>(k)]), b.extent[k] = static_cast<float>(ext[static_cast<size_t>(k)]);
   return b;
 }
+
+// The mesh's bounds as uniforms, from its float positions, for a rig that reads them.
+void addBounds(const Rig& rig, rt::Mesh& m) {
+  if (!declaresUniform(rig, "mesh.bounds_min") && !declaresUniform(rig, "mesh.bounds_extent")) return;
+  if (m.uniforms.count("mesh.bounds_min") && m.uniforms.count("mesh.bounds_extent")) return;
+  const PositionBounds b = meshBounds(m);
+  m.uniforms["mesh.bounds_min"] = {b.min.x, b.min.y, b.min.z};
+  m.uniforms["mesh.bounds_extent"] = {b.extent.x, b.extent.y, b.extent.z};
+}
+
+// The bounds `addBounds` put in the mesh; none for an encoding that reads no bounds.
+PositionBounds boundsFor(const VertexEncoding& e, const rt::Mesh& m) { return e.uniforms.empty() ? PositionBounds{} : meshBounds(m); }
 
 // Each target's delta scale as a uniform array, from its float deltas, for a rig that reads
 // them (a target without deltas: 0).
@@ -230,6 +253,92 @@ rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
     if (m.has(se.name(se.e->encoded))) decodeInto(se, decodeUniformsFor(se, m), m.at(se.name(se.e->encoded)), m);
   quantizeStreams(rig, m);  // a source the rig stores too, in a rounded format
   return m;
+}
+
+// The largest error of each input quantizedMesh changes, as the formats and encodings state
+// it. A stream the mesh lacks (codes given without their float source) has no float data to
+// differ from and gets none.
+std::vector<InputErrorBound> errorBounds(const Rig& rig, const rt::Mesh& mesh) {
+  std::vector<InputErrorBound> out;
+  const WeightSets weights = renormalisedWeights(rig, mesh);
+  std::vector<const std::vector<glm::vec4>*> weightStreams;
+  for (const auto& s : weights.sets) weightStreams.push_back(&mesh.at(s));
+  // Plain values in a format that rounds them.
+  for (const auto& a : rig.attributes) {
+    const int n = formatComponents(a.format);
+    if (formatIsFloat32(a.format) || formatIsInteger(a.format)) continue;
+    for (int t = 0; t < (a.perMorphTarget ? rig.morphTargets() : 1); ++t)
+      for (const auto& p : a.provides) {
+        if (encodingOf(p.semantic)) continue;  // below
+        InputErrorBound b;
+        b.semantic = partSemantic(a, p, a.perMorphTarget ? t : -1);
+        if (!mesh.has(b.semantic)) continue;
+        const auto& x = mesh.at(b.semantic);
+        b.bound.assign(mesh.vertexCount, glm::dvec4(0));
+        const bool renormalised = std::count(weights.sets.begin(), weights.sets.end(), p.semantic) != 0;
+        const double step = 1 / (std::ldexp(1.0, weights.bits) - 1);
+        const std::string swz = p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(n)) : p.swizzle;
+        for (size_t v = 0; v < mesh.vertexCount && v < x.size(); ++v) {
+          // Renormalised weights: each code is the floor of w / sum in steps, or one more.
+          const double sum = renormalised ? partitionSum(weightStreams, v) : NAN;
+          for (size_t k = 0; k < swz.size(); ++k) {
+            const double xv = x[v][static_cast<int>(k)];
+            b.bound[v][static_cast<int>(k)] =
+                std::isnan(sum) ? storedValueMaxError(a.format, swizzleIndex(swz[k]), xv)
+                                : step + std::ldexp(1.0, -24) + std::abs(xv) * std::abs(1 - 1 / sum);
+          }
+        }
+        out.push_back(std::move(b));
+      }
+  }
+  // Encoded values: each value a code decodes within its stated error (a QTangent's
+  // handedness, decoded exactly, has none).
+  const double rounding = std::ldexp(1.0, -24);
+  for (const StoredEncoding& se : storedEncodings(rig)) {
+    const VertexEncoding& e = *se.e;
+    const double stated = *encodingMaxError(e, se.format);
+    const std::vector<std::string> values = se.values();
+    for (size_t i = 0; i < e.sources.size(); ++i) {
+      InputErrorBound b;
+      b.semantic = values[i];
+      if (!mesh.has(b.semantic)) continue;
+      const auto& x = mesh.at(b.semantic);
+      b.bound.assign(mesh.vertexCount, glm::dvec4(0));
+      if (e.angular()) {
+        // Within the stated angle of the direction the encoder stores: at most its chord
+        // 2 sin(angle / 2) from that unit vector, which is itself |ideal - x| from x (the data
+        // normalised; a QTangent's frame also orthonormalised, its tangent made perpendicular
+        // to the normal). The decode is rounded to float: sqrt(3) 2^-24 more.
+        b.ball = true;
+        const double chord = 2 * std::sin(glm::radians(stated) / 2) + std::sqrt(3.0) * rounding;
+        const bool frame = e.name == "qtangent" && mesh.has(values[0]) && mesh.has(values[1]);
+        for (size_t v = 0; v < mesh.vertexCount && v < x.size(); ++v) {
+          const glm::dvec3 xv(x[v]);
+          glm::dvec3 ideal = glm::length(xv) > 0 ? glm::normalize(xv) : xv;
+          if (frame) {
+            const double h = mesh.has(values[2]) ? double(mesh.at(values[2])[v].x) : 1.0;
+            const QTangentFrame f = qtangentDecode(qtangentEncode(glm::dvec3(mesh.at(values[0])[v]), glm::dvec3(mesh.at(values[1])[v]), h, 0));
+            ideal = i == 0 ? f.normal : f.tangent;
+          }
+          b.bound[v] = glm::dvec4(chord + glm::length(ideal - xv));
+        }
+      } else if (e.name == "bounds") {
+        // Each coordinate within the stated fraction of its axis's extent, and the float
+        // rounding of the decoded coordinate (2^-24 of it).
+        const PositionBounds box = meshBounds(mesh);
+        for (size_t v = 0; v < mesh.vertexCount && v < x.size(); ++v)
+          b.bound[v] = glm::dvec4(stated * glm::dvec3(box.extent) + glm::abs(glm::dvec3(x[v])) * rounding, 0);
+      } else {
+        // Scaled deltas: the delta within the stated fraction of its target's scale (a bound
+        // on its length, so on each coordinate), and the float rounding of code x scale.
+        const double scale = deltaScale(x);
+        for (size_t v = 0; v < mesh.vertexCount && v < x.size(); ++v)
+          b.bound[v] = glm::dvec4(glm::dvec3(stated * scale + rounding * scale) + glm::abs(glm::dvec3(x[v])) * rounding, 0);
+      }
+      out.push_back(std::move(b));
+    }
+  }
+  return out;
 }
 
 // Element bytes of a buffer element from up to 16 float components.
@@ -361,6 +470,8 @@ UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape
 }
 
 rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh) { return quantizedMesh(rig, mesh); }
+
+std::vector<InputErrorBound> quantizationErrorBounds(const Rig& rig, const rt::Mesh& mesh) { return errorBounds(rig, mesh); }
 
 rt::VertexStream vertexStream(const Rig& rig, const EmittedInput& in, const rt::Mesh& mesh) {
   const RigAttribute& a = rig.attributes[in.attribute];

@@ -35,6 +35,17 @@ std::vector<rt::DescriptorBinding> declaredDescriptors(const std::vector<ShaderD
 // streams derived from their sources (and the sources replaced by their decodes), the
 // mesh's bounds as uniforms, unorm skin weights rounded to sum to exactly one.
 rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh);
+// How far quantizeForRig(rig, mesh) may move one stream the reference reads, from the
+// worst errors the formats (storedValueMaxError) and encodings (encodingMaxError) state:
+// per vertex, component k by at most bound[v][k] (a box), or, for a unit vector
+// (octahedral), xyz by at most bound[v].x in Euclidean distance (a ball). Streams stored
+// exactly (float32, integers) have none. docs/validation.md, "Against the float data".
+struct InputErrorBound {
+  std::string semantic;  // "vertex.normal", "morph.position[2]"
+  bool ball = false;
+  std::vector<glm::dvec4> bound;
+};
+std::vector<InputErrorBound> quantizationErrorBounds(const Rig& rig, const rt::Mesh& mesh);
 // The stream of one program input over `mesh` (quantizeForRig'd): the attribute's elements
 // encoded in its format, tightly packed (the stride is the format's size).
 rt::VertexStream vertexStream(const Rig& rig, const EmittedInput& in, const rt::Mesh& mesh);

@@ -8,11 +8,13 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <optional>
 #include <type_traits>
 #include <random>
 #include <set>
 
 #include "runtime/procedural.h"
+#include "validate/float_check.h"
 #include "validate/interpreter.h"
 #include "validate/poses.h"
 
@@ -158,6 +160,8 @@ struct PoseReference {
   UniformValues uniforms;  // what they were computed with
   std::map<std::string, std::vector<double>> values;
   std::map<std::string, std::string> unchecked;  // why a semantic cannot be evaluated ("" if it can)
+  // The reference on the float data and its tolerances (float_check.h), for the second check.
+  std::map<std::string, std::vector<double>> floatValues, floatTolerance;
 };
 
 struct Validator::ReferenceCache {
@@ -177,8 +181,9 @@ struct Validator::ReferenceCache {
   void trim(size_t i) {
     size_t bytes = 0;
     for (const auto& p : poses)
-      for (const auto& [sem, v] : p.values) bytes += v.size() * sizeof(double);
-    if (bytes > kMaxBytes) poses[i].values.clear();
+      for (const auto* m : {&p.values, &p.floatValues, &p.floatTolerance})
+        for (const auto& [sem, v] : *m) bytes += v.size() * sizeof(double);
+    if (bytes > kMaxBytes) poses[i].values.clear(), poses[i].floatValues.clear(), poses[i].floatTolerance.clear();
   }
 };
 
@@ -229,7 +234,6 @@ RunReport Validator::runOne(const GenerateResult& r, const ValidationScene& scen
 
 RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh, const ValidationScene& scene,
                                   const std::vector<rt::Pose>& poses, const std::string& label, ReferenceCache* cache) {
-  (void)scene;
   RunReport rep;
   rep.label = label;
   rep.planCost = r.plan.cost;
@@ -252,6 +256,19 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
   size_t before = reportedMessages_;
   const RigShape shape = shapeOfRig(rig, r.in.rules);
   const RuleSet& rules = r.in.rules;
+  // The second check (float_check.h): the reference on the original float data where the
+  // scene has it, on what the device reads elsewhere (codes given without their source, the
+  // mesh's bounds). It costs two reference evaluations per bounded input component, so it
+  // compares every floatStride-th vertex of a large mesh.
+  const size_t cap = opts_.floatCheckVertices;
+  const size_t floatStride = cap == 0 ? 1 : std::max<size_t>(1, (mesh.vertexCount + cap - 1) / cap);
+  std::vector<InputErrorBound> bounds;
+  if (opts_.checkFloatData) bounds = quantizationErrorBounds(rig, scene.mesh);
+  for (InputErrorBound& b : bounds)
+    for (size_t v = 0; v < b.bound.size(); v += floatStride) b.bound[v / floatStride] = b.bound[v];
+  for (InputErrorBound& b : bounds) b.bound.resize((b.bound.size() + floatStride - 1) / floatStride);
+  std::optional<rt::Mesh> floatMesh;  // built when a pose first needs it
+  rep.floatCheckStride = floatStride;
   for (size_t pi = 0; pi < poses.size(); ++pi) {
     const rt::Pose& pose = poses[pi];
     // The pose's uniforms (and those defined over them, as floats) and palettes; the
@@ -310,6 +327,28 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
       for (size_t k = 0; k < missing.size(); ++k) pr.values[missing[k]] = std::move(values[k]);
     }
     rep.referenceMs += msSince(t0);
+    if (!bounds.empty()) {
+      auto tf = Clock::now();
+      std::vector<std::string> floatMissing;
+      for (size_t oi = 0; oi < r.glsl.outputs.size(); ++oi)
+        if (!rep.outputs[oi].unchecked)
+          for (const auto& sem : r.glsl.outputs[oi].semantics)
+            if (!pr.floatValues.count(sem) &&
+                std::find(floatMissing.begin(), floatMissing.end(), sem) == floatMissing.end())
+              floatMissing.push_back(sem);
+      if (!floatMissing.empty()) {
+        if (!floatMesh) {
+          floatMesh = rt::everyNthVertex(mesh, floatStride);
+          for (auto& [sem, stream] : rt::everyNthVertex(scene.mesh, floatStride).streams) floatMesh->streams[sem] = std::move(stream);
+        }
+        FloatReference f = floatReference(rules, shape, *floatMesh, pr.uniforms, bounds, floatMissing);
+        for (size_t k = 0; k < floatMissing.size(); ++k) {
+          pr.floatValues[floatMissing[k]] = std::move(f.values[k]);
+          pr.floatTolerance[floatMissing[k]] = std::move(f.tolerance[k]);
+        }
+      }
+      rep.floatCheckMs += msSince(tf);
+    }
     // Compare vertex by vertex, every output of a captured record together (one pass over
     // the capture). Matrices: columns in order; arrays: elements in order (both as their
     // semantics list them).
@@ -318,6 +357,7 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
       OutputReport* out;
       std::vector<std::pair<const double*, size_t>> refs;  // values, components
       size_t comps;
+      std::vector<std::pair<const double*, const double*>> floatRefs;  // float values and tolerances, as refs
     };
     std::vector<Compared> compared;
     size_t widest = 0;
@@ -325,12 +365,15 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
       if (rep.outputs[oi].unchecked) continue;
       const EmittedOutput& o = r.glsl.outputs[oi];
       Compared c{&o, &rep.outputs[oi], {}, static_cast<size_t>(componentCount(o.type) * std::max(1, o.arraySize))};
-      for (const auto& sem : o.semantics)
+      for (const auto& sem : o.semantics) {
         c.refs.emplace_back(pr.values.at(sem).data(), static_cast<size_t>(reference.components(sem)));
+        if (!bounds.empty()) c.floatRefs.emplace_back(pr.floatValues.at(sem).data(), pr.floatTolerance.at(sem).data());
+      }
+      rep.outputs[oi].floatCheck.ran = !bounds.empty();
       widest = std::max(widest, c.comps);
       compared.push_back(std::move(c));
     }
-    std::vector<double> ref(widest), gpu(widest);
+    std::vector<double> ref(widest), gpu(widest), floatRef(widest), floatTol(widest);
     for (size_t v = 0; v < mesh.vertexCount; ++v) {
       const uint8_t* record = res.captured.data() + v * r.glsl.captureStride;
       for (Compared& cmp : compared) {
@@ -340,6 +383,14 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
         size_t k = 0;
         for (const auto& [values, width] : cmp.refs)
           for (size_t c = 0; c < width && k < comps; ++c) ref[k++] = values[v * width + c];
+        k = 0;
+        for (size_t si = 0; si < cmp.floatRefs.size(); ++si) {
+          const size_t width = cmp.refs[si].second;
+          for (size_t c = 0; c < width && k < comps; ++c, ++k) {
+            floatRef[k] = cmp.floatRefs[si].first[v / floatStride * width + c];
+            floatTol[k] = cmp.floatRefs[si].second[v / floatStride * width + c];
+          }
+        }
         const uint8_t* rec = record + o.captureOffset;
         const ScalarKind kind = scalarKind(o.type);
         double scale = 1.0;
@@ -372,7 +423,32 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
           }
           out.maxAbsError = std::max(out.maxAbsError, err);
           out.maxRelError = std::max(out.maxRelError, rel);
-          if (err > opts_.tolerance.abs + opts_.tolerance.rel * scale) out.pass = false;
+          if (err > opts_.tolerance.abs + opts_.tolerance.rel * scale) out.storedPass = false;
+        }
+        if (cmp.floatRefs.empty() || v % floatStride != 0) continue;
+        // Second check: the float tolerance (at the float reference's scale) plus the derived
+        // bound of what storing the inputs changes.
+        double floatScale = 1.0;
+        for (size_t c = 0; c < comps; ++c)
+          if (std::isfinite(floatRef[c])) floatScale = std::max(floatScale, std::abs(floatRef[c]));
+        OutputReport::FloatCheck& fc = out.floatCheck;
+        for (size_t c = 0; c < comps; ++c) {
+          if (!std::isfinite(floatRef[c]) || !std::isfinite(floatTol[c])) {
+            ++fc.notCompared;
+            continue;
+          }
+          const double dev = std::isfinite(gpu[c]) ? std::abs(gpu[c] - floatRef[c]) : INFINITY;
+          const double tol = opts_.tolerance.abs + opts_.tolerance.rel * floatScale + floatTol[c];
+          const double ratio = tol / dev;
+          if (ratio < fc.ratio) {
+            fc.ratio = ratio;
+            fc.tolerance = tol;
+            fc.deviation = dev;
+            fc.worstVertex = v;
+            fc.worstComponent = static_cast<int>(c);
+          }
+          fc.maxDeviation = std::max(fc.maxDeviation, dev);
+          if (!(dev <= tol)) fc.pass = false;
         }
       }
     }
@@ -382,8 +458,7 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
   rep.validationMessages.assign(msgs.begin() + static_cast<long>(before), msgs.end());
   reportedMessages_ = msgs.size();
   rep.pass = rep.validationMessages.empty();
-  for (auto& o : rep.outputs)
-    if (o.unchecked && opts_.strict) o.pass = false;
+  for (auto& o : rep.outputs) o.pass = o.storedPass && o.floatCheck.pass && !(o.unchecked && opts_.strict);
   for (const auto& o : rep.outputs) rep.pass = rep.pass && o.pass;
   return rep;
 }
@@ -477,14 +552,27 @@ std::string formatReport(const ValidateReport& report) {
         continue;
       }
       s += fmt::format("  {:<4} {:<20} max abs {:.3e}  max rel {:.3e}  worst vertex {} [{}]  ({})\n",
-                       o.pass ? "ok" : "FAIL", o.name, o.maxAbsError, o.maxRelError, o.worstVertex, o.worstComponent, sems);
+                       o.storedPass ? "ok" : "FAIL", o.name, o.maxAbsError, o.maxRelError, o.worstVertex, o.worstComponent, sems);
       if (!o.nonFinite.empty()) s += "       " + o.nonFinite + "\n";
+      if (const auto& f = o.floatCheck; f.ran) {
+        s += fmt::format("  {:<4} {:<20} vs float data: max dev {:.3e}  tolerance/observed {:.3g} at vertex {} [{}] "
+                         "(tolerance {:.3e}, dev {:.3e})",
+                         f.pass ? "ok" : "FAIL", "", f.maxDeviation, f.ratio, f.worstVertex, f.worstComponent,
+                         f.tolerance, f.deviation);
+        s += f.notCompared ? fmt::format(", {} component(s) not compared: not finite\n", f.notCompared) : "\n";
+      }
     }
     for (const auto& m : run.validationMessages) s += "  validation layer: " + m + "\n";
     s += fmt::format("  time: generate {:.1f} ms, setup {:.1f} ms, upload {:.1f} ms, run {:.1f} ms, readback {:.1f} ms, "
-                     "reference {:.1f} ms\n",
+                     "reference {:.1f} ms",
                      run.generateMs, run.timings.setupMs, run.timings.uploadMs, run.timings.runMs,
                      run.timings.readbackMs, run.referenceMs);
+    bool floatChecked = false;
+    for (const auto& o : run.outputs) floatChecked = floatChecked || o.floatCheck.ran;
+    s += !floatChecked ? "\n"
+         : run.floatCheckStride > 1
+             ? fmt::format(", float check {:.1f} ms (1 vertex in {})\n", run.floatCheckMs, run.floatCheckStride)
+             : fmt::format(", float check {:.1f} ms\n", run.floatCheckMs);
   }
   s += fmt::format("{}: {} run(s)\n", report.pass ? "PASS" : "FAIL", report.runs.size());
   return s;

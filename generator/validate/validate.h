@@ -2,6 +2,7 @@
 // mesh in given poses and compare every output with the GLM reference of its
 // semantics. Tolerances and their justification: docs/validation.md.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -34,12 +35,26 @@ struct OutputReport {
   size_t worstVertex = 0;
   int worstComponent = 0;
   std::vector<double> worstGpu, worstReference;  // the output's components at the worst vertex
-  bool pass = true;
+  bool pass = true;        // every check below
+  bool storedPass = true;  // the first check alone: within the tolerance of the reference on the data as stored
   // A semantic it carries has no definition (and the rig does not provide it): not compared.
   bool unchecked = false;
   std::string uncheckedReason;
   // The first NaN or infinity seen, on which side, where, and the inputs that produced it.
   std::string nonFinite;
+  // The second check, for a rig that stores encoded or quantized streams: the device against
+  // the reference on the original float data, within the float tolerance plus the derived
+  // bound of what storing the inputs may change (validate/float_check.h).
+  struct FloatCheck {
+    bool ran = false;
+    bool pass = true;
+    double maxDeviation = 0;  // max |gpu - float reference|
+    double ratio = INFINITY;  // the smallest tolerance / |gpu - float reference| (< 1 fails)
+    double tolerance = 0, deviation = 0;  // where the ratio is smallest
+    size_t worstVertex = 0;
+    int worstComponent = 0;
+    size_t notCompared = 0;  // components whose float reference or tolerance is not finite
+  } floatCheck;
 };
 
 struct RunReport {
@@ -51,6 +66,8 @@ struct RunReport {
   std::vector<std::string> validationMessages;
   rt::RunTimings timings;
   double referenceMs = 0;
+  double floatCheckMs = 0;  // the float reference and its tolerances
+  size_t floatCheckStride = 1;  // the second check compared every this-th vertex
   double generateMs = 0;
   bool pass = true;
 };
@@ -108,6 +125,11 @@ struct ValidateOptions {
   std::string device;       // "" = lavapipe
   bool validationLayers = true;
   bool strict = false;  // an unchecked output (no definition) fails the run
+  // Also check against the original float data (OutputReport::FloatCheck) when the rig
+  // stores encoded or quantized streams.
+  bool checkFloatData = true;
+  // At most this many vertices (every k-th) in the second check; 0: all.
+  size_t floatCheckVertices = 20000;
 };
 
 class Validator {

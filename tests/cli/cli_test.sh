@@ -470,6 +470,12 @@ pack)  # docs/rig-format.md "Packing": the streams and their layout, byte-identi
     ok "the error names the stream" || fail "$(cat last.err)"
   [ ! -e c ] && ok "nothing written on failure" || fail "pack left $(ls c)"
   expect 2 "--mesh and --model together" -- "$SG" pack "${OCT[@]}" --mesh limb --model x.glb#0/0 -o d/x -q
+  # validate checks the stored streams twice (docs/validation.md, "Against the float data").
+  expect 0 "validate the packed rig" -- "$SG" validate "${OCT[@]}" --mesh limb --poses 1 --no-validation-layers
+  grep -qE "^  ok +vs float data: max dev .* tolerance/observed" last.out && ok "validate checks against the float data" ||
+    fail "validate printed: $(head -6 last.out)"
+  expect 0 "validate --no-float-check" -- "$SG" validate "${OCT[@]}" --mesh limb --poses 1 --no-validation-layers --no-float-check
+  grep -q "vs float data" last.out && fail "--no-float-check still checked" || ok "--no-float-check skips the second check"
   ;;
 
 *)

@@ -29,7 +29,7 @@ using sgtest::RulesCopy;
 using sgtest::sourcePath;
 using sgtest::writeText;
 
-sg::RuleSet standardRules() { return sg::loadRules({sourcePath("rules/standard.yaml")}); }
+using sgtest::standardRules;
 
 // The first error of loading `text` (the vocabulary plus it), or "" if it loads.
 std::string loadError(const std::string& text) {

@@ -28,10 +28,7 @@ namespace rt = sg::rt;
 using sgtest::rigFor;
 using sgtest::sourcePath;
 
-const sg::RuleSet& standardRules() {
-  static const sg::RuleSet rules = sg::loadRules({sourcePath("rules/standard.yaml")});
-  return rules;
-}
+using sgtest::standardRules;
 
 // What one evaluation gives: values, or the error it threw.
 struct Outcome {
@@ -85,17 +82,6 @@ Agreement compareAll(const sg::RuleSet& rules, const sg::Rig& rig, const rt::Mes
   return expectSame(tree, compiled, semantics);
 }
 
-rt::Mesh everyNth(const rt::Mesh& mesh, size_t n) {
-  rt::Mesh m;
-  m.name = mesh.name + "/" + std::to_string(n);
-  for (size_t v = 0; v < mesh.vertexCount; v += n) ++m.vertexCount;
-  for (const auto& [sem, values] : mesh.streams) {
-    auto& s = m.streams[sem];
-    for (size_t v = 0; v < values.size(); v += n) s.push_back(values[v]);
-  }
-  return m;
-}
-
 TEST(Program, AgreesWithTreeOnProceduralMeshes) {
   size_t compared = 0;
   sgtest::forEachProceduralCase([&](const sgtest::ProceduralCase& c) {
@@ -111,7 +97,7 @@ TEST(Program, AgreesWithTreeOnDawnSubset) {
   // Every 61st of the 180,000 vertices (2,951 across the face); the 2,009-vertex head of the
   // same shape in the sanitizer build, where building the large mesh is the slow part.
   sg::ValidationScene scene = sg::proceduralScene(rig, sgtest::kSanitized ? "head" : "dawn", 1, 2);
-  rt::Mesh mesh = sgtest::kSanitized ? sg::quantizeForRig(rig, scene.mesh) : everyNth(sg::quantizeForRig(rig, scene.mesh), 61);
+  rt::Mesh mesh = sgtest::kSanitized ? sg::quantizeForRig(rig, scene.mesh) : rt::everyNthVertex(sg::quantizeForRig(rig, scene.mesh), 61);
   size_t compared = 0;
   for (const auto& pose : scene.poses) compared += compareAll(rules, rig, mesh, sg::poseUniforms(rig, pose)).compared;
   EXPECT_GT(compared, 200000u);

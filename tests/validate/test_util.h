@@ -34,6 +34,11 @@ inline constexpr bool kSanitized = false;
 
 inline std::string sourcePath(const std::string& rel) { return std::string(SG_SOURCE_DIR) + "/" + rel; }
 inline std::string dataPath(const std::string& name) { return sourcePath("tests/validate/data/" + name); }
+// rules/standard.yaml, loaded once.
+inline const sg::RuleSet& standardRules() {
+  static const sg::RuleSet rules = sg::loadRules({sourcePath("rules/standard.yaml")});
+  return rules;
+}
 
 inline std::string readText(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
