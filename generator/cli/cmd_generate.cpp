@@ -47,7 +47,8 @@ void GenerateArgs::add(CLI::App& cmd) {
       ->check(CLI::Range(16, 1 << 30));
   cmd.add_option("--vertices", opts.maxVertices,
                  "The most vertices one draw has: per-vertex storage buffers that would exceed "
-                 "maxStorageBufferRange (2^27 bytes) at that count are not used (default: unknown, all allowed)")
+                 "maxStorageBufferRange (2^27 bytes) at that count are not used, and a device profile's per-draw "
+                 "weights are spread over that many (default: unknown, all allowed; the profile's vertices_per_draw)")
       ->check(CLI::Range(int64_t{0}, int64_t{1} << 32));
   cmd.add_option("--device-profile", opts.deviceProfilePath,
                  "Device profile (YAML, docs/device-profiles.md): weights in ns per vertex of arithmetic, vertex "
