@@ -440,6 +440,16 @@ device_profile)
   expect 0 "explain --device-profile" -- "$SG" explain "${DAWN[@]}" --device-profile "$P" --no-alternatives
   grep -q "predicted per vertex on 'example" last.out && ok "explain shows the terms" || fail "$(cat last.out)"
   grep -qE "^    buffer_loads +[1-9]" last.out && ok "explain: buffer loads counted" || fail "$(cat last.out)"
+  # A profile with per-draw weights prices its own workload, or the vertices a draw is said to have.
+  H=$SRC/devices/nvidia-h200.yaml
+  expect 0 "explain, H200 profile" -- "$SG" explain "${DAWN[@]}" --device-profile "$H" --no-alternatives
+  grep -q "at 180000 vertices per draw:" last.out && ok "the profile's workload" || fail "$(cat last.out)"
+  dawn_total=$(awk '$1 == "total" && NF == 2 {print $2}' last.out)
+  expect 0 "explain --vertices 2010" -- "$SG" explain "${DAWN[@]}" --device-profile "$H" --no-alternatives --vertices 2010
+  grep -q "at 2010 vertices per draw:" last.out && ok "--vertices sets the workload" || fail "$(cat last.out)"
+  head_total=$(awk '$1 == "total" && NF == 2 {print $2}' last.out)
+  awk -v a="$dawn_total" -v b="$head_total" 'BEGIN {exit !(b > a + 0.1)}' && ok "a small draw pays more per vertex ($dawn_total -> $head_total ns)" ||
+    fail "per-vertex prediction $dawn_total at 180000, $head_total at 2010"
   # A rig storing its frame both ways: every command that generates says which form it reads.
   V=$SRC/tests/validate/data
   FORMS=(--rig "$V/octahedral_or_float.rig.yaml" -f "$V/world.frag" -r "$SRC/rules/standard.yaml" --mesh limb
