@@ -270,9 +270,11 @@ TEST(FloatCheck, CodesTenTimesCoarserThanTheirFormatFail) {
                                       "format: float32x4, provides: { vertex.normal_octahedral: xy, vertex.tangent_octahedral: zw }"));
     const std::string rig = (dir / file).string();
     sgtest::writeText(rig, text);
+    const std::string code = encoded;  // structured bindings cannot be captured before C++20
+    const double codeSteps = steps;
     auto run = [&](double coarse) {
       return validate(rig, dataPath("world.frag"), sourcePath("rules/standard.yaml"), "limb",
-                      [&](sg::ValidationScene& s) { plantCodes(s, encoded, steps, coarse); });
+                      [&](sg::ValidationScene& s) { plantCodes(s, code, codeSteps, coarse); });
     };
     // The codes the packer writes pass; ten times coarser, only the second check fails.
     EXPECT_TRUE(run(1).pass);
