@@ -16,24 +16,27 @@ DeviceProfile loadDeviceProfile(const std::string& path) { return parseDevicePro
 
 namespace {
 
-// A non-negative finite number no larger than `max`, else a located error naming `what`
-// ("weight 'locations'"); `unit` names the number ("nanoseconds"), `symbol` abbreviates it.
-double parseWeight(const YamlCtx& c, const YAML::Node& n, const std::string& what, const char* unit, const char* symbol,
-                   double max) {
+// A finite number in [min, max], else a located error naming `what` ("weight 'locations'");
+// `unit` names the number ("nanoseconds"), `symbol` abbreviates it. Below a minimum of 0 is
+// a negative cost, which would let the search buy time by reading more.
+double parseNumber(const YamlCtx& c, const YAML::Node& n, const std::string& what, const char* unit, const char* symbol,
+                   double min, double max) {
   const std::string s = c.scalar(n, what.c_str());
   errno = 0;
   char* end = nullptr;
   double v = std::strtod(s.c_str(), &end);
   if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE || !std::isfinite(v))
     c.fail(n, fmt::format("{} must be a number of {}, not '{}'", what, unit, s));
-  if (v < 0 && symbol == std::string("ns")) c.fail(n, fmt::format("{} is negative ({}): a term cannot save time", what, s));
-  if (v < 1 && symbol != std::string("ns")) c.fail(n, fmt::format("{} is {}: it must be at least 1", what, s));
+  if (v < min)
+    c.fail(n, min == 0 ? fmt::format("{} is negative ({}): a term cannot save time", what, s)
+                       : fmt::format("{} is {}: it must be at least {:g}", what, s, min));
   if (v > max) c.fail(n, fmt::format("{} is {} {}, above the {:g} {} a profile may state", what, s, symbol, max, symbol));
   return v;
 }
 
 // weights: or draw_weights: (term -> ns per unit).
-void parseTermWeights(const YamlCtx& c, const YAML::Node& w, const char* section, double max,
+// `what` names one weight in messages ("weight", "draw weight").
+void parseTermWeights(const YamlCtx& c, const YAML::Node& w, const char* section, const char* what, double max,
                       std::array<double, kTermCount>& out) {
   c.expectMap(w, section);
   for (auto it = w.begin(); it != w.end(); ++it) {
@@ -47,7 +50,7 @@ void parseTermWeights(const YamlCtx& c, const YAML::Node& w, const char* section
       c.fail(it->first, fmt::format("unknown cost term '{}' (known: {})", key, known));
     }
     out[static_cast<size_t>(term)] =
-        parseWeight(c, it->second, fmt::format("{} '{}'", section == std::string("weights") ? "weight" : "draw weight", key), "nanoseconds", "ns", max);
+        parseNumber(c, it->second, fmt::format("{} '{}'", what, key), "nanoseconds", "ns", 0, max);
   }
 }
 
@@ -82,12 +85,11 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
                                      c.scalar(root["unit"], "unit")));
   if (root["notes"]) c.scalar(root["notes"], "notes");
   if (!root["weights"]) c.fail(root, "device profile: missing 'weights' (nanoseconds per unit of each term)");
-  parseTermWeights(c, root["weights"], "weights", kMaxProfileWeightNs, prof.nanoseconds);
-  if (root["vertices_per_draw"]) {
-    prof.verticesPerDraw = parseWeight(c, root["vertices_per_draw"], "'vertices_per_draw'", "vertices", "vertices", kMaxVerticesPerDraw);
-  }
+  parseTermWeights(c, root["weights"], "weights", "weight", kMaxProfileWeightNs, prof.nanoseconds);
+  if (root["vertices_per_draw"])
+    prof.verticesPerDraw = parseNumber(c, root["vertices_per_draw"], "'vertices_per_draw'", "vertices", "vertices", 1, kMaxVerticesPerDraw);
   if (root["draw_weights"]) {
-    parseTermWeights(c, root["draw_weights"], "draw_weights", kMaxProfileDrawWeightNs, prof.drawNanoseconds);
+    parseTermWeights(c, root["draw_weights"], "draw_weights", "draw weight", kMaxProfileDrawWeightNs, prof.drawNanoseconds);
     if (!root["vertices_per_draw"])
       c.fail(root["draw_weights"], "device profile: 'draw_weights' needs 'vertices_per_draw' (the workload they are spread over)");
   }
