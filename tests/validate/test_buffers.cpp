@@ -62,6 +62,7 @@ const std::string kFaceFrag = "examples/dawn/face.frag", kFaceRules = "examples/
 // (Opt-in until the reference was compiled: the tree walker took 247 s for both.) The size
 // is the point here, and its ~1.5 GB of streams and buffers under ASan would dominate the
 // sanitizer suite: that build checks the same code on the smaller meshes of the other tests.
+// Full scale only uninstrumented: cmake/dev.sh test runs it in the plain tree (full_scale_tests).
 TEST(Buffers, Face52TargetsAt180kVerticesDenseAndSparse) {
   if (kSanitized) GTEST_SKIP() << "180,000 vertices x 52 targets: run by the plain suite";
   for (const char* rig : {"face52.rig.yaml", "face52_sparse.rig.yaml"}) {

@@ -91,6 +91,7 @@ TEST(Program, AgreesWithTreeOnProceduralMeshes) {
   EXPECT_GT(compared, 500000u);
 }
 
+// Full scale only uninstrumented: cmake/dev.sh test runs it in the plain tree (full_scale_tests).
 TEST(Program, AgreesWithTreeOnDawnSubset) {
   const sg::RuleSet rules = sg::loadRules({sourcePath("examples/dawn/rules.yaml")});
   sg::Rig rig = sg::loadRigFile(sourcePath("examples/dawn/face.rig.yaml"));
@@ -376,6 +377,7 @@ class RandomDefinition {
   int locals_ = 0;
 };
 
+// Full scale only uninstrumented: cmake/dev.sh test runs it in the plain tree (full_scale_tests).
 TEST(Program, AgreesWithTreeOnRandomDefinitions) {
   rt::MeshOptions mo;
   mo.influences = 4;
