@@ -77,6 +77,9 @@ void registerCalibrate(CLI::App& app, CliState& state) {
   sub->add_option("--rounds", cmd->co.rounds, "Timings per program; the best counts (default 2)")->check(CLI::Range(1, 100));
   sub->add_option("--refits", cmd->co.refits, "With --rig: fits again with the plans each profile chose (default 1)")
       ->check(CLI::Range(0, 10));
+  sub->add_option("--near-best-weight", cmd->co.nearBestPower,
+                  "With --rig: a plan's row in the fit weighs (its rig's fastest / its time)^P (default 4; 0: all alike)")
+      ->check(CLI::Range(0.0, 16.0));
   sub->add_flag("--no-check", cmd->noCheck, "With --rig: do not time the rigs' plans under the fitted profile afterwards");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer (use for timings)");
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });

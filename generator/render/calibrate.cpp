@@ -345,21 +345,34 @@ double medianOf(std::vector<double> v) {
 }  // namespace
 
 DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
-                               double workloadVertices) {
+                               double workloadVertices, double nearBestPower) {
   std::vector<const CalibrationSample*> rows;
   std::set<double> sizes;
+  std::map<std::pair<std::string, std::string>, double> fastest;  // (rig, mesh) -> ns per vertex
   for (const auto& s : samples)
-    if (s.fitted && s.validated && s.measuredNs > 0 && s.vertices > 0) rows.push_back(&s), sizes.insert(s.vertices);
+    if (s.fitted && s.validated && s.measuredNs > 0 && s.vertices > 0) {
+      rows.push_back(&s), sizes.insert(s.vertices);
+      auto [it, added] = fastest.emplace(std::make_pair(s.rig, s.mesh), s.measuredNs);
+      if (!added) it->second = std::min(it->second, s.measuredNs);
+    }
   if (rows.empty()) throw std::runtime_error("calibration: no validated timing to fit");
+  // A probe varies one term and weighs 1; a rig's programs weigh more the nearer they come
+  // to its fastest. The GPU hides some costs under others (a 16-location plan's palette loads
+  // under its fetch): no additive model fits both, so the fit favours the plans the search
+  // must order right, those near the fastest.
+  std::vector<double> rowWeight(rows.size(), 1.0);
+  for (size_t i = 0; i < rows.size(); ++i)
+    if (!rows[i]->rig.empty() && nearBestPower > 0)
+      rowWeight[i] = std::pow(fastest.at({rows[i]->rig, rows[i]->mesh}) / rows[i]->measuredNs, nearBestPower);
   // Per-draw columns only when meshes of two sizes separate them from the per-vertex ones.
   const size_t n = sizes.size() > 1 ? 2 * kTermCount : kTermCount;
   // Relative errors weigh equally: row i divided by its measured time. Each column is scaled
   // to a largest entry of 1 (per-draw amounts are ~1e-5 of per-vertex ones), then unscaled.
-  std::vector<double> a(rows.size() * n), b(rows.size(), 1.0), scale(n, 0.0);
+  std::vector<double> a(rows.size() * n), b(rowWeight), scale(n, 0.0);
   for (size_t i = 0; i < rows.size(); ++i)
     for (size_t j = 0; j < n; ++j) {
       const double amount = double(rows[i]->amounts[j % kTermCount]) / (j < kTermCount ? 1.0 : rows[i]->vertices);
-      a[i * n + j] = amount / rows[i]->measuredNs;
+      a[i * n + j] = rowWeight[i] * amount / rows[i]->measuredNs;
       scale[j] = std::max(scale[j], std::abs(a[i * n + j]));
     }
   for (size_t i = 0; i < rows.size(); ++i)
@@ -539,7 +552,8 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   double workload = 0;
   for (const auto& s : rep.samples)
     if (s.mesh == opts.meshes.front()) workload = s.vertices;
-  rep.profile = fitDeviceProfile(rep.samples, rep.device + " (" + rep.driver + ")", workload);
+  rep.nearBestPower = opts.rigs.empty() ? 0 : opts.nearBestPower;
+  rep.profile = fitDeviceProfile(rep.samples, rep.device + " (" + rep.driver + ")", workload, opts.nearBestPower);
   // The check: each rig's plans under the fitted profile. The plans a profile chooses are
   // where its errors cost time, so each refit adds them to the fit; the last check's plans
   // are never fitted.
@@ -551,7 +565,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
     benchRigs(fitted, false, last ? "checked plan: " : fmt::format("plan under fit {}: ", round + 1));
     if (last) break;
     for (auto& s : rep.samples) s.fitted = true;
-    rep.profile = fitDeviceProfile(rep.samples, rep.profile.device, workload);
+    rep.profile = fitDeviceProfile(rep.samples, rep.profile.device, workload, opts.nearBestPower);
   }
   rep.fits = evaluateFit(rep.samples, rep.profile, opts.meshes);
   return rep;
@@ -604,6 +618,8 @@ std::string deviceProfileYaml(const CalibrationReport& r) {
   std::string s = "# Measured by `shadergen calibrate` (docs/device-profiles.md): ns per vertex per unit of each\n"
                   "# term (and, under draw_weights, ns per draw), the non-negative least-squares fit of every\n"
                   "# validated probe's, plan's and floor's time.\n";
+  if (r.nearBestPower > 0)
+    s += fmt::format("# A rig's plans and floors weighed (its fastest on that mesh / their time)^{:g}.\n", r.nearBestPower);
   s += fmt::format("# clock: {}; driver: {}\n", r.clock, r.driver);
   for (const auto& f : r.fits) s += "# " + fitLine(f) + "\n";
   for (const auto& c : r.checks)

@@ -43,6 +43,10 @@ struct CalibrationOptions {
   // Refits: each adds the plans the profile chose to the samples and fits again; the last
   // profile's plans are the check, which no fit saw.
   uint32_t refits = 1;
+  // Each plan's and floor's row in the fit weighs (fastest of its rig and mesh / its time)^P:
+  // the search only compares plans of one rig, and the ones near the fastest are where a
+  // wrong order costs time (docs/device-profiles.md, "Where the fit looks"). 0: all alike.
+  double nearBestPower = 4;
 };
 
 struct CalibrationSample {
@@ -79,6 +83,7 @@ struct CalibrationReport {
   std::string device, driver;
   std::string clock;  // what measured the samples: GPU timestamps, or host time on a CPU device
   std::vector<CalibrationSample> samples;
+  double nearBestPower = 0;  // of the fit (CalibrationOptions)
   DeviceProfile profile;
   std::vector<CalibrationFit> fits;  // one per mesh
   std::vector<CalibrationCheck> checks;
@@ -87,11 +92,12 @@ struct CalibrationReport {
 CalibrationReport calibrateDevice(const CalibrationOptions& opts);
 
 // The fit alone (exposed for tests): weights >= 0 minimising the relative error of
-// predicted against measured ns per vertex over the validated, fitted samples; per-draw
+// predicted against measured ns per vertex over the validated, fitted samples, a rig's
+// samples weighted by (its fastest on that mesh / their time)^nearBestPower; per-draw
 // weights too when the samples' meshes differ in size. The profile prices draws of
 // `workloadVertices`.
 DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
-                               double workloadVertices);
+                               double workloadVertices, double nearBestPower = 0);
 // Fills predictedNs of every sample and the fit statistics per mesh.
 std::vector<CalibrationFit> evaluateFit(std::vector<CalibrationSample>& samples, const DeviceProfile& profile,
                                         const std::vector<std::string>& meshes);
