@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <time.h>
+
 #include <chrono>
 #include <stdexcept>
 
@@ -33,6 +35,12 @@ std::string Renderer::driver() const {
 }
 
 namespace {
+
+double processCpuNs() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) * 1e9 + double(t.tv_nsec);
+}
 
 setup::PassDesc passOf(const DrawRequest& r, bool rasterize) {
   setup::PassDesc p;
@@ -119,8 +127,10 @@ Timing Renderer::time(const DrawRequest& r, const TimingRequest& t) {
     vkCmdWriteTimestamp(o.cmd(), VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, 1);
     o.endPass();
     auto t0 = std::chrono::steady_clock::now();
+    const double cpu0 = processCpuNs();
     o.submitAndWait();
     out.wallNs.push_back(std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count());
+    out.cpuNs.push_back(processCpuNs() - cpu0);
     uint64_t ts[2] = {0, 0};
     check(vkGetQueryPoolResults(dev.h.device, queries, 0, 2, sizeof(ts), ts, sizeof(uint64_t),
                                 VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),

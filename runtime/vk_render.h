@@ -48,6 +48,9 @@ struct Timing {
   // Host time of each frame's submit + wait: on a CPU device (lavapipe) work may run outside
   // the timestamps' reach (deferred binning, rasterizer threads), so this is the honest one there.
   std::vector<double> wallNs;
+  // This process's CPU time over the same span, every thread's: a CPU device's threads do
+  // the work here, so this counts the work itself, not what other processes took meanwhile.
+  std::vector<double> cpuNs;
   uint32_t verticesPerDraw = 0;  // vertex shader invocations asked for per draw (unique vertices)
 };
 

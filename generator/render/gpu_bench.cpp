@@ -359,6 +359,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
         rt::Timing tm = renderer.time(req, t);
         best(p.row.rasterOnNsPerVertex, perVertex(tm.frameNs, tm.verticesPerDraw));
         best(p.row.rasterOnWallNsPerVertex, perVertex(tm.wallNs, tm.verticesPerDraw));
+        best(p.row.rasterOnCpuNsPerVertex, perVertex(tm.cpuNs, tm.verticesPerDraw));
       }
       if (opts.rasterOff) {
         rt::DrawRequest req = drawRequest(p.capture, frag, textures, scene);

@@ -163,12 +163,12 @@ TEST(Calibrate, TwoMeshSizesSeparatePerDrawFromPerVertexCosts) {
     EXPECT_NEAR(back.drawNanoseconds[size_t(t)], p.drawNanoseconds[size_t(t)], 1e-5 * (1 + p.drawNanoseconds[size_t(t)]));
 }
 
-// The samples an H200 calibration measured (bench/data/h200-calibrate.log: probes, floors and
+// The samples an H200 calibration measured (bench/data/h200-calibrate-alike.log, fitted with every row alike: probes, floors and
 // both Dawn layouts' plans at Dawn scale and on the cached head, each validated before it was
 // timed): data the fit was not designed around. Rows "checked plan" are never fitted.
 std::vector<CalibrationSample> h200Samples() {
   const std::map<std::string, double> vertices = {{"dawn", 180000}, {"head", 2009}};  // the log's meshes
-  std::ifstream in(std::string(SG_SOURCE_DIR) + "/bench/data/h200-calibrate.log");
+  std::ifstream in(std::string(SG_SOURCE_DIR) + "/bench/data/h200-calibrate-alike.log");
   std::vector<CalibrationSample> samples;
   std::string line;
   while (std::getline(in, line)) {
