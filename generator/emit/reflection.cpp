@@ -93,9 +93,12 @@ std::string packedFieldsHeader(const RigAttribute& a, const std::string& name) {
     for (int c = 0; c < formatComponents(f.format); ++c) bits += fmt::format("{}{}", c ? ", " : "", formatComponentBits(f.format, c));
     const std::string field = fmt::format("{}_FIELD{}", name, i);
     h += fmt::format("/* field {}: {} ({}), bits per component {} */\n", i, formatName(f.format), sems, bits);
-    h += fmt::format("#define {}_FORMAT {}u /* {} */\n#define {}_WORD {}u\n#define {}_BIT {}u\n#define {}_COMPONENTS {}u\n",
+    h += fmt::format("#define {}_FORMAT {}u /* {} */\n#define {}_WORD {}u\n#define {}_BIT {}u\n#define {}_COMPONENTS {}u\n"
+                     "#define {}_BITS {}u\n",
                      field, vulkanFormat(f.format).value, vulkanFormat(f.format).name, field, f.word, field, f.bit, field,
-                     formatComponents(f.format));
+                     formatComponents(f.format), field, formatComponentBits(f.format, 0));
+    if (formatComponentBits(f.format, 3) != formatComponentBits(f.format, 0) && formatComponents(f.format) == 4)
+      h += fmt::format("#define {}_BITS_W {}u\n", field, formatComponentBits(f.format, 3));  // 10-10-10-2
   }
   return h;
 }

@@ -92,6 +92,26 @@ int fieldComponentBit(const PackedField& f, int c) {
 
 FieldUnpack unpackField(const PackedField& f, const std::string& swizzle, const std::string& input, int inputComponents) {
   const int n = swizzle.empty() ? formatComponents(f.format) : static_cast<int>(swizzle.size());
+  auto component = [&](int k) {
+    return swizzle.empty() ? k : static_cast<int>(std::string("xyzw").find(swizzle[static_cast<size_t>(k)]));
+  };
+  // Small unsigned integers, several: one shift and one mask of the words, each repeated per
+  // component (a gather of one register, which costs no move).
+  if (formatKind(f.format) == FormatKind::Uint && formatComponentBits(f.format, 0) < 32 && n > 1) {
+    const auto type = vectorType(ScalarKind::UInt, n);
+    std::vector<std::string> words, shifts;
+    for (int k = 0; k < n; ++k) {
+      const int at = fieldComponentBit(f, component(k));
+      words.push_back(inputComponents == 1 ? input : input + "." + std::string(1, "xyzw"[at / 32]));
+      shifts.push_back(fmt::format("{}u", at % 32));
+    }
+    const std::string t(type ? glslName(*type) : "?");
+    FieldUnpack out;
+    out.glsl = fmt::format("({}({}) >> {}({})) & {}u", t, fmt::join(words, ", "), t, fmt::join(shifts, ", "),
+                           (1u << formatComponentBits(f.format, 0)) - 1u);
+    out.slots = 2;  // shift, and
+    return out;
+  }
   // Consecutive lanes of one unpack stay one swizzle of it: unpackUnorm2x16(w).xy.
   struct Piece {
     FieldComponentRead read;
@@ -101,8 +121,7 @@ FieldUnpack unpackField(const PackedField& f, const std::string& swizzle, const 
   std::set<std::string> calls, regs;
   int64_t slots = 0;
   for (int k = 0; k < n; ++k) {
-    const int c = swizzle.empty() ? k : static_cast<int>(std::string("xyzw").find(swizzle[static_cast<size_t>(k)]));
-    FieldComponentRead r = readFieldComponent(f, c, input, inputComponents);
+    FieldComponentRead r = readFieldComponent(f, component(k), input, inputComponents);
     if (calls.insert(r.call).second) slots += r.slots;  // the compiler reads a repeated unpack once
     regs.insert(r.reg);
     const char lane = "xyzw"[r.lane];
