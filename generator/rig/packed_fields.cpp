@@ -36,14 +36,14 @@ FieldComponentRead readFieldComponent(const PackedField& f, int c, const std::st
     // Data Conversions"); the 2-bit snorm w is c itself.
     if (kind == FormatKind::Unorm) {
       r.call = fmt::format("(float(bitfieldExtract({}, {}, {})) / {}.0)", word, bit, bits, (1 << bits) - 1);
-      r.slots = 4;  // extract, convert, divide (2)
+      r.slots = 3;  // extract, convert, divide (by a constant: spirv-opt multiplies by its reciprocal)
     } else if (bits == 2) {
       r.call = fmt::format("max(float(bitfieldExtract(int({}), {}, {})), -1.0)", word, bit, bits);
       r.slots = 3;  // extract, convert, max
     } else {
       r.call = fmt::format("max(float(bitfieldExtract(int({}), {}, {})) / {}.0, -1.0)", word, bit, bits,
                            (1 << (bits - 1)) - 1);
-      r.slots = 5;  // extract, convert, divide (2), max
+      r.slots = 4;  // extract, convert, divide (a multiply, as above), max
     }
   } else if (kind == FormatKind::Uint) {
     r.call = bits == 32 ? word : fmt::format("bitfieldExtract({}, {}, {})", word, bit, bits);

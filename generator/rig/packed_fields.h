@@ -28,8 +28,9 @@ int fieldComponentBit(const PackedField& f, int c);
 // input of `inputComponents` uint words (uvec4: `input.x`..; uint: `input`), with the
 // builtins (unpackUnorm2x16, unpackSnorm4x8, unpackHalf2x16, bitfieldExtract, ...), and
 // its cost in instruction slots counted as `cost: auto` counts them (docs/cost-model.md:
-// an unpack, an extract or a conversion 1, a division 2, a bit cast 0, and one move per
-// unpacked register when the value gathers several).
+// an unpack, an extract, a conversion, a min or max 1, a division by a constant 1 (spirv-opt
+// multiplies by the reciprocal), a bit cast 0, and one move per unpacked register when the
+// value gathers several; tests/validate/test_bitpacked.cpp measures them).
 struct FieldUnpack {
   std::string glsl;
   int64_t slots = 0;
