@@ -877,6 +877,7 @@ TEST(VertexFormats, VulkanFormatsAreTheHeadersOwn) {
   SG_EXPECT_VK(Snorm10_10_10_2, VK_FORMAT_A2B10G10R10_SNORM_PACK32);
   SG_EXPECT_VK(Uint8x2, VK_FORMAT_R8G8_UINT);
   SG_EXPECT_VK(Uint16x2, VK_FORMAT_R16G16_UINT);
+  SG_EXPECT_VK(Uint32x1, VK_FORMAT_R32_UINT);
 #undef SG_EXPECT_VK
   EXPECT_EQ(checked, sg::kVertexFormatCount);
 }
