@@ -21,7 +21,7 @@ struct FieldComponentRead {
   int lanes = 0;  // lanes the call returns; 0: a scalar expression
   int lane = 0;
   int64_t slots = 0;
-  std::string reg;  // the register it lands in (a bit cast of a word stays the word's)
+  std::string reg;  // the register it lands in (a whole uint word: the input itself)
 };
 
 FieldComponentRead readFieldComponent(const PackedField& f, int c, const std::string& input, int inputComponents) {
@@ -66,7 +66,9 @@ FieldComponentRead readFieldComponent(const PackedField& f, int c, const std::st
 
 }  // namespace
 
-bool formatHoldsFields(VertexFormat f) { return f == VertexFormat::Uint32x4 || f == VertexFormat::Uint32x1; }
+bool formatHoldsFields(VertexFormat f) {
+  return f == VertexFormat::Uint32x4 || f == VertexFormat::Uint32x2 || f == VertexFormat::Uint32x1;
+}
 
 int fieldBits(VertexFormat f) { return 8 * formatBytes(f); }
 

@@ -1,5 +1,5 @@
 // Bit-packed attributes (docs/rig-format.md, "Bit-packed attributes"): several fields, each
-// a value in one of the vertex formats, in the 32-bit words of one uint32x4 (or uint32)
+// a value in one of the vertex formats, in the 32-bit words of one uint32x4 (uint32x2, uint32)
 // attribute. The layout rule, the shader's unpack of a field (what the fixed-function
 // conversion of the field's format would return) and the host's packing of one field.
 #pragma once

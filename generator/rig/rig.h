@@ -47,7 +47,7 @@ struct RigAttribute {
   Type shaderType = Type::Vec4;  // type declared in the shader (derived from format)
   bool perMorphTarget = false;   // one stream per morph target; semantics get "[target]"
   std::vector<ProvidedPart> provides;
-  std::vector<PackedField> fields;  // non-empty: bit-packed (format uint32x4 or uint32)
+  std::vector<PackedField> fields;  // non-empty: bit-packed (format uint32x4, uint32x2 or uint32)
   SourceLoc loc;
 };
 

@@ -161,8 +161,8 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
     if (fields) {
       // Bit-packed: the fields provide, each from its place in the words (rig/packed_fields.h).
       if (!formatHoldsFields(a.format))
-        y.fail(body["format"], fmt::format("attribute '{}' has 'fields', so its format must be uint32x4 or uint32 "
-                                           "(the words its fields are packed into), not {}", a.name, fmtName));
+        y.fail(body["format"], fmt::format("attribute '{}' has 'fields', so its format must be uint32x4, uint32x2 or "
+                                           "uint32 (the words its fields are packed into), not {}", a.name, fmtName));
       if (prov) y.fail(prov, fmt::format("attribute '{}' has 'fields': each field says what it provides, the "
                                          "attribute itself does not", a.name));
       if (a.perMorphTarget)

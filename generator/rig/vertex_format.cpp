@@ -44,6 +44,7 @@ constexpr std::array<FormatInfo, kVertexFormatCount> kFormats{{
     {VertexFormat::Uint8x2, "uint8x2", 2, 2, Kind::Uint, {8, 8, 0, 0}, {"VK_FORMAT_R8G8_UINT", 20}},
     {VertexFormat::Uint16x2, "uint16x2", 2, 4, Kind::Uint, {16, 16, 0, 0}, {"VK_FORMAT_R16G16_UINT", 81}},
     {VertexFormat::Uint32x1, "uint32", 1, 4, Kind::Uint, {32, 0, 0, 0}, {"VK_FORMAT_R32_UINT", 98}},
+    {VertexFormat::Uint32x2, "uint32x2", 2, 8, Kind::Uint, {32, 32, 0, 0}, {"VK_FORMAT_R32G32_UINT", 101}},
 }};
 const FormatInfo& info(VertexFormat f) { return kFormats[static_cast<size_t>(f)]; }
 static_assert([] {

@@ -17,9 +17,9 @@ enum class VertexFormat {
   Unorm8x2, Unorm16x2,
   Unorm10_10_10_2, Snorm10_10_10_2,  // x, y, z in 10 bits, w in 2 (A2B10G10R10_*_PACK32)
   Uint8x2, Uint16x2,
-  Uint32x1,
+  Uint32x1, Uint32x2,
 };
-constexpr int kVertexFormatCount = 22;
+constexpr int kVertexFormatCount = 23;
 
 const char* formatName(VertexFormat f);  // "float32x3", "unorm8x4", "unorm10-10-10-2", ...
 bool parseFormat(const std::string& name, VertexFormat& out);

@@ -291,7 +291,8 @@ TEST(RigLoader, Formats) {
                      F{"snorm10-10-10-2", sg::VertexFormat::Snorm10_10_10_2, 4, 4, false},
                      F{"uint8x2", sg::VertexFormat::Uint8x2, 2, 2, true},
                      F{"uint16x2", sg::VertexFormat::Uint16x2, 2, 4, true},
-                     F{"uint32", sg::VertexFormat::Uint32x1, 1, 4, true}}) {
+                     F{"uint32", sg::VertexFormat::Uint32x1, 1, 4, true},
+                     F{"uint32x2", sg::VertexFormat::Uint32x2, 2, 8, true}}) {
     sg::VertexFormat out{};
     ASSERT_TRUE(sg::parseFormat(f.name, out)) << f.name;
     EXPECT_EQ(out, f.f) << f.name;

@@ -77,6 +77,12 @@ TEST(BitPacked, FieldsArePlacedInOrderAlignedToTheirComponents) {
            sg::VertexFormat::Float32x1, sg::VertexFormat::Unorm8x2, sg::VertexFormat::Snorm16x2},
           4, &fits);
   EXPECT_FALSE(fits);
+  // Two words (uint32x2): a 16-bit pair, then two byte pairs in word 1's halves.
+  auto two = laidOut({sg::VertexFormat::Snorm16x2, sg::VertexFormat::Snorm8x2, sg::VertexFormat::Snorm8x2}, 2, &fits);
+  EXPECT_TRUE(fits);
+  EXPECT_EQ(two[1].word, 1);
+  EXPECT_EQ(two[2].word, 1);
+  EXPECT_EQ(two[2].bit, 16);
   // One word (uint32): two byte pairs fit, a third does not.
   laidOut({sg::VertexFormat::Unorm8x2, sg::VertexFormat::Unorm8x2}, 1, &fits);
   EXPECT_TRUE(fits);
@@ -186,7 +192,7 @@ TEST(BitPacked, LoaderRefusesWithALocation) {
                 .find("t.yaml:4:5: error: field 2 (float32x3) would take bits 64..159, past the 128 bits of uint32x4"),
             std::string::npos);
   EXPECT_NE(loaderError("  p: { format: uint16x4, fields: [ { format: unorm8x4, provides: vertex.color } ] }\n")
-                .find("t.yaml:3:16: error: attribute 'p' has 'fields', so its format must be uint32x4 or uint32"),
+                .find("t.yaml:3:16: error: attribute 'p' has 'fields', so its format must be uint32x4, uint32x2 or uint32"),
             std::string::npos);
   EXPECT_NE(loaderError("  p: { format: uint32, fields: [ { format: snorm8x2, provides: { vertex.uv: xyz } } ] }\n")
                 .find("t.yaml:3:77: error: 'xyz' is not a valid swizzle of a 2-component field (snorm8x2)"),
@@ -224,6 +230,20 @@ TEST(BitPacked, PackedVertexValidatesOnTheDevice) {
   EXPECT_TRUE(sgtest::planHas(rep.runs[0], "unpack_packed.vertex.position_in_bounds"));
   EXPECT_TRUE(sgtest::planHas(rep.runs[0], "unpack_skin.skin.joints[0]"));
   EXPECT_TRUE(sgtest::planHas(rep.runs[0], "vertex_normal_from_octahedral"));
+}
+
+// One- and two-word attributes (uint, uvec2 inputs): an snorm16 pair in word 0, two snorm8
+// pairs in word 1's halves, halves and bytes each in a uint.
+TEST(BitPacked, OneAndTwoWordAttributesValidateOnTheDevice) {
+  sg::ValidateOptions vo = limbOptions("bitpacked_small.rig.yaml");
+  const sg::GenerateResult g = sg::generate(vo.gen);
+  for (const char* line : {"layout(location = 1) in uvec2 a_frame;", "layout(location = 2) in uint a_uv;",
+                           "unpackSnorm4x8(a_frame.y).xy", "unpackSnorm4x8(a_frame.y).z;", "unpackHalf2x16(a_uv)",
+                           "(uvec4(a_joints, a_joints, a_joints, a_joints) >> uvec4(0u, 8u, 16u, 24u)) & 255u"})
+    EXPECT_NE(g.glsl.text.find(line), std::string::npos) << line << "\n" << g.glsl.text;
+  const sg::ValidationScene scene = sg::proceduralScene(g.in.rig, "limb", 1, 2);
+  const sg::ValidateReport rep = sg::Validator(vo).run(scene);
+  EXPECT_TRUE(rep.pass) << sg::formatReport(rep);
 }
 
 // Wrong unpacks planted in the generated GLSL fail on the outputs that read them: the

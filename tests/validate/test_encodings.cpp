@@ -878,6 +878,7 @@ TEST(VertexFormats, VulkanFormatsAreTheHeadersOwn) {
   SG_EXPECT_VK(Uint8x2, VK_FORMAT_R8G8_UINT);
   SG_EXPECT_VK(Uint16x2, VK_FORMAT_R16G16_UINT);
   SG_EXPECT_VK(Uint32x1, VK_FORMAT_R32_UINT);
+  SG_EXPECT_VK(Uint32x2, VK_FORMAT_R32G32_UINT);
 #undef SG_EXPECT_VK
   EXPECT_EQ(checked, sg::kVertexFormatCount);
 }
