@@ -502,6 +502,7 @@ class Checker {
     std::vector<bool> producible(p.facts.size(), false);
     for (const auto& a : p.actions) producible[a.add] = true;
     for (const auto& a : p.actions) {
+      if (a.rule < 0) continue;  // a bit-packed field's unpack reads only its attribute
       const Rule& rule = rules_.rules[a.rule];
       for (int f : a.pre) {
         if (reach[f]) continue;

@@ -63,6 +63,7 @@ ProbeRig probeRigFromRig(const Rig& rig, const RuleSet& rules) {
     int targets = a.perMorphTarget ? rig.morphTargets() : 1;
     for (int t = 0; t < targets; ++t)
       for (const auto& part : a.provides) {
+        if (part.field >= 0) continue;  // unpacked into a local first: read like a uniform of its type
         std::string fact = a.perMorphTarget ? indexedName(part.semantic, t) : part.semantic;
         std::string input = a.perMorphTarget ? fmt::format("a_{}{}", a.name, t) : "a_" + a.name;
         pr.streams[fact] = ProbeRig::Stream{input, a.shaderType, part.swizzle};

@@ -10,7 +10,7 @@ struct TypeInfo {
   int components;
   ScalarKind kind;
 };
-constexpr std::array<TypeInfo, 10> kTypes{{
+constexpr std::array<TypeInfo, 11> kTypes{{
     {Type::Float, "float", 1, ScalarKind::Float},
     {Type::Vec2, "vec2", 2, ScalarKind::Float},
     {Type::Vec3, "vec3", 3, ScalarKind::Float},
@@ -21,6 +21,7 @@ constexpr std::array<TypeInfo, 10> kTypes{{
     {Type::UVec4, "uvec4", 4, ScalarKind::UInt},
     {Type::Mat3, "mat3", 9, ScalarKind::Float},
     {Type::Mat4, "mat4", 16, ScalarKind::Float},
+    {Type::UVec2, "uvec2", 2, ScalarKind::UInt},  // a uint32x2, uint8x2 or uint16x2 attribute
 }};
 const TypeInfo& info(Type t) { return kTypes[static_cast<size_t>(t)]; }
 }  // namespace

@@ -6,7 +6,7 @@
 
 namespace sg {
 
-enum class Type { Float, Vec2, Vec3, Vec4, Int, IVec4, UInt, UVec4, Mat3, Mat4 };
+enum class Type { Float, Vec2, Vec3, Vec4, Int, IVec4, UInt, UVec4, Mat3, Mat4, UVec2 };
 
 enum class ScalarKind { Float, Int, UInt };
 

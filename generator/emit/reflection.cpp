@@ -4,6 +4,8 @@
 
 #include <cctype>
 
+#include "rig/packed_fields.h"
+
 namespace sg {
 namespace {
 
@@ -75,6 +77,32 @@ std::string crossJson(const CrossShader& c) {
   return j + "\n  },\n";
 }
 
+// A bit-packed attribute's fields (docs/rig-format.md, "Bit-packed attributes"): per field,
+// the VkFormat whose conversion the shader's unpack reproduces (encode each field as an
+// attribute of that format would be), the word and bit it starts at, its components and
+// the bits of each.
+std::string packedFieldsHeader(const RigAttribute& a, const std::string& name) {
+  if (a.fields.empty()) return "";
+  std::string h = fmt::format("#define {}_FIELD_COUNT {}u\n", name, a.fields.size());
+  for (size_t i = 0; i < a.fields.size(); ++i) {
+    const PackedField& f = a.fields[i];
+    std::string sems;
+    for (const auto& p : a.provides)
+      if (p.field == static_cast<int>(i)) sems += fmt::format("{}{}{}", sems.empty() ? "" : ", ", p.semantic, p.swizzle.empty() ? "" : "." + p.swizzle);
+    std::string bits;
+    for (int c = 0; c < formatComponents(f.format); ++c) bits += fmt::format("{}{}", c ? ", " : "", formatComponentBits(f.format, c));
+    const std::string field = fmt::format("{}_FIELD{}", name, i);
+    h += fmt::format("/* field {}: {} ({}), bits per component {} */\n", i, formatName(f.format), sems, bits);
+    h += fmt::format("#define {}_FORMAT {}u /* {} */\n#define {}_WORD {}u\n#define {}_BIT {}u\n#define {}_COMPONENTS {}u\n"
+                     "#define {}_BITS {}u\n",
+                     field, vulkanFormat(f.format).value, vulkanFormat(f.format).name, field, f.word, field, f.bit, field,
+                     formatComponents(f.format), field, formatComponentBits(f.format, 0));
+    if (formatComponentBits(f.format, 3) != formatComponentBits(f.format, 0) && formatComponents(f.format) == 4)
+      h += fmt::format("#define {}_BITS_W {}u\n", field, formatComponentBits(f.format, 3));  // 10-10-10-2
+  }
+  return h;
+}
+
 }  // namespace
 
 std::string vertexInputsHeader(const Rig& rig, const EmittedGlsl& glsl, const std::string& symbol) {
@@ -89,6 +117,7 @@ std::string vertexInputsHeader(const Rig& rig, const EmittedGlsl& glsl, const st
     for (char c : in.name) name += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
     h += fmt::format("#define {}_LOCATION {}u\n#define {}_FORMAT {}u /* {} */\n#define {}_STRIDE {}u\n", name, in.location,
                      name, vulkanFormat(f).value, vulkanFormat(f).name, name, formatBytes(f));
+    h += packedFieldsHeader(rig.attributes[in.attribute], name);
   }
   return h;
 }
@@ -120,14 +149,18 @@ std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvM
     std::string sems;
     for (const auto& p : a.provides) {
       std::string s = in.target >= 0 ? fmt::format("{}[{}]", p.semantic, in.target) : p.semantic;
-      sems += fmt::format("{}{{\"semantic\": {}, \"components\": {}}}", sems.empty() ? "" : ", ", jsonQuote(s),
-                          jsonQuote(p.swizzle.empty() ? std::string("xyzw").substr(0, formatComponents(a.format)) : p.swizzle));
+      const int n = formatComponents(partFormat(a, p));
+      sems += fmt::format("{}{{\"semantic\": {}, \"components\": {}{}}}", sems.empty() ? "" : ", ", jsonQuote(s),
+                          jsonQuote(p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(n)) : p.swizzle),
+                          p.field >= 0 ? fmt::format(", \"field\": {}", p.field) : "");
     }
+    // A bit-packed attribute: where each field sits in its words (rig/packed_fields.h).
+    const std::string fields = a.fields.empty() ? "" : ", \"fields\": " + packedFieldsJson(a);
     j += fmt::format("{}\n    {{\"name\": {}, \"location\": {}, \"attribute\": {}, \"target\": {}, \"format\": {}, "
-                     "\"vk_format\": {}, \"stride\": {}, \"type\": {}, \"provides\": [{}]}}",
+                     "\"vk_format\": {}, \"stride\": {}, \"type\": {}, \"provides\": [{}]{}}}",
                      i ? "," : "", jsonQuote(in.name), in.location, jsonQuote(a.name), in.target, jsonQuote(formatName(a.format)),
                      jsonQuote(vulkanFormat(a.format).name), formatBytes(a.format), jsonQuote(std::string(glslName(in.type))),
-                     sems);
+                     sems, fields);
   }
   j += "\n  ],\n";
   j += fmt::format("  \"uniform_block\": {{\"name\": \"ShadergenUniforms\", \"set\": 0, \"binding\": 0, \"size\": {}, "

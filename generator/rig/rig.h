@@ -27,7 +27,18 @@ constexpr size_t kMaxRigUniforms = 256;
 // A semantic provided by (part of) an attribute: e.g. "vertex.occlusion" is the "w" of "normal".
 struct ProvidedPart {
   std::string semantic;  // may carry an index: "skin.joints[1]"
-  std::string swizzle;   // "" = whole attribute, else "xyz", "w", ...
+  std::string swizzle;   // "" = whole attribute (or field), else "xyz", "w", ...
+  int field = -1;        // index in RigAttribute::fields; -1: a part of the attribute itself
+};
+
+// A field of a bit-packed attribute (docs/rig-format.md, "Bit-packed attributes"): a value
+// in one of the vertex formats, stored in the attribute's 32-bit words at the place the
+// loader computed (rig/packed_fields.h) and unpacked by the shader.
+struct PackedField {
+  VertexFormat format = VertexFormat::Unorm8x4;
+  int word = 0;  // the 32-bit word holding its first component
+  int bit = 0;   // that component's first bit in the word
+  SourceLoc loc;
 };
 
 struct RigAttribute {
@@ -36,8 +47,14 @@ struct RigAttribute {
   Type shaderType = Type::Vec4;  // type declared in the shader (derived from format)
   bool perMorphTarget = false;   // one stream per morph target; semantics get "[target]"
   std::vector<ProvidedPart> provides;
+  std::vector<PackedField> fields;  // non-empty: bit-packed (format uint32x4, uint32x2 or uint32)
   SourceLoc loc;
 };
+
+// The format a part is stored in: its field's, else the attribute's.
+inline VertexFormat partFormat(const RigAttribute& a, const ProvidedPart& p) {
+  return p.field >= 0 ? a.fields[static_cast<size_t>(p.field)].format : a.format;
+}
 
 struct RigUniform {
   std::string name;      // GLSL member name in the uniform block

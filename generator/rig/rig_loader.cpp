@@ -6,6 +6,7 @@
 #include <set>
 
 #include "common/yaml_util.h"
+#include "rig/packed_fields.h"
 #include "rig/rig.h"
 #include "rig/vertex_encoding.h"
 
@@ -109,46 +110,95 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
     if (!validIdentifier(a.name)) y.fail(it->first, fmt::format("'{}' is not a valid attribute name", a.name));
     YAML::Node body = it->second;  // a copy: it->second lives in a temporary proxy
     y.expectMap(body, "an attribute");
-    y.checkKeys(body, {"format", "provides", "per_target", "doc"});
+    y.checkKeys(body, {"format", "provides", "fields", "per_target", "doc"});
     if (!body["format"]) y.fail(body, fmt::format("attribute '{}' has no 'format'", a.name));
     std::string fmtName = y.scalar(body["format"], "'format'");
     if (!parseFormat(fmtName, a.format))
       y.fail(body["format"], fmt::format("unknown vertex format '{}' (expected one of: {})", fmtName, formatNames()));
-    int n = formatComponents(a.format);
+    const int n = formatComponents(a.format);
     a.shaderType = *vectorType(formatIsInteger(a.format) ? ScalarKind::UInt : ScalarKind::Float, n);
     if (body["per_target"]) a.perMorphTarget = y.boolean(body["per_target"], "'per_target'");
-    YAML::Node prov = body["provides"];
-    if (!prov) y.fail(body, fmt::format("attribute '{}' provides no semantic ('provides')", a.name));
-    auto addPart = [&](const YAML::Node& semNode, const YAML::Node* swzNode) {
+    // A part of the attribute (field -1, `what` "attribute") or of one of its fields.
+    auto addPart = [&](const YAML::Node& semNode, const YAML::Node* swzNode, int field, VertexFormat format,
+                       const YAML::Node& formatNode) {
+      const int comps = formatComponents(format);
+      const std::string what = field < 0 ? "attribute" : fmt::format("field ({})", formatName(format));
       ProvidedPart p;
+      p.field = field;
       p.semantic = y.scalar(semNode, "a semantic name");
       if (!validRigSemanticName(p.semantic)) y.fail(semNode, fmt::format("'{}' is not a valid semantic name", p.semantic));
       if (swzNode) {
         p.swizzle = y.scalar(*swzNode, "a swizzle");
-        if (!validSwizzle(p.swizzle, n))
-          y.fail(*swzNode, fmt::format("'{}' is not a valid swizzle of a {}-component attribute", p.swizzle, n));
+        if (!validSwizzle(p.swizzle, comps))
+          y.fail(*swzNode, fmt::format("'{}' is not a valid swizzle of a {}-component {}", p.swizzle, comps, what));
       }
       if (!providedSemantics.insert(p.semantic).second)
         y.fail(semNode, fmt::format("semantic '{}' is provided twice", p.semantic));
       // An encoded value is decoded by its rule from the whole attribute, in a format
       // whose error is known (rig/vertex_encoding.h).
       if (const VertexEncoding* e = encodingOf(p.semantic);
-          e && (!encodingMaxError(*e, a.format) ||
-                (p.swizzle.empty() ? n : static_cast<int>(p.swizzle.size())) != e->components))
-        y.fail(swzNode ? *swzNode : body["format"],
+          e && (!encodingMaxError(*e, format) ||
+                (p.swizzle.empty() ? comps : static_cast<int>(p.swizzle.size())) != e->components))
+        y.fail(swzNode ? *swzNode : formatNode,
                fmt::format("'{}' ({} {}) must be stored in {}, not {}{}", p.semantic, e->name, e->decodesText(),
-                           encodingFormats(*e), formatName(a.format), p.swizzle.empty() ? "" : " ." + p.swizzle));
+                           encodingFormats(*e), formatName(format), p.swizzle.empty() ? "" : " ." + p.swizzle));
       if (const VertexEncoding* e = encodingOf(p.semantic); e && e->perTarget != a.perMorphTarget)
         y.fail(semNode, fmt::format("'{}' ({} {}) is {}stored per morph target: its attribute needs 'per_target: {}'",
                                     p.semantic, e->name, e->decodesText(), e->perTarget ? "" : "not ",
                                     e->perTarget ? "true" : "false"));
       a.provides.push_back(p);
     };
-    if (prov.IsScalar()) {
-      addPart(prov, nullptr);
+    auto addParts = [&](const YAML::Node& prov, int field, VertexFormat format, const YAML::Node& formatNode) {
+      if (prov.IsScalar()) {
+        addPart(prov, nullptr, field, format, formatNode);
+      } else {
+        y.expectMap(prov, "'provides'");
+        for (auto p = prov.begin(); p != prov.end(); ++p) addPart(p->first, &p->second, field, format, formatNode);
+      }
+    };
+    YAML::Node prov = body["provides"];
+    YAML::Node fields = body["fields"];
+    if (fields) {
+      // Bit-packed: the fields provide, each from its place in the words (rig/packed_fields.h).
+      if (!formatHoldsFields(a.format))
+        y.fail(body["format"], fmt::format("attribute '{}' has 'fields', so its format must be uint32x4, uint32x2 or "
+                                           "uint32 (the words its fields are packed into), not {}", a.name, fmtName));
+      if (prov) y.fail(prov, fmt::format("attribute '{}' has 'fields': each field says what it provides, the "
+                                         "attribute itself does not", a.name));
+      if (a.perMorphTarget)
+        y.fail(body["per_target"], fmt::format("attribute '{}': bit-packed attributes are not stored per morph target "
+                                               "(pack each target's values into an attribute of its own)", a.name));
+      y.expectSeq(fields, "'fields'");
+      if (fields.size() == 0) y.fail(fields, fmt::format("attribute '{}' has no fields", a.name));
+      std::vector<YAML::Node> fieldNodes;
+      for (const auto& fn : fields) {
+        YAML::Node f = fn;  // a copy: the iterator's node is a temporary
+        y.expectMap(f, "a field");
+        y.checkKeys(f, {"format", "provides", "doc"});
+        if (!f["format"]) y.fail(f, "a field has no 'format'");
+        const std::string name = y.scalar(f["format"], "'format'");
+        PackedField pf;
+        pf.loc = locOf(f, fileName);
+        if (!parseFormat(name, pf.format))
+          y.fail(f["format"], fmt::format("unknown vertex format '{}' (expected one of: {})", name, formatNames()));
+        if (!f["provides"]) y.fail(f, "a field provides no semantic ('provides')");
+        a.fields.push_back(pf);
+        fieldNodes.push_back(f);
+        addParts(f["provides"], static_cast<int>(a.fields.size()) - 1, pf.format, f["format"]);
+      }
+      if (!layoutFields(a.fields, n)) {
+        for (size_t i = 0; i < a.fields.size(); ++i) {
+          const PackedField& f = a.fields[i];
+          const int end = 32 * f.word + f.bit + fieldBits(f.format);
+          if (end > 32 * n)
+            y.fail(fieldNodes[i], fmt::format("field {} ({}) would take bits {}..{}, past the {} bits of {} (fields are "
+                                              "placed in order, each aligned to its component size)", i + 1,
+                                              formatName(f.format), end - fieldBits(f.format), end - 1, 32 * n, fmtName));
+        }
+      }
     } else {
-      y.expectMap(prov, "'provides'");
-      for (auto p = prov.begin(); p != prov.end(); ++p) addPart(p->first, &p->second);
+      if (!prov) y.fail(body, fmt::format("attribute '{}' provides no semantic ('provides')", a.name));
+      addParts(prov, -1, a.format, body["format"]);
     }
     rig.attributes.push_back(std::move(a));
   }

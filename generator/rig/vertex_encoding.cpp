@@ -253,7 +253,7 @@ Rig withinErrorBudgets(const Rig& rig, const std::map<std::string, double>& budg
   for (const RigAttribute& a : rig.attributes)
     for (const auto& p : a.provides) {
       const VertexEncoding* e = encodingOf(p.semantic);
-      const std::optional<double> err = e ? encodingMaxError(*e, a.format) : std::nullopt;
+      const std::optional<double> err = e ? encodingMaxError(*e, partFormat(a, p)) : std::nullopt;
       if (!err) continue;
       for (const std::string& source : e->sources) {  // the first budget it breaks removes it
         auto budget = budgets.find(source);
@@ -261,7 +261,7 @@ Rig withinErrorBudgets(const Rig& rig, const std::map<std::string, double>& budg
         over.insert(p.semantic);
         const std::string why = fmt::format("{} (attribute '{}', {}) is not offered to the search: it errs up to {:.3g} {}, "
                                             "over the budget of {:.3g} {} for {} (--max-error)",
-                                            p.semantic, a.name, formatName(a.format), *err, e->unit, budget->second,
+                                            p.semantic, a.name, formatName(partFormat(a, p)), *err, e->unit, budget->second,
                                             e->unit, source);
         // Without its deltas a morph target would silently stop moving the value (the
         // unmorphed rules apply): no plan meets the budget, unless the rig stores them plainly too.

@@ -10,7 +10,7 @@
 namespace sg {
 namespace {
 
-enum class Kind { Float32, Float16, Unorm, Snorm, Uint };
+using Kind = FormatKind;
 
 struct FormatInfo {
   VertexFormat format;
@@ -43,6 +43,8 @@ constexpr std::array<FormatInfo, kVertexFormatCount> kFormats{{
     {VertexFormat::Snorm10_10_10_2, "snorm10-10-10-2", 4, 4, Kind::Snorm, {10, 10, 10, 2}, {"VK_FORMAT_A2B10G10R10_SNORM_PACK32", 65}},
     {VertexFormat::Uint8x2, "uint8x2", 2, 2, Kind::Uint, {8, 8, 0, 0}, {"VK_FORMAT_R8G8_UINT", 20}},
     {VertexFormat::Uint16x2, "uint16x2", 2, 4, Kind::Uint, {16, 16, 0, 0}, {"VK_FORMAT_R16G16_UINT", 81}},
+    {VertexFormat::Uint32x1, "uint32", 1, 4, Kind::Uint, {32, 0, 0, 0}, {"VK_FORMAT_R32_UINT", 98}},
+    {VertexFormat::Uint32x2, "uint32x2", 2, 8, Kind::Uint, {32, 32, 0, 0}, {"VK_FORMAT_R32G32_UINT", 101}},
 }};
 const FormatInfo& info(VertexFormat f) { return kFormats[static_cast<size_t>(f)]; }
 static_assert([] {
@@ -77,6 +79,8 @@ int formatBytes(VertexFormat f) { return info(f).bytes; }
 bool formatIsInteger(VertexFormat f) { return info(f).kind == Kind::Uint; }
 bool formatIsFloat32(VertexFormat f) { return info(f).kind == Kind::Float32; }
 VulkanFormat vulkanFormat(VertexFormat f) { return info(f).vulkan; }
+FormatKind formatKind(VertexFormat f) { return info(f).kind; }
+int formatComponentBits(VertexFormat f, int c) { return info(f).bits[static_cast<size_t>(c)]; }
 bool parseFormat(const std::string& name, VertexFormat& out) {
   for (const auto& i : kFormats)
     if (name == i.name) {

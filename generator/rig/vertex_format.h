@@ -17,8 +17,9 @@ enum class VertexFormat {
   Unorm8x2, Unorm16x2,
   Unorm10_10_10_2, Snorm10_10_10_2,  // x, y, z in 10 bits, w in 2 (A2B10G10R10_*_PACK32)
   Uint8x2, Uint16x2,
+  Uint32x1, Uint32x2,
 };
-constexpr int kVertexFormatCount = 21;
+constexpr int kVertexFormatCount = 23;
 
 const char* formatName(VertexFormat f);  // "float32x3", "unorm8x4", "unorm10-10-10-2", ...
 bool parseFormat(const std::string& name, VertexFormat& out);
@@ -28,6 +29,11 @@ int formatComponents(VertexFormat f);
 int formatBytes(VertexFormat f);       // bytes per vertex (the stride of a stream of it)
 bool formatIsInteger(VertexFormat f);  // read as uint in the shader (uint8/16/32)
 bool formatIsFloat32(VertexFormat f);  // stored exactly: nothing to quantize
+// The conversion the device applies to a component, and the component's bits (10-10-10-2:
+// 10, 10, 10, 2), for the shader that unpacks a field of a bit-packed attribute itself.
+enum class FormatKind { Float32, Float16, Unorm, Snorm, Uint };
+FormatKind formatKind(VertexFormat f);
+int formatComponentBits(VertexFormat f, int c);
 // The VkFormat a format is read as: its name and enum value (so that the reflection and
 // the C header can name it without a Vulkan header; the runtime casts the value).
 struct VulkanFormat {

@@ -44,7 +44,7 @@ int defTypeComponents(DefType t) {
 DefType declType(Type t) {
   switch (t) {
     case Type::Float: return DefType::Float;
-    case Type::Vec2: return DefType::Vec2;
+    case Type::Vec2: case Type::UVec2: return DefType::Vec2;
     case Type::Vec3: return DefType::Vec3;
     case Type::Vec4: case Type::IVec4: case Type::UVec4: return DefType::Vec4;
     case Type::Int: case Type::UInt: return DefType::Int;

@@ -10,6 +10,7 @@
 #include <set>
 
 #include "interface/fragment_interface.h"
+#include "rig/packed_fields.h"
 #include "rig/rig.h"
 #include "rules/rules.h"
 #include "rules/instantiate.h"
@@ -176,6 +177,10 @@ class Builder {
   void provideFromRig() {
     for (size_t a = 0; a < rig_.attributes.size(); ++a) {
       const RigAttribute& attr = rig_.attributes[a];
+      if (!attr.fields.empty()) {
+        provideFields(static_cast<int>(a));
+        continue;
+      }
       int targets = attr.perMorphTarget ? rig_.morphTargets() : 1;
       for (int t = 0; t < targets; ++t)
         for (const auto& part : attr.provides) {
@@ -211,6 +216,46 @@ class Builder {
     }
     for (const auto& d : rules_.semantics)
       if (!d.bufferOf.empty()) provideBuffer(d);
+  }
+
+  // A bit-packed attribute (rig/packed_fields.h): its words are a fact of their own, read
+  // (its location and bytes paid once) by one unpack action per part, which costs the
+  // part's unpack arithmetic. So the search weighs the unpacking of each value it reads.
+  void provideFields(int a) {
+    const RigAttribute& attr = rig_.attributes[static_cast<size_t>(a)];
+    const std::string input = "a_" + attr.name;
+    Fact w;
+    w.name = "attribute " + input;  // not a semantic name: no rule can read it
+    w.type = attr.shaderType;
+    const int words = static_cast<int>(p_.facts.size());
+    p_.facts.push_back(w);
+    provide(words, Fact::Source::Attribute, a, -1, "", attr.shaderType, attr.loc);
+    const int item = resourceFor("attribute " + input, kLimitAttributes, 1);
+    p_.facts[words].resource = item;
+    p_.resources[item].terms[kTermLocations] = vertexInputLocations(attr.shaderType);
+    p_.resources[item].terms[kTermAttributeBytes] = formatBytes(attr.format);
+    for (const auto& part : attr.provides) {
+      const PackedField& field = attr.fields[static_cast<size_t>(part.field)];
+      const int n = part.swizzle.empty() ? formatComponents(field.format) : static_cast<int>(part.swizzle.size());
+      const std::optional<Type> have = vectorType(formatIsInteger(field.format) ? ScalarKind::UInt : ScalarKind::Float, n);
+      if (!have)
+        throw InputError(field.loc, fmt::format("attribute '{}' provides '{}' through swizzle '{}' of a {} field: {} "
+                                                "components have no supported type",
+                                                attr.name, part.semantic, part.swizzle, formatName(field.format), n));
+      const int f = factOrFail(part.semantic, field.loc, fmt::format("attribute '{}' provides", attr.name).c_str());
+      if (p_.facts[f].type != *have)
+        throw InputError(field.loc, fmt::format("'{}' is {} in the rules but the rig provides {}", part.semantic,
+                                                glslName(p_.facts[f].type), glslName(*have)));
+      const FieldUnpack u = unpackField(field, part.swizzle, factRef(words), componentCount(attr.shaderType));
+      Action act;
+      act.name = fmt::format("unpack_{}.{}", attr.name, part.semantic);
+      act.pre = {words};
+      act.add = f;
+      act.cost = act.terms[kTermArithmetic] = u.slots;
+      act.code.push_back(CodeLine{factRef(f) + " = " + u.glsl + ";", field.loc});
+      p_.actions.push_back(std::move(act));
+      unpacked_.insert(f);
+    }
   }
 
   // A `buffer_of:` semantic is provided when the rig provides every instance of what it
@@ -314,7 +359,7 @@ class Builder {
     act.cost = ruleCost(rule, shape_);
     act.terms[kTermArithmetic] = act.cost;
     for (auto& l : inst.code) act.code.push_back(CodeLine{std::move(l.text), l.loc});
-    if (p_.facts[act.add].source != Fact::Source::Computed) {
+    if (p_.facts[act.add].source != Fact::Source::Computed || unpacked_.count(act.add)) {
       p_.skippedRules.emplace_back(r, fmt::format("'{}' is provided by the rig", rule.produces));
       return;
     }
@@ -326,6 +371,7 @@ class Builder {
   RigShape shape_;
   Problem p_;
   std::map<std::string, int> index_;
+  std::set<int> unpacked_;  // facts a bit-packed attribute's field provides
 };
 
 }  // namespace

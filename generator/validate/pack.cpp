@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rig/packed_fields.h"
 #include "rig/vertex_encoding.h"
 #include "validate/program_inputs.h"
 
@@ -21,19 +22,21 @@ PackedVertices packVertices(const GenerateResult& r, const rt::Mesh& mesh) {
     out.bytes.insert(out.bytes.end(), s.data.begin(), s.data.end());
     nlohmann::json provides = nlohmann::json::array();
     for (const auto& p : a.provides) {
+      const VertexFormat format = partFormat(a, p);
       nlohmann::json part = {{"semantic", in.target >= 0 ? p.semantic + "[" + std::to_string(in.target) + "]" : p.semantic},
-                             {"components", p.swizzle.empty() ? std::string("xyzw").substr(0, formatComponents(a.format))
+                             {"components", p.swizzle.empty() ? std::string("xyzw").substr(0, formatComponents(format))
                                                               : p.swizzle}};
+      if (p.field >= 0) part["field"] = p.field;  // components of that field of `fields`
       if (const VertexEncoding* e = encodingOf(p.semantic)) {
         part["encodes"] = e->decodes();
         part["encoding"] = e->name;
         if (e->angular()) {
-          part["max_error_deg"] = *encodingMaxError(*e, a.format);
+          part["max_error_deg"] = *encodingMaxError(*e, format);
         } else if (e->perTarget) {  // scaled deltas: delta = code * scale, the target's own
-          part["max_error_of_target_scale"] = *encodingMaxError(*e, a.format);
+          part["max_error_of_target_scale"] = *encodingMaxError(*e, format);
           part["scale"] = quantized.uniforms.at(e->uniforms.at(0)).at(static_cast<size_t>(in.target));
         } else {  // bounds: source = bias + code * scale, the code as the format reads it
-          part["max_error_of_bounds_diagonal"] = *encodingMaxError(*e, a.format);
+          part["max_error_of_bounds_diagonal"] = *encodingMaxError(*e, format);
           part["bias"] = quantized.uniforms.at(e->uniforms.at(0));
           part["scale"] = quantized.uniforms.at(e->uniforms.at(1));
         }
@@ -49,6 +52,7 @@ PackedVertices packVertices(const GenerateResult& r, const rt::Mesh& mesh) {
                        {"stride", s.stride},
                        {"size", s.data.size()},
                        {"provides", std::move(provides)}});
+    if (!a.fields.empty()) streams.back()["fields"] = nlohmann::json::parse(packedFieldsJson(a));
   }
   const nlohmann::json layout = {{"rig", rig.name},
                                  {"vertex_count", out.vertexCount},

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "rig/packed_fields.h"
 #include "rig/vertex_encoding.h"
 #include "rules/instantiate.h"
 #include "validate/poses.h"
@@ -21,23 +22,38 @@ std::string partSemantic(const RigAttribute& a, const ProvidedPart& p, int targe
 
 int swizzleIndex(char c) { return c == 'x' ? 0 : c == 'y' ? 1 : c == 'z' ? 2 : 3; }
 
+// Writes a part's values from the mesh into `comps` (n components per vertex: those of the
+// attribute, or of the part's field), each at the component its swizzle names.
+void gatherPart(const RigAttribute& a, const ProvidedPart& p, int target, const rt::Mesh& mesh, int n,
+                std::vector<float>& comps) {
+  std::string sem = partSemantic(a, p, target);
+  if (!mesh.has(sem))
+    throw InputError(a.loc, fmt::format("mesh '{}' has no data for '{}' (attribute '{}')", mesh.name, sem, a.name));
+  const auto& src = mesh.at(sem);
+  std::string swz = p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(n)) : p.swizzle;
+  for (size_t v = 0; v < mesh.vertexCount; ++v)
+    for (size_t k = 0; k < swz.size(); ++k)
+      comps[v * static_cast<size_t>(n) + static_cast<size_t>(swizzleIndex(swz[k]))] = src[v][static_cast<int>(k)];
+}
+
 // Replaces, in the mesh, every value an attribute of a non-float32 format carries by the
 // value the device reads back from its stored form, so the reference sees exactly what the
 // GPU reads. A part's stream component k is the attribute's component of its swizzle's
 // k-th letter (10-10-10-2 stores w in 2 bits, x, y and z in 10).
 void quantizeStreams(const Rig& rig, rt::Mesh& m) {
   for (const auto& a : rig.attributes) {
-    if (formatIsFloat32(a.format)) continue;
-    const int n = formatComponents(a.format);
     int targets = a.perMorphTarget ? rig.morphTargets() : 1;
     for (int t = 0; t < targets; ++t)
       for (const auto& p : a.provides) {
+        const VertexFormat format = partFormat(a, p);  // a bit-packed field's own
+        if (formatIsFloat32(format)) continue;
+        const int n = formatComponents(format);
         auto it = m.streams.find(partSemantic(a, p, a.perMorphTarget ? t : -1));
         if (it == m.streams.end()) continue;
         const std::string swz = p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(n)) : p.swizzle;
         for (auto& v : it->second)
           for (size_t k = 0; k < swz.size(); ++k)
-            v[static_cast<int>(k)] = storedValue(a.format, swizzleIndex(swz[k]), v[static_cast<int>(k)]);
+            v[static_cast<int>(k)] = storedValue(format, swizzleIndex(swz[k]), v[static_cast<int>(k)]);
       }
   }
 }
@@ -56,7 +72,8 @@ WeightSets renormalisedWeights(const Rig& rig, const rt::Mesh& m) {
   for (const auto& a : rig.attributes)
     for (const auto& p : a.provides) {
       if (p.semantic.rfind("skin.weights[", 0) != 0) continue;
-      const int b = a.format == VertexFormat::Unorm8x4 ? 8 : a.format == VertexFormat::Unorm16x4 ? 16 : 0;
+      const VertexFormat format = partFormat(a, p);
+      const int b = format == VertexFormat::Unorm8x4 ? 8 : format == VertexFormat::Unorm16x4 ? 16 : 0;
       if (b == 0 || (out.bits != 0 && b != out.bits) || (!p.swizzle.empty() && p.swizzle != "xyzw")) return {};  // floats, or mixed
       out.bits = b;
       if (!m.has(p.semantic)) return {};
@@ -118,7 +135,7 @@ std::vector<StoredEncoding> storedEncodings(const Rig& rig) {
     for (const auto& p : a.provides)
       if (const VertexEncoding* e = encodingOf(p.semantic); e && e->perTarget == a.perMorphTarget)
         for (int t = a.perMorphTarget ? 0 : -1; t < (a.perMorphTarget ? rig.morphTargets() : 0); ++t)
-          out.push_back({e, a.format, t});
+          out.push_back({e, partFormat(a, p), t});
   return out;
 }
 
@@ -265,10 +282,11 @@ std::vector<InputErrorBound> errorBounds(const Rig& rig, const rt::Mesh& mesh) {
   for (const auto& s : weights.sets) weightStreams.push_back(&mesh.at(s));
   // Plain values in a format that rounds them.
   for (const auto& a : rig.attributes) {
-    const int n = formatComponents(a.format);
-    if (formatIsFloat32(a.format) || formatIsInteger(a.format)) continue;
     for (int t = 0; t < (a.perMorphTarget ? rig.morphTargets() : 1); ++t)
       for (const auto& p : a.provides) {
+        const VertexFormat format = partFormat(a, p);
+        const int n = formatComponents(format);
+        if (formatIsFloat32(format) || formatIsInteger(format)) continue;
         if (encodingOf(p.semantic)) continue;  // below
         InputErrorBound b;
         b.semantic = partSemantic(a, p, a.perMorphTarget ? t : -1);
@@ -284,7 +302,7 @@ std::vector<InputErrorBound> errorBounds(const Rig& rig, const rt::Mesh& mesh) {
           for (size_t k = 0; k < swz.size(); ++k) {
             const double xv = x[v][static_cast<int>(k)];
             b.bound[v][static_cast<int>(k)] =
-                std::isnan(sum) ? storedValueMaxError(a.format, swizzleIndex(swz[k]), xv)
+                std::isnan(sum) ? storedValueMaxError(format, swizzleIndex(swz[k]), xv)
                                 : step + std::ldexp(1.0, -24) + std::abs(xv) * std::abs(1 - 1 / sum);
           }
         }
@@ -480,19 +498,24 @@ rt::VertexStream vertexStream(const Rig& rig, const EmittedInput& in, const rt::
   s.location = static_cast<uint32_t>(in.location);
   s.format = vkFormat(a.format);
   s.stride = static_cast<uint32_t>(formatBytes(a.format));
+  s.data.resize(mesh.vertexCount * s.stride);
+  if (!a.fields.empty()) {  // bit-packed: each field's components rounded to its format, into its bits
+    for (size_t f = 0; f < a.fields.size(); ++f) {
+      const PackedField& field = a.fields[f];
+      const int fn = formatComponents(field.format);
+      std::vector<float> comps(mesh.vertexCount * static_cast<size_t>(fn), 0.0f);
+      bool any = false;
+      for (const auto& p : a.provides)
+        if (p.field == static_cast<int>(f)) gatherPart(a, p, in.target, mesh, fn, comps), any = true;
+      if (!any) continue;  // a field no value of this rig reads: its bits stay 0
+      for (size_t v = 0; v < mesh.vertexCount; ++v)
+        packField(field, comps.data() + v * static_cast<size_t>(fn), s.data.data() + v * s.stride);
+    }
+    return s;
+  }
   // Gather the parts into one flat array of n components per vertex, then encode.
   std::vector<float> comps(mesh.vertexCount * static_cast<size_t>(n), 0.0f);
-  for (const auto& p : a.provides) {
-    std::string sem = partSemantic(a, p, in.target);
-    if (!mesh.has(sem))
-      throw InputError(a.loc, fmt::format("mesh '{}' has no data for '{}' (attribute '{}')", mesh.name, sem, a.name));
-    const auto& src = mesh.at(sem);
-    std::string swz = p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(n)) : p.swizzle;
-    for (size_t v = 0; v < mesh.vertexCount; ++v)
-      for (size_t k = 0; k < swz.size(); ++k)
-        comps[v * static_cast<size_t>(n) + static_cast<size_t>(swizzleIndex(swz[k]))] = src[v][static_cast<int>(k)];
-  }
-  s.data.resize(mesh.vertexCount * s.stride);
+  for (const auto& p : a.provides) gatherPart(a, p, in.target, mesh, n, comps);
   for (size_t v = 0; v < mesh.vertexCount; ++v)
     encodeElement(a.format, comps.data() + v * static_cast<size_t>(n), s.data.data() + v * s.stride);
   return s;

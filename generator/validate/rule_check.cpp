@@ -154,7 +154,7 @@ std::string showValues(const std::vector<double>& v) {
 std::string requestShader(Type t) {
   std::string use;
   switch (t) {
-    case Type::Vec2: use = "vec4(v, 0.0, 0.0)"; break;
+    case Type::Vec2: case Type::UVec2: use = "vec4(v, 0.0, 0.0)"; break;
     case Type::Vec3: use = "vec4(v, 0.0)"; break;
     case Type::Vec4: use = "v"; break;
     case Type::Mat3: use = "vec4(v[0], 0.0)"; break;

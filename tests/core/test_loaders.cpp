@@ -290,7 +290,9 @@ TEST(RigLoader, Formats) {
                      F{"unorm10-10-10-2", sg::VertexFormat::Unorm10_10_10_2, 4, 4, false},
                      F{"snorm10-10-10-2", sg::VertexFormat::Snorm10_10_10_2, 4, 4, false},
                      F{"uint8x2", sg::VertexFormat::Uint8x2, 2, 2, true},
-                     F{"uint16x2", sg::VertexFormat::Uint16x2, 2, 4, true}}) {
+                     F{"uint16x2", sg::VertexFormat::Uint16x2, 2, 4, true},
+                     F{"uint32", sg::VertexFormat::Uint32x1, 1, 4, true},
+                     F{"uint32x2", sg::VertexFormat::Uint32x2, 2, 8, true}}) {
     sg::VertexFormat out{};
     ASSERT_TRUE(sg::parseFormat(f.name, out)) << f.name;
     EXPECT_EQ(out, f.f) << f.name;
@@ -1470,7 +1472,7 @@ TEST(Problem, AttributeTypeMismatch) {
 }
 
 TEST(Problem, IntegerAttributeSwizzleWithoutGlslType) {
-  // uint8x4 read as uvec4; "xy" would be a uvec2, which is not a type the generator has.
+  // uint8x4 read as uvec4; "xyz" would be a uvec3, which is not a type the generator has.
   // This must be a located input error, not a crash.
   const std::string rules =
       "semantics:\n"
@@ -1482,13 +1484,13 @@ TEST(Problem, IntegerAttributeSwizzleWithoutGlslType) {
       "rig: j\n"
       "attributes:\n"
       "  pos: { format: float32x3, provides: vertex.position }\n"
-      "  idx: { format: uint8x4, provides: { \"skin.joints[0]\": xy } }\n";
+      "  idx: { format: uint8x4, provides: { \"skin.joints[0]\": xyz } }\n";
   sg::Rig rig = sg::loadRigText(rigText, "j.rig.yaml");
   auto d = errorOf([&] { sg::buildProblem(rig, set, {}); });
   Pos p = posOf(rigText, "idx:");
   EXPECT_LOC(d, "j.rig.yaml", p.line, p.col);
   EXPECT_MSG(d, "skin.joints[0]");
-  EXPECT_MSG(d, "swizzle 'xy'");
+  EXPECT_MSG(d, "swizzle 'xyz'");
 }
 
 TEST(Problem, UnknownRequestedSemanticAndWhenSkipping) {

@@ -136,7 +136,7 @@ TEST_P(DawnValidation, ValidatesWithCrossCheckOnLavapipe) {
   if (std::string(frag) == "face.frag") EXPECT_GE(report.runs.size(), 4u) << formatReport(report);
   // The packed face stores encoded and quantized streams: every run is also checked against
   // the float data (docs/validation.md, "Against the float data").
-  if (std::string(rig) == "face-packed.rig.yaml")
+  if (std::string(rig) == "face-packed.rig.yaml" || std::string(rig) == "face-bitpacked.rig.yaml")
     for (const auto& run : report.runs)
       for (const auto& o : run.outputs) EXPECT_TRUE(o.floatCheck.ran && o.floatCheck.pass) << run.label << " " << o.name;
 }
@@ -144,6 +144,7 @@ TEST_P(DawnValidation, ValidatesWithCrossCheckOnLavapipe) {
 INSTANTIATE_TEST_SUITE_P(Examples, DawnValidation,
                          ::testing::Values(std::make_pair("face.rig.yaml", "face.frag"),
                                            std::make_pair("face-packed.rig.yaml", "face.frag"),  // encoded, halves, bytes
+                                           std::make_pair("face-bitpacked.rig.yaml", "face.frag"),  // the same in uint32x4 words
                                            std::make_pair("body.rig.yaml", "face.frag"),
                                            std::make_pair("face.rig.yaml", "depth.frag")));
 
