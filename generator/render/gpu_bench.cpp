@@ -12,6 +12,8 @@
 #include "analysis/cost.h"
 #include "common/glsl_compile.h"
 #include "common/input_file.h"
+#include "rig/packed_fields.h"
+#include "rig/vertex_format.h"
 #include "runtime/procedural.h"
 #include "runtime/vk_render.h"
 
@@ -58,15 +60,24 @@ GlslShader parseVertex(const std::string& text, const std::string& path, TargetE
 std::string floorShader(const GenerateResult& g, bool capture, bool allInputs) {
   std::string pos;
   int location = -1;
-  for (const auto& in : g.glsl.inputs)
-    for (const auto& part : g.in.rig.attributes[in.attribute].provides)
+  for (const auto& in : g.glsl.inputs) {
+    const RigAttribute& a = g.in.rig.attributes[in.attribute];
+    for (const auto& part : a.provides)
       // The stored position in whichever form the rig keeps it (a bounds-relative code is a
       // position too, for a floor): without it the floor would read no input at all.
       if ((part.semantic == "vertex.position" || part.semantic == "vertex.position_in_bounds") && location < 0) {
         location = in.location;
-        pos = in.name + (componentCount(in.type) > 3 ? ".xyz" : "");
-        if (componentCount(in.type) < 3) pos = "";
+        if (part.field >= 0) {  // in a bit-packed attribute's words: unpacked as the plan would
+          const PackedField& f = a.fields[static_cast<size_t>(part.field)];
+          pos = formatComponents(f.format) < 3 ? ""
+                                                : "(" + unpackField(f, part.swizzle.empty() ? "xyz" : part.swizzle, in.name,
+                                                                    componentCount(in.type)).glsl + ").xyz";
+        } else {
+          pos = in.name + (componentCount(in.type) > 3 ? ".xyz" : "");
+          if (componentCount(in.type) < 3) pos = "";
+        }
       }
+  }
   std::string text = "#version 450\n";
   for (const auto& in : g.glsl.inputs)
     if (in.location == location || allInputs)

@@ -101,10 +101,11 @@ TEST(GpuBench, AProgramThatFailsOnTheDeviceIsReportedAndNotTimed) {
 }
 
 TEST(GpuBench, FloorsReadThePositionInEitherLayoutAndArePredicted) {
-  // The pass-through floor reads the stored position, float or bounds-relative (it once read
-  // nothing for the packed face); the other floor reads every input of the generated plan.
+  // The pass-through floor reads the stored position, float, bounds-relative or unpacked from a
+  // bit-packed attribute's words (it once read nothing for the packed face, then raw words for the
+  // bit-packed one); the other floor reads every input of the generated plan.
   // Under a profile both are predicted from their amounts, at the bench mesh's vertex count.
-  for (const char* rig : {"examples/dawn/face.rig.yaml", "examples/dawn/face-packed.rig.yaml"}) {
+  for (const char* rig : {"examples/dawn/face.rig.yaml", "examples/dawn/face-packed.rig.yaml", "examples/dawn/face-bitpacked.rig.yaml"}) {
     sg::GpuBenchOptions b = quickBench(sourcePath("examples/dawn/rules.yaml"));
     b.render.gen.rigPath = sourcePath(rig);
     b.render.gen.deviceProfilePath = sourcePath("devices/nvidia-h200.yaml");
