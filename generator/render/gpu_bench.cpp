@@ -370,7 +370,6 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
         rt::Timing tm = renderer.time(req, t);
         best(p.row.rasterOnNsPerVertex, perVertex(tm.frameNs, tm.verticesPerDraw));
         best(p.row.rasterOnWallNsPerVertex, perVertex(tm.wallNs, tm.verticesPerDraw));
-        best(p.row.rasterOnCpuNsPerVertex, perVertex(tm.cpuNs, tm.verticesPerDraw));
       }
       if (opts.rasterOff) {
         rt::DrawRequest req = drawRequest(p.capture, frag, textures, scene);
@@ -379,6 +378,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
         rt::Timing tm = renderer.time(req, t);
         best(p.row.rasterOffNsPerVertex, perVertex(tm.frameNs, tm.verticesPerDraw));
         best(p.row.rasterOffWallNsPerVertex, perVertex(tm.wallNs, tm.verticesPerDraw));
+        best(p.row.rasterOffCpuNsPerVertex, perVertex(tm.cpuNs, tm.verticesPerDraw));
       }
     }
   for (const auto& p : programs) rep.rows.push_back(p.row);

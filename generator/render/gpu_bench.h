@@ -46,7 +46,7 @@ struct GpuBenchRow {
   double rasterOnNsPerVertex = -1;   // median frame / (draws x vertices); -1 = not measured
   double rasterOffNsPerVertex = -1;
   double rasterOnWallNsPerVertex = -1;   // host submit-to-fence time (see rt::Timing::wallNs)
-  double rasterOnCpuNsPerVertex = -1;    // this process's CPU time over it (rt::Timing::cpuNs): calibrate's clock on a CPU device
+  double rasterOffCpuNsPerVertex = -1;   // this process's CPU time over it, raster off (rt::Timing::cpuNs): calibrate's clock on a CPU device
   double rasterOffWallNsPerVertex = -1;
 };
 
