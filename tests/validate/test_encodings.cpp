@@ -547,10 +547,10 @@ namespace {
 
 // A rig storing the frame both ways offers the search a real choice. Instruction slots
 // charge nothing for a location, so the decode only costs: the float frame. The H200
-// profile charges 0.46 ns per location and 0.0017 ns per slot: one location saved for 22
-// slots of decode is cheaper, so the codes. Lavapipe on a 2-core CPU charges 4.3 ns per
-// location and 1.5 ns per slot: the decode would cost 34 ns to save 4, so the floats, its
-// own choice. Every plan validates on the device, and the chosen rig keeps only the
+// profile charges 0.36 ns per location and 0.0016 ns per slot: one location saved for 22
+// slots of decode is cheaper, so the codes. Lavapipe on a 2-core CPU charges 1.58 ns per
+// location and 0.66 ns per slot: the decode would cost 14.5 ns to save 1.6, so the floats,
+// its own choice. Every plan validates on the device, and the chosen rig keeps only the
 // attributes of the chosen form.
 TEST(Octahedral, TheSearchChoosesTheStoredFormPerDevice) {
   for (const std::string profile : {"", "nvidia-h200.yaml", "llvmpipe-2core.yaml"}) {
