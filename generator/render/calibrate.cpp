@@ -439,6 +439,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   // would otherwise bury the vertex stage (the Dawn face's plans on the head: ~8 us per vertex
   // raster on, bench/data/lavapipe-calibrate-busy.log).
   rep.clock = hostClock ? "process CPU time over submit-to-fence, rasterizer discarded (a CPU device)" : "GPU timestamps";
+  double GpuBenchRow::*const clock = hostClock ? &GpuBenchRow::rasterOffCpuNsPerVertex : &GpuBenchRow::rasterOnNsPerVertex;
 
   for (const auto& meshName : opts.meshes) {
     ProbeMesh m = probeMesh(meshName);
@@ -524,22 +525,14 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
         bo.frames = opts.frames;
         bo.rounds = opts.rounds;
         GpuBenchReport br = runGpuBench(bo);
-        auto measured = [&](const GpuBenchRow& row) { return hostClock ? row.rasterOffCpuNsPerVertex : row.rasterOnNsPerVertex; };
         if (!fitted) {  // the plans' predicted against measured time, by this calibration's clock
+          const PredictionCheck pc = checkPredictions(br.rows, clock);
           CalibrationCheck c;
           c.rig = rig;
           c.mesh = meshName;
-          std::vector<double> predicted, times;
-          double fastest = INFINITY;
-          for (const auto& row : br.rows)
-            if (row.hasCost && row.validation == "pass" && measured(row) > 0) {
-              ++c.plans;
-              fastest = std::min(fastest, measured(row));
-              predicted.push_back(row.predictedNsPerVertex), times.push_back(measured(row));
-            }
-          c.spearman = spearmanWithinSpread(predicted, times, 0.005);
-          if (!br.rows.empty() && br.rows.front().label == "generated" && measured(br.rows.front()) > 0)
-            c.generatedOverFastest = measured(br.rows.front()) / fastest;
+          c.plans = pc.plans;
+          c.spearman = pc.spearman;
+          c.generatedOverFastest = pc.generatedOverFastest;
           rep.checks.push_back(c);
         }
         for (const auto& row : br.rows) {
@@ -551,9 +544,9 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           s.rig = std::filesystem::path(rig).filename().string();
           s.fitted = fitted;
           s.amounts = row.amounts;
-          s.validated = row.validation == "pass" || (!row.hasCost && measured(row) > 0);
+          s.validated = row.validation == "pass" || (!row.hasCost && row.*clock > 0);
           s.failure = s.validated ? "" : row.validation;
-          s.measuredNs = !s.validated ? -1 : measured(row);
+          s.measuredNs = !s.validated ? -1 : row.*clock;
           rep.samples.push_back(std::move(s));
         }
       }

@@ -226,6 +226,22 @@ double spearmanWithinSpread(const std::vector<double>& x, const std::vector<doub
 // Two timings of one program on one device differ by up to this much (relative): docs/performance.md.
 constexpr double kRunToRunSpread = 0.005;
 
+PredictionCheck checkPredictions(const std::vector<GpuBenchRow>& rows, double GpuBenchRow::*clock) {
+  PredictionCheck c;
+  std::vector<double> predicted, measured;
+  double fastest = INFINITY;
+  for (const auto& r : rows)
+    if (r.hasCost && r.validation == "pass" && r.*clock > 0) {
+      ++c.plans;
+      fastest = std::min(fastest, r.*clock);
+      if (r.predictedNsPerVertex >= 0) predicted.push_back(r.predictedNsPerVertex), measured.push_back(r.*clock);
+    }
+  c.spearman = spearmanWithinSpread(predicted, measured, kRunToRunSpread);
+  if (!rows.empty() && rows.front().label == "generated" && rows.front().*clock > 0 && !predicted.empty())
+    c.generatedOverFastest = rows.front().*clock / fastest;
+  return c;
+}
+
 GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   const TargetEnv env = opts.render.gen.targetEnv;
   // Every program is validated on the device that times it, which is opened first: a named
@@ -396,16 +412,9 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   rep.spearmanOn = spearman(cost, on);
   rep.pearsonOff = pearson(cost, off);
   rep.spearmanOff = spearman(cost, off);
-  std::vector<double> predicted, measured;
-  double fastest = INFINITY;
-  for (const auto& r : rep.rows)
-    if (r.hasCost && r.validation == "pass" && r.rasterOnNsPerVertex > 0) {
-      fastest = std::min(fastest, r.rasterOnNsPerVertex);
-      if (r.predictedNsPerVertex >= 0) predicted.push_back(r.predictedNsPerVertex), measured.push_back(r.rasterOnNsPerVertex);
-    }
-  rep.spearmanPredictedOn = spearmanWithinSpread(predicted, measured, kRunToRunSpread);
-  if (!rep.rows.empty() && rep.rows.front().label == "generated" && rep.rows.front().rasterOnNsPerVertex > 0 && predicted.size())
-    rep.generatedOverFastestOn = rep.rows.front().rasterOnNsPerVertex / fastest;
+  const PredictionCheck predictedOn = checkPredictions(rep.rows, &GpuBenchRow::rasterOnNsPerVertex);
+  rep.spearmanPredictedOn = predictedOn.spearman;
+  rep.generatedOverFastestOn = predictedOn.generatedOverFastest;
   const auto& msgs = validator.harness().validationMessages();
   if (!msgs.empty()) throw std::runtime_error("validation layer: " + msgs.front());
   return rep;

@@ -69,6 +69,18 @@ struct GpuBenchReport {
 
 GpuBenchReport runGpuBench(const GpuBenchOptions& opts);
 
+// Predicted against measured time by one clock (`clock`: &GpuBenchRow::rasterOnNsPerVertex,
+// ...), over the rows with a plan cost that passed validation and were timed by it: how many,
+// their Spearman within the run-to-run spread (rows with a prediction), and the generated
+// program's time over the fastest's (NaN without predictions). Bench reports it for raster
+// on, calibrate for its own clock.
+struct PredictionCheck {
+  size_t plans = 0;
+  double spearman = NAN;
+  double generatedOverFastest = NAN;
+};
+PredictionCheck checkPredictions(const std::vector<GpuBenchRow>& rows, double GpuBenchRow::*clock);
+
 // Markdown table + summary lines.
 std::string formatGpuBench(const GpuBenchReport& report);
 

@@ -28,6 +28,36 @@ TEST(GpuBench, CorrelationsMatchHandComputedValues) {
   EXPECT_TRUE(std::isnan(sg::pearson({1, 1, 1}, {1, 2, 3})));  // no variance
 }
 
+TEST(GpuBench, PredictionsAreCheckedByTheClockAsked) {
+  // Three plans (the generated one first), a floor, a plan that failed validation and one not
+  // timed by the second clock; each clock sees only the plans it timed that passed.
+  auto row = [](const char* label, bool cost, const char* validation, double predicted, double on, double cpu) {
+    sg::GpuBenchRow r;
+    r.label = label;
+    r.hasCost = cost;
+    r.validation = validation;
+    r.predictedNsPerVertex = predicted;
+    r.rasterOnNsPerVertex = on;
+    r.rasterOffCpuNsPerVertex = cpu;
+    return r;
+  };
+  const std::vector<sg::GpuBenchRow> rows = {
+      row("generated", true, "pass", 1.5, 2.0, 1.0), row("a", true, "pass", 1.0, 1.0, 2.0),
+      row("b", true, "pass", 3.0, 3.0, 3.0),         row("floor", false, "", 0.1, 0.1, 0.1),
+      row("failed", true, "FAIL: x", 0.1, 0.1, 0.1), row("c", true, "pass", 9.0, 9.0, -1)};
+  // Raster on: predictions rank like the times (1, 2, 3, 9); the generated takes 2 / 1.
+  const sg::PredictionCheck on = sg::checkPredictions(rows, &sg::GpuBenchRow::rasterOnNsPerVertex);
+  EXPECT_EQ(on.plans, 4u);
+  EXPECT_DOUBLE_EQ(on.spearman, 1.0);
+  EXPECT_DOUBLE_EQ(on.generatedOverFastest, 2.0);
+  // CPU time (c untimed): predicted ranks (1, 0, 2) against measured (0, 1, 2): Pearson of
+  // the ranks = 1 / 2 by hand; the generated program is the fastest.
+  const sg::PredictionCheck cpu = sg::checkPredictions(rows, &sg::GpuBenchRow::rasterOffCpuNsPerVertex);
+  EXPECT_EQ(cpu.plans, 3u);
+  EXPECT_NEAR(cpu.spearman, 0.5, 1e-12);
+  EXPECT_DOUBLE_EQ(cpu.generatedOverFastest, 1.0);
+}
+
 TEST(GpuBench, CaptureQualifiersGoOnEveryOutputAndUnknownOutputsAreErrors) {
   sg::EmittedGlsl capture;
   capture.captureStride = 32;
