@@ -8,8 +8,8 @@
 option(SHADERGEN_SANITIZE "Build everything with AddressSanitizer and UndefinedBehaviorSanitizer" OFF)
 option(SHADERGEN_FUZZ "Build the libFuzzer targets (tests/fuzz; needs Clang)" OFF)
 
-set(SHADERGEN_SANITIZER_FLAGS
-  -fsanitize=address,undefined -fno-sanitize=vptr -fno-sanitize-recover=all -fno-omit-frame-pointer)
+# The instrumentation (tests/CMakeLists.txt leaves it off the tests' own code).
+set(SHADERGEN_SANITIZER_FLAGS -fsanitize=address,undefined -fno-sanitize=vptr -fno-sanitize-recover=all)
 if(SHADERGEN_FUZZ)
   if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
     message(FATAL_ERROR "SHADERGEN_FUZZ needs Clang (libFuzzer): configure with -DCMAKE_CXX_COMPILER=clang++-14")
@@ -20,7 +20,7 @@ endif()
 if(SHADERGEN_SANITIZE OR SHADERGEN_FUZZ)
   # -O1 with line tables: readable stacks, and a build that fits the CI budget on two cores.
   # _GLIBCXX_ASSERTIONS: bounds-checked operator[] on the standard containers as well.
-  add_compile_options(${SHADERGEN_SANITIZER_FLAGS} -O1 $<IF:$<CXX_COMPILER_ID:Clang>,-gline-tables-only,-g1>
+  add_compile_options(${SHADERGEN_SANITIZER_FLAGS} -fno-omit-frame-pointer -O1 $<IF:$<CXX_COMPILER_ID:Clang>,-gline-tables-only,-g1>
                       -D_GLIBCXX_ASSERTIONS)
   add_link_options(-fsanitize=address,undefined)
 endif()
