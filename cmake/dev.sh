@@ -46,6 +46,20 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
+# The suite's outside implementations (three.js, the Khronos glTF-Validator) are npm packages
+# pinned by tests/js/package-lock.json; Node.js comes from Debian where the machine has none.
+if [ "$what" = test ] || [ "$what" = plain ] || [ "$what" = build ] || [ "$what" = sanitize ]; then
+  if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+    sudo=""; [ "$(id -u)" -eq 0 ] || sudo="sudo"
+    $sudo apt-get update -q
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends nodejs npm
+  fi
+  # npm ci once per lockfile: the stamp is the lockfile it installed.
+  if ! cmp -s tests/js/package-lock.json tests/js/node_modules/.sg-installed-lock 2>/dev/null; then
+    (cd tests/js && npm ci --no-audit --no-fund --loglevel=error && cp package-lock.json node_modules/.sg-installed-lock)
+  fi
+fi
+
 # The Vulkan loader wants a runtime dir; lavapipe needs nothing else.
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/shadergen-xdg}
 mkdir -p "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
