@@ -105,15 +105,7 @@ TermWeights profileWeights(const DeviceProfile& profile) {
 
 void applyDeviceProfile(Problem& p, const DeviceProfile& profile) { priceProblem(p, profileWeights(profile)); }
 
-TermAmounts planTermAmounts(const Plan& plan, const Problem& p) {
-  TermAmounts a = p.fixedTerms;
-  auto add = [&](const TermAmounts& x) {
-    for (int t = 0; t < kTermCount; ++t) a[static_cast<size_t>(t)] += x[static_cast<size_t>(t)];
-  };
-  for (int act : plan.actions) add(p.actions[static_cast<size_t>(act)].terms);
-  for (int r : itemsRead(p, plan.actions)) add(p.resources[static_cast<size_t>(r)].terms);
-  return a;
-}
+TermAmounts planTermAmounts(const Plan& plan, const Problem& p) { return planAmounts(p, plan.actions); }
 
 PlanCostPrediction predictPlanCost(const Plan& plan, const Problem& p, const DeviceProfile& profile) {
   PlanCostPrediction out;

@@ -203,6 +203,33 @@ std::optional<Plan> integerProgramSearch(const Problem& p, SearchStats* stats, c
         }
     }
   }
+  // A roofline objective (Problem::componentWeights): minimise an auxiliary T with one row
+  // per component, T - (its actions' and items' sums) >= its fixed part; the x and z columns
+  // then cost nothing themselves.
+  if (!p.componentWeights.empty()) {
+    const int t = ++cols;
+    glp_add_cols(P, 1);
+    glp_set_col_kind(P, t, GLP_CV);
+    glp_set_col_bnds(P, t, GLP_LO, 0, 0);
+    glp_set_obj_coef(P, t, 1);
+    for (int c = 1; c < t; ++c) glp_set_obj_coef(P, c, 0);
+    for (const TermWeights& w : p.componentWeights) {
+      glp_add_rows(P, 1);
+      glp_set_row_bnds(P, ++rows, GLP_LO, static_cast<double>(weighTerms(w, p.fixedTerms)), 0);
+      auto put = [&](int col, const TermAmounts& terms) {
+        const int64_t c = weighTerms(w, terms);
+        if (!col || !c) return;
+        ia.push_back(rows);
+        ja.push_back(col);
+        ar.push_back(-static_cast<double>(c));
+      };
+      for (size_t i = 0; i < acts.size(); ++i) put(static_cast<int>(i) + 1, p.actions[acts[i]].terms);
+      for (size_t r = 0; r < p.resources.size(); ++r) put(zCol[r], p.resources[r].terms);
+      ia.push_back(rows);
+      ja.push_back(t);
+      ar.push_back(1);
+    }
+  }
   glp_load_matrix(P, static_cast<int>(ia.size()) - 1, ia.data(), ja.data(), ar.data());
 
   glp_iocp parm;

@@ -38,6 +38,8 @@ Plan tidyPlan(const Problem& p, const std::vector<int>& actions) {
   // Inputs are paid once per plan however many rules read them (zero without a profile).
   for (int r : itemsRead(p, plan.actions)) plan.cost += p.resources[r].cost;
   plan.cost += p.fixedCost;
+  // A roofline objective is not a sum of the actions' costs: the largest component.
+  if (!p.componentWeights.empty()) plan.cost = weighPlan(p, planAmounts(p, plan.actions));
   return plan;
 }
 

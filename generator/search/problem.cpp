@@ -8,6 +8,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <stdexcept>
 
 #include "interface/fragment_interface.h"
 #include "rig/packed_fields.h"
@@ -59,7 +60,9 @@ Problem inputsAsFacts(const Problem& p) {
     if (p.resources[r].cost <= 0) continue;
     if (passThrough[r]) {  // read by every plan
       q.fixedCost += p.resources[r].cost;
+      for (size_t t = 0; t < kTermCount; ++t) q.fixedTerms[t] += p.resources[r].terms[t];
       q.resources[r].cost = 0;
+      q.resources[r].terms = {};
       continue;
     }
     factOf[r] = static_cast<int>(q.facts.size());
@@ -70,8 +73,10 @@ Problem inputsAsFacts(const Problem& p) {
     a.name = f.name;
     a.add = factOf[r];
     a.cost = p.resources[r].cost;
+    a.terms = p.resources[r].terms;
     q.actions.push_back(std::move(a));
     q.resources[r].cost = 0;  // paid by its action now
+    q.resources[r].terms = {};
   }
   for (size_t a = 0; a < p.actions.size(); ++a) {
     std::vector<int>& pre = q.actions[a].pre;
@@ -424,9 +429,47 @@ std::vector<int64_t> resourceUsage(const Problem& p, const std::vector<int>& act
 
 void priceProblem(Problem& p, const TermWeights& w) {
   p.weights = w;
+  p.componentWeights.clear();
   for (auto& a : p.actions) a.cost = weighTerms(w, a.terms);
   for (auto& r : p.resources) r.cost = weighTerms(w, r.terms);
   p.fixedCost = weighTerms(w, p.fixedTerms);
+}
+
+void priceProblemByMax(Problem& p, const std::vector<TermWeights>& components) {
+  if (components.empty()) throw std::invalid_argument("priceProblemByMax: no components");
+  if (components.size() == 1) return priceProblem(p, components[0]);
+  auto largest = [&](const TermAmounts& a) {
+    int64_t m = 0;
+    for (const TermWeights& w : components) m = std::max(m, weighTerms(w, a));
+    return m;
+  };
+  p.weights = components[0];
+  p.componentWeights = components;
+  for (auto& a : p.actions) a.cost = largest(a.terms);
+  for (auto& r : p.resources) r.cost = largest(r.terms);
+  p.fixedCost = largest(p.fixedTerms);
+}
+
+TermAmounts planAmounts(const Problem& p, const std::vector<int>& actions) {
+  TermAmounts a = p.fixedTerms;
+  auto add = [&](const TermAmounts& x) {
+    for (size_t t = 0; t < kTermCount; ++t) a[t] += x[t];
+  };
+  for (int act : actions) add(p.actions[static_cast<size_t>(act)].terms);
+  for (int r : itemsRead(p, actions)) add(p.resources[static_cast<size_t>(r)].terms);
+  return a;
+}
+
+std::vector<int64_t> componentCosts(const Problem& p, const TermAmounts& amounts) {
+  if (p.componentWeights.empty()) return {weighTerms(p.weights, amounts)};
+  std::vector<int64_t> out;
+  for (const TermWeights& w : p.componentWeights) out.push_back(weighTerms(w, amounts));
+  return out;
+}
+
+int64_t weighPlan(const Problem& p, const TermAmounts& amounts) {
+  const std::vector<int64_t> c = componentCosts(p, amounts);
+  return *std::max_element(c.begin(), c.end());
 }
 
 bool hasItemCosts(const Problem& p) {

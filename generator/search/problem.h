@@ -142,6 +142,12 @@ struct Problem {
   TermWeights weights = kSlotWeights;
   TermAmounts fixedTerms{};
   int64_t fixedCost = 0;
+  // A roofline objective (docs/search.md, "Roofline objectives"): when not empty, a plan
+  // costs the LARGEST of these weighted sums of its term amounts (one per pipe a device
+  // overlaps, or per device of a portable choice), each summed as `weights` is (rules, the
+  // inputs read once, fixed terms). Then Action::cost and the items' costs are the largest
+  // component (for reports); the engines search the components. Empty: the one sum.
+  std::vector<TermWeights> componentWeights;
 
   int findFact(const std::string& name) const;  // -1 if absent
 };
@@ -168,6 +174,15 @@ std::vector<int64_t> resourceUsage(const Problem& p, const std::vector<int>& act
 // Prices actions, items and the fixed terms with `w` (costs = weighTerms of their terms).
 // With kSlotWeights every cost is what it was without a cost model: the rules' slots.
 void priceProblem(Problem& p, const TermWeights& w);
+// A roofline objective: a plan costs max over `components` of its amounts' weighted sum
+// (Problem::componentWeights). One component is priceProblem; none is refused.
+void priceProblemByMax(Problem& p, const std::vector<TermWeights>& components);
+// What a set of actions pays per term: their terms, each input read once, the fixed terms.
+TermAmounts planAmounts(const Problem& p, const std::vector<int>& actions);
+// The cost of a plan with these amounts (the largest component, or the one sum); and each
+// component's sum (one entry without components).
+int64_t weighPlan(const Problem& p, const TermAmounts& amounts);
+std::vector<int64_t> componentCosts(const Problem& p, const TermAmounts& amounts);
 // Whether some resource item has a cost (the search must then track the items a plan reads).
 bool hasItemCosts(const Problem& p);
 // The A* engines' view of priced inputs (docs/search.md, "Device profiles"): every rig

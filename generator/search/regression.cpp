@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <memory>
 #include <queue>
 #include <stdexcept>
 #include <unordered_set>
@@ -303,6 +304,59 @@ class OpenSetHeuristic {
   std::vector<char> zone_, before_;
 };
 
+// Device limits during a regression search (docs/search.md, "Resource limits"): the items a
+// partial plan reads live in its state words after the open set, its usage per limit beside.
+class LimitTracker {
+ public:
+  LimitTracker(const Problem& p, const RankedTask& t)
+      : p_(p), t_(t), OW(static_cast<size_t>(t.words)), L(t.itemWords ? p.limits.size() : 0),
+        extra_(static_cast<size_t>(t.itemWords)) {}
+  // Reads `items` into the state words at `s` (resource part) and `use`; false if a limit breaks.
+  bool read(uint64_t* s, int64_t* use, const int* begin, const int* end) const {
+    if (!L) return true;
+    for (const int* it = begin; it != end; ++it) {
+      uint64_t& w = s[OW + (static_cast<size_t>(*it) >> 6)];
+      const uint64_t bit = uint64_t{1} << (*it & 63);
+      if (w & bit) continue;
+      w |= bit;
+      const ResourceItem& item = p_.resources[*it];
+      if (static_cast<size_t>(item.limit) >= L) continue;
+      use[item.limit] += item.amount;
+      if (use[item.limit] > p_.limits[item.limit].max) return false;
+    }
+    return true;
+  }
+  // Whether the items every completion must still read (the open facts' resource
+  // landmarks) fit next to those already read.
+  bool landmarksFit(const uint64_t* s, const int64_t* use) {
+    if (!L) return true;
+    const size_t IW = static_cast<size_t>(t_.itemWords);
+    std::fill(extra_.begin(), extra_.end(), 0);
+    forEachBit(s, t_.words, [&](int r) {
+      for (size_t w = 0; w < IW; ++w) extra_[w] |= t_.itemLandmarks[static_cast<size_t>(r) * IW + w];
+    });
+    std::vector<int64_t> more(use, use + L);
+    for (size_t w = 0; w < IW; ++w) extra_[w] &= ~s[OW + w];
+    bool fits = true;
+    forEachBit(extra_.data(), t_.itemWords, [&](int i) {
+      const ResourceItem& item = p_.resources[i];
+      if (static_cast<size_t>(item.limit) < L && (more[item.limit] += item.amount) > p_.limits[item.limit].max)
+        fits = false;
+    });
+    return fits;
+  }
+
+ private:
+  const Problem& p_;
+  const RankedTask& t_;
+
+ public:
+  const size_t OW, L;  // open-set words; limits tracked (0: none can bind)
+
+ private:
+  std::vector<uint64_t> extra_;
+};
+
 struct RegressionNode {
   int64_t g;
   int64_t h;
@@ -321,6 +375,153 @@ struct RegressionOpenEntry {
     return seq < o.seq;            // then newest: dives, deterministic
   }
 };
+
+// A* over the same open sets when a plan costs the largest of K sums (Problem::componentWeights,
+// docs/search.md "Roofline objectives"). A label carries one g per component; its estimate is
+// max over k of (g_k + h_k), each h_k the chosen heuristic on a task priced by component k,
+// which bounds the rest of that sum, so the estimate bounds every completion and the first
+// goal label taken is optimal. Costs no longer add up to a scalar, so a state keeps every label
+// whose g vector no other label of that state undercuts in every component (dominance): a
+// dominated label's completions all cost at least as much as the dominating label's.
+std::optional<Plan> searchLargestComponent(const Problem& p, const RankedTask& t, OpenSetHeuristic::Kind kind,
+                                           SearchStats& st, SearchBudget& budget) {
+  const size_t K = p.componentWeights.size();
+  // Ranks depend on the rule graph alone, so each component's task has the same ranks and
+  // open sets; only its costs (and so the order of a rank's achievers) differ.
+  std::vector<RankedTask> tasks;
+  tasks.reserve(K);
+  for (const TermWeights& w : p.componentWeights) {
+    Problem q = p;
+    priceProblem(q, w);
+    tasks.push_back(rankTask(q));
+  }
+  std::vector<std::unique_ptr<OpenSetHeuristic>> hs;
+  for (const RankedTask& tk : tasks) hs.push_back(std::make_unique<OpenSetHeuristic>(tk, kind));
+  std::vector<int64_t> opCost(t.ops.size() * K), fixed(K);
+  for (size_t o = 0; o < t.ops.size(); ++o)
+    for (size_t k = 0; k < K; ++k)
+      opCost[o * K + k] = weighTerms(p.componentWeights[k], p.actions[static_cast<size_t>(t.ops[o].action)].terms);
+  for (size_t k = 0; k < K; ++k) fixed[k] = weighTerms(p.componentWeights[k], p.fixedTerms);
+
+  const size_t OW = static_cast<size_t>(t.words), W = OW + static_cast<size_t>(t.itemWords);
+  const size_t L = t.itemWords ? p.limits.size() : 0;
+  struct Label {
+    int parent, op;
+    int nextSame;  // the next label of the same state (-1: none)
+    bool closed, dominated;
+  };
+  std::vector<Label> labels;
+  std::vector<uint64_t> states;  // W words per label
+  std::vector<int64_t> g, h, usage;  // K, K and L per label
+  auto stateOf = [&](int i) { return states.data() + static_cast<size_t>(i) * W; };
+  auto hashOf = [&](int i) {
+    uint64_t x = 1469598103934665603ull;
+    const uint64_t* s = stateOf(i);
+    for (size_t w = 0; w < W; ++w) x = (x ^ s[w]) * 1099511628211ull;
+    return static_cast<size_t>(x ^ (x >> 29));
+  };
+  auto same = [&](int a, int b) { return std::equal(stateOf(a), stateOf(a) + W, stateOf(b)); };
+  std::unordered_set<int, decltype(hashOf), decltype(same)> index(1024, hashOf, same);  // first label per state
+  std::priority_queue<RegressionOpenEntry, std::vector<RegressionOpenEntry>, std::greater<>> open;
+  auto f = [&](const int64_t* gl, const int64_t* hl) {
+    int64_t m = 0;
+    for (size_t k = 0; k < K; ++k) m = std::max(m, gl[k] + hl[k]);
+    return m;
+  };
+  auto largest = [&](const int64_t* gl) { return *std::max_element(gl, gl + K); };
+  auto estimate = [&](const uint64_t* s, int64_t* out) {
+    timed(st.heuristicSeconds, [&] {
+      for (size_t k = 0; k < K; ++k) out[k] = hs[k]->estimate(s);
+      return 0;
+    });
+  };
+
+  states.assign(W, 0);
+  for (int goal : t.goals) states[static_cast<size_t>(goal) >> 6] |= uint64_t{1} << (goal & 63);
+  usage.assign(L, 0);
+  LimitTracker lim(p, t);
+  if (!lim.read(states.data(), usage.data(), t.goalItems.data(), t.goalItems.data() + t.goalItems.size()))
+    return std::nullopt;
+  g = fixed;
+  h.resize(K);
+  estimate(stateOf(0), h.data());
+  st.initialH = f(g.data(), h.data());
+  labels.push_back(Label{-1, -1, -1, false, false});
+  index.insert(0);
+  int64_t seq = 0;
+  open.push(RegressionOpenEntry{st.initialH, largest(g.data()), seq++, 0});
+  std::vector<uint64_t> child(W);
+  std::vector<int64_t> childUse(L), cg(K), ch(K);
+
+  while (!open.empty()) {
+    RegressionOpenEntry e = open.top();
+    open.pop();
+    Label& taken = labels[static_cast<size_t>(e.node)];
+    if (taken.closed || taken.dominated) continue;
+    taken.closed = true;
+    const int top = topOf(stateOf(e.node), t.words);
+    if (top < 0) {
+      std::vector<int> order;
+      for (int i = e.node; labels[static_cast<size_t>(i)].op >= 0; i = labels[static_cast<size_t>(i)].parent)
+        order.push_back(t.ops[static_cast<size_t>(labels[static_cast<size_t>(i)].op)].action);
+      return tidyPlan(p, order);
+    }
+    budget.onExpansion(++st.expanded);
+    for (int o = t.achBegin[top]; o < t.achBegin[top + 1]; ++o) {
+      const auto& op = t.ops[static_cast<size_t>(o)];
+      std::copy(stateOf(e.node), stateOf(e.node) + W, child.begin());
+      child[static_cast<size_t>(top) >> 6] &= ~(uint64_t{1} << (top & 63));
+      for (int i = op.preBegin; i < op.preEnd; ++i)
+        child[static_cast<size_t>(t.pre[i]) >> 6] |= uint64_t{1} << (t.pre[i] & 63);
+      std::copy(usage.begin() + static_cast<long>(static_cast<size_t>(e.node) * L),
+                usage.begin() + static_cast<long>((static_cast<size_t>(e.node) + 1) * L), childUse.begin());
+      if (!lim.read(child.data(), childUse.data(), t.items.data() + op.itemBegin, t.items.data() + op.itemEnd)) continue;
+      if (!lim.landmarksFit(child.data(), childUse.data())) continue;
+      for (size_t k = 0; k < K; ++k) cg[k] = g[static_cast<size_t>(e.node) * K + k] + opCost[static_cast<size_t>(o) * K + k];
+      ++st.generated;
+      budget.checkTime(st.expanded);
+      const int id = static_cast<int>(labels.size());
+      states.insert(states.end(), child.begin(), child.end());
+      auto it = index.find(id);
+      int first = it == index.end() ? -1 : *it;
+      bool undercut = false;
+      for (int j = first; j >= 0 && !undercut; j = labels[static_cast<size_t>(j)].nextSame) {
+        const int64_t* gj = &g[static_cast<size_t>(j) * K];
+        undercut = !labels[static_cast<size_t>(j)].dominated &&
+                   std::equal(gj, gj + K, cg.begin(), [](int64_t a, int64_t b) { return a <= b; });
+      }
+      if (undercut) {
+        states.resize(states.size() - W);
+        continue;
+      }
+      for (int j = first; j >= 0; j = labels[static_cast<size_t>(j)].nextSame) {
+        const int64_t* gj = &g[static_cast<size_t>(j) * K];
+        if (std::equal(cg.begin(), cg.end(), gj, [](int64_t a, int64_t b) { return a <= b; }))
+          labels[static_cast<size_t>(j)].dominated = true;
+      }
+      // Pathmax per component, as in the one-sum search.
+      estimate(stateOf(id), ch.data());
+      for (size_t k = 0; k < K; ++k)
+        ch[k] = std::max(ch[k], h[static_cast<size_t>(e.node) * K + k] - opCost[static_cast<size_t>(o) * K + k]);
+      labels.push_back(Label{e.node, o, -1, false, false});
+      if (first >= 0) {  // append to the state's chain
+        int j = first;
+        while (labels[static_cast<size_t>(j)].nextSame >= 0) j = labels[static_cast<size_t>(j)].nextSame;
+        labels[static_cast<size_t>(j)].nextSame = id;
+      } else {
+        index.insert(id);
+      }
+      g.insert(g.end(), cg.begin(), cg.end());
+      h.insert(h.end(), ch.begin(), ch.end());
+      usage.insert(usage.end(), childUse.begin(), childUse.end());
+      open.push(RegressionOpenEntry{f(cg.data(), ch.data()), largest(cg.data()), seq++, id});
+    }
+    st.peakBytes = std::max<int64_t>(st.peakBytes, static_cast<int64_t>(states.capacity() * sizeof(uint64_t) +
+                                                                       labels.capacity() * sizeof(Label) +
+                                                                       (g.capacity() + h.capacity()) * sizeof(int64_t)));
+  }
+  return std::nullopt;
+}
 
 }  // namespace
 
@@ -377,47 +578,20 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
     return plan;
   };
   if (t.unsolvable) return finish(std::nullopt);
+  if (!p.componentWeights.empty()) {
+    std::optional<Plan> plan = searchLargestComponent(p, t, kind, st, budget);
+    st.finalCost = plan ? plan->cost : -1;
+    st.totalSeconds = budget.seconds();
+    return plan;
+  }
 
   OpenSetHeuristic h(t, kind);
   auto estimate = [&](const uint64_t* s) { return timed(st.heuristicSeconds, [&] { return h.estimate(s); }); };
   states.assign(W, 0);
   for (int g : t.goals) states[static_cast<size_t>(g) >> 6] |= uint64_t{1} << (g & 63);
   usage.assign(L, 0);
-  // Reads `items` into the state words at `s` (resource part) and `use`; false if a limit breaks.
-  auto readItems = [&](uint64_t* s, int64_t* use, const int* begin, const int* end) {
-    if (!L) return true;
-    for (const int* it = begin; it != end; ++it) {
-      uint64_t& w = s[OW + (static_cast<size_t>(*it) >> 6)];
-      const uint64_t bit = uint64_t{1} << (*it & 63);
-      if (w & bit) continue;
-      w |= bit;
-      const ResourceItem& item = p.resources[*it];
-      if (static_cast<size_t>(item.limit) >= L) continue;
-      use[item.limit] += item.amount;
-      if (use[item.limit] > p.limits[item.limit].max) return false;
-    }
-    return true;
-  };
-  // Whether the items every completion must still read (the open facts' resource
-  // landmarks) fit next to those already read.
-  std::vector<uint64_t> extra(static_cast<size_t>(t.itemWords));
-  auto landmarksFit = [&](const uint64_t* s, const int64_t* use) {
-    const size_t IW = static_cast<size_t>(t.itemWords);
-    std::fill(extra.begin(), extra.end(), 0);
-    forEachBit(s, t.words, [&](int r) {
-      for (size_t w = 0; w < IW; ++w) extra[w] |= t.itemLandmarks[static_cast<size_t>(r) * IW + w];
-    });
-    std::vector<int64_t> more(use, use + L);
-    for (size_t w = 0; w < IW; ++w) extra[w] &= ~s[OW + w];
-    bool fits = true;
-    forEachBit(extra.data(), t.itemWords, [&](int i) {
-      const ResourceItem& item = p.resources[i];
-      if (static_cast<size_t>(item.limit) < L && (more[item.limit] += item.amount) > p.limits[item.limit].max)
-        fits = false;
-    });
-    return fits;
-  };
-  if (!readItems(states.data(), usage.data(), t.goalItems.data(), t.goalItems.data() + t.goalItems.size()))
+  LimitTracker lim(p, t);
+  if (!lim.read(states.data(), usage.data(), t.goalItems.data(), t.goalItems.data() + t.goalItems.size()))
     return finish(std::nullopt);  // the pass-through inputs alone break a limit
   const int64_t g0 = p.fixedCost;  // what every plan pays (a device profile's fixed terms)
   int64_t h0 = estimate(stateOf(0));
@@ -451,9 +625,9 @@ std::optional<Plan> regressionSearch(const Problem& p, const std::string& heuris
         child[static_cast<size_t>(t.pre[i]) >> 6] |= uint64_t{1} << (t.pre[i] & 63);
       std::copy(usage.begin() + static_cast<long>(e.node * L), usage.begin() + static_cast<long>((e.node + 1) * L),
                 childUse.begin());
-      if (!readItems(child.data(), childUse.data(), t.items.data() + op.itemBegin, t.items.data() + op.itemEnd))
+      if (!lim.read(child.data(), childUse.data(), t.items.data() + op.itemBegin, t.items.data() + op.itemEnd))
         continue;  // over a device limit: no completion of this partial plan is feasible
-      if (L && !landmarksFit(child.data(), childUse.data())) continue;
+      if (!lim.landmarksFit(child.data(), childUse.data())) continue;
       const int64_t ng = g + op.cost;
       ++st.generated;
       budget.checkTime(st.expanded);

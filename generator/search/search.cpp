@@ -16,6 +16,9 @@ std::optional<Plan> findPlan(const Problem& p, const SearchOptions& opts, Search
   if (e == "regression" || (e == "auto" && regressionApplies(p)))
     return regressionSearch(p, opts.heuristic, stats, opts.limits);
   if (e != "auto" && e != "forward") throw std::invalid_argument("unknown search engine '" + e + "'");
+  // A roofline objective is not additive: the forward engine's g cannot carry it, so a
+  // cyclic rule graph (or an explicit forward request) is solved by the integer program.
+  if (!p.componentWeights.empty()) return integerProgramSearch(p, stats, opts.limits);
   // Priced inputs (a device profile) are searched as facts, so each is paid once.
   if (hasItemCosts(p)) {
     const Problem q = inputsAsFacts(p);

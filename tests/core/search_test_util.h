@@ -56,6 +56,19 @@ inline ::testing::AssertionResult planIsValid(const Problem& p, const Plan& plan
     if (p.facts[g].resource >= 0) items.insert(p.facts[g].resource);
   for (int r : items) sum += p.resources[r].cost;
   sum += p.fixedCost;
+  if (!p.componentWeights.empty()) {  // a roofline: the largest component of the amounts
+    TermAmounts amounts = p.fixedTerms;
+    for (int ai : plan.actions)
+      for (size_t t = 0; t < kTermCount; ++t) amounts[t] += p.actions[ai].terms[t];
+    for (int r : items)
+      for (size_t t = 0; t < kTermCount; ++t) amounts[t] += p.resources[r].terms[t];
+    sum = 0;
+    for (const TermWeights& w : p.componentWeights) {
+      int64_t c = 0;
+      for (size_t t = 0; t < kTermCount; ++t) c += w[t] * amounts[t];
+      sum = std::max(sum, c);
+    }
+  }
   if (sum != plan.cost)
     return ::testing::AssertionFailure() << "plan.cost " << plan.cost << " != sum of action and input costs " << sum;
   return ::testing::AssertionSuccess();
