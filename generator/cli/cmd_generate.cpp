@@ -50,10 +50,11 @@ void GenerateArgs::add(CLI::App& cmd) {
                  "maxStorageBufferRange (2^27 bytes) at that count are not used, and a device profile's per-draw "
                  "weights are spread over that many (default: unknown, all allowed; the profile's vertices_per_draw)")
       ->check(CLI::Range(int64_t{0}, int64_t{1} << 32));
-  cmd.add_option("--device-profile", opts.deviceProfilePath,
+  cmd.add_option("--device-profile", profiles,
                  "Device profile (YAML, docs/device-profiles.md): weights in ns per vertex of arithmetic, vertex "
                  "input locations, bytes fetched, buffer and indexed uniform loads, outputs. The plan becomes the "
-                 "cheapest in predicted time on that device (default: instruction slots)");
+                 "cheapest in predicted time on that device (default: instruction slots). Given several times: the "
+                 "plan with the least worst-case regret across the devices (a portable plan)");
   cmd.add_option("--target-env", targetEnv, "vulkan1.0 (default), vulkan1.1, vulkan1.2, vulkan1.3")
       ->check(CLI::IsMember({"vulkan", "vulkan1.0", "vulkan1.1", "vulkan1.2", "vulkan1.3"}));
   cmd.add_option("--templates", opts.templateDir, "Directory with vertex.glsl templates");
@@ -69,6 +70,10 @@ void GenerateArgs::add(CLI::App& cmd) {
 GenerateOptions GenerateArgs::resolve() const {
   GenerateOptions o = opts;
   parseTargetEnv(targetEnv, o.targetEnv);
+  if (!profiles.empty()) {
+    o.deviceProfilePath = profiles.front();
+    o.portableProfilePaths.assign(profiles.begin() + 1, profiles.end());
+  }
   for (const auto& m : maps) {
     auto eq = m.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == m.size())
@@ -220,6 +225,12 @@ struct GenerateCommand {
                              r.plan.actions.size(), r.stats.expanded, o.heuristic);
     std::cout << describePlan(r.in.problem, r.plan);
     if (r.in.profile) std::cout << describePlanCost(r.plan, r.in.problem, *r.in.profile);
+    for (const DeviceProfile& d : r.in.portable) std::cout << describePlanCost(r.plan, r.in.problem, d);
+    if (r.in.profile && !r.in.portable.empty()) {
+      std::vector<DeviceProfile> all{*r.in.profile};
+      all.insert(all.end(), r.in.portable.begin(), r.in.portable.end());
+      std::cout << describePortable(r.plan, r.in.problem, all, r.in.portableBest);
+    }
   }
 
   int run() {

@@ -23,6 +23,7 @@ struct GenerateArgs {
   std::vector<std::string> maps;  // "Name=sem[,sem...]"
   std::vector<std::string> sets;  // "param=value" (rig deformer parameters)
   std::vector<std::string> maxErrors;  // "semantic=0.1deg" (error budgets)
+  std::vector<std::string> profiles;   // --device-profile, once per device (several: a portable plan)
   std::string targetEnv = "vulkan1.0";
   CLI::Option* maxAttributes = nullptr;  // whether the device limits were given (applyDeviceLimits)
   CLI::Option* maxUniformBytes = nullptr;

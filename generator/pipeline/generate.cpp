@@ -224,6 +224,8 @@ std::vector<std::string> inputsRead(const LoadedInputs& in, const TemplateSet& t
   files.insert(files.end(), in.rules.files.begin(), in.rules.files.end());
   files.push_back(templates.file());
   if (in.profile && !in.profile->file.empty()) files.push_back(in.profile->file);
+  for (const DeviceProfile& d : in.portable)
+    if (!d.file.empty()) files.push_back(d.file);
   return files;
 }
 
@@ -236,13 +238,29 @@ Plan searchUnderOptions(LoadedInputs& in, const GenerateOptions& opts, SearchSta
   if (!opts.bannedRules.empty()) in.problem = withoutRules(in.problem, opts.bannedRules);
   setDeviceLimits(in.problem, opts.maxAttributes, opts.maxUniformBlockBytes, opts.maxStorageBuffers);
   dropOversizedBuffers(in.problem, opts.maxVertices, opts.maxStorageBufferBytes);
-  return searchStage(in, SearchOptions{opts.searchEngine, opts.heuristic, opts.searchLimits}, stats);
+  const SearchOptions search{opts.searchEngine, opts.heuristic, opts.searchLimits};
+  if (in.profile && !in.portable.empty()) {
+    // Least worst-case regret: each device's own optimum first, under the same limits.
+    std::vector<DeviceProfile> all{*in.profile};
+    all.insert(all.end(), in.portable.begin(), in.portable.end());
+    std::vector<int64_t> best;
+    for (const DeviceProfile& d : all) {
+      LoadedInputs one = in;
+      applyDeviceProfile(one.problem, d);
+      best.push_back(searchStage(one, search, nullptr).cost);
+    }
+    applyPortableProfiles(in.problem, all, best);
+    in.portableBest = best;
+  }
+  return searchStage(in, search, stats);
 }
 
 LoadedInputs instantiateAndPrice(Rig rig, const RuleSet& rules, const FragmentInterface& fragment,
-                                 const GenerateOptions& opts, const std::optional<DeviceProfile>& profile) {
+                                 const GenerateOptions& opts, const std::optional<DeviceProfile>& profile,
+                                 const std::vector<DeviceProfile>& portable) {
   LoadedInputs in = instantiateStage(std::move(rig), rules, fragment, opts.overrides, opts.conventions);
   if (profile) priceStage(in, *profile);
+  in.portable = portable;
   return in;
 }
 
@@ -254,7 +272,7 @@ LoadedInputs instantiateAndPrice(Rig rig, const RuleSet& rules, const FragmentIn
 // At most four encodings, so at most sixteen searches.
 LoadedInputs cheapestStoredForms(const Rig& rig, const RuleSet& rules, const FragmentInterface& fragment,
                                  const GenerateOptions& opts, const std::optional<DeviceProfile>& profile,
-                                 std::vector<Diagnostic>& notes) {
+                                 const std::vector<DeviceProfile>& portable, std::vector<Diagnostic>& notes) {
   auto plain = [&](const VertexEncoding& e) {
     std::vector<std::string> out;
     for (const std::string& s : e.decodes())
@@ -264,7 +282,7 @@ LoadedInputs cheapestStoredForms(const Rig& rig, const RuleSet& rules, const Fra
   std::vector<const VertexEncoding*> twice;
   for (const auto& e : vertexEncodings())
     if (attributeProviding(rig, e.encoded) && !plain(e).empty()) twice.push_back(&e);
-  if (twice.empty()) return instantiateAndPrice(rig, rules, fragment, opts, profile);
+  if (twice.empty()) return instantiateAndPrice(rig, rules, fragment, opts, profile, portable);
   std::optional<LoadedInputs> best;
   int64_t bestCost = 0;
   uint32_t bestMask = 0;
@@ -278,7 +296,7 @@ LoadedInputs cheapestStoredForms(const Rig& rig, const RuleSet& rules, const Fra
       }
     }
     try {
-      LoadedInputs cand = instantiateAndPrice(withoutProvided(rig, dropped), rules, fragment, opts, profile);
+      LoadedInputs cand = instantiateAndPrice(withoutProvided(rig, dropped), rules, fragment, opts, profile, portable);
       LoadedInputs searched = cand;
       const int64_t cost = searchUnderOptions(searched, opts, nullptr).cost;
       if (!best || cost < bestCost) best = std::move(cand), bestCost = cost, bestMask = mask;
@@ -286,7 +304,7 @@ LoadedInputs cheapestStoredForms(const Rig& rig, const RuleSet& rules, const Fra
       continue;  // this combination cannot serve the request; another may
     }
   }
-  if (!best) return instantiateAndPrice(rig, rules, fragment, opts, profile);  // the full rig's own error
+  if (!best) return instantiateAndPrice(rig, rules, fragment, opts, profile, portable);  // the full rig's own error
   for (size_t i = 0; i < twice.size(); ++i) {
     const VertexEncoding* e = twice[i];
     const std::vector<std::string> plainForm = plain(*e);
@@ -304,12 +322,12 @@ LoadedInputs cheapestStoredForms(const Rig& rig, const RuleSet& rules, const Fra
 }  // namespace
 
 LoadedInputs prepareInputs(Rig rig, const RuleSet& rules, const FragmentInterface& fragment, const GenerateOptions& opts,
-                           const std::optional<DeviceProfile>& profile) {
+                           const std::optional<DeviceProfile>& profile, const std::vector<DeviceProfile>& portable) {
   std::vector<Diagnostic> notes;
   if (!opts.maxError.empty()) rig = withinErrorBudgets(rig, opts.maxError, notes);
   LoadedInputs in;
   try {
-    in = cheapestStoredForms(rig, rules, fragment, opts, profile, notes);
+    in = cheapestStoredForms(rig, rules, fragment, opts, profile, portable, notes);
   } catch (InputError& e) {  // a request the budgets made unsatisfiable says so
     e.related.insert(e.related.end(), notes.begin(), notes.end());
     throw;
@@ -324,10 +342,20 @@ LoadedInputs loadInputs(const GenerateOptions& opts) {
   const RuleSet rules = loadRulesStage(opts.rulesPaths);
   const FragmentInterface fragment = loadFragmentStage(opts.fragmentPath, opts.targetEnv);
   std::optional<DeviceProfile> profile;
-  if (!opts.deviceProfilePath.empty()) profile = loadDeviceProfileStage(opts.deviceProfilePath);
-  // A profile's per-draw weights are spread over the draw's vertices: the given count, when there is one.
-  if (profile && profile->hasDrawWeights() && opts.maxVertices > 0) profile->verticesPerDraw = double(opts.maxVertices);
-  LoadedInputs in = prepareInputs(std::move(rig), rules, fragment, opts, profile);
+  std::vector<DeviceProfile> portable;
+  if (!opts.portableProfilePaths.empty() && opts.deviceProfilePath.empty())
+    throw InputError(SourceLoc{}, "a portable choice needs at least two device profiles (--device-profile given twice)");
+  // A profile prices the workload given: the draw's vertices (for per-draw weights) and the
+  // mesh's features (for terms scaled by one), each where known.
+  auto forWorkload = [&](DeviceProfile d) {
+    d.workload = opts.workload;
+    const double vertices = opts.maxVertices > 0 ? double(opts.maxVertices) : opts.workload.verticesPerDraw;
+    if (d.hasDrawWeights() && vertices > 0) d.verticesPerDraw = vertices;
+    return d;
+  };
+  if (!opts.deviceProfilePath.empty()) profile = forWorkload(loadDeviceProfileStage(opts.deviceProfilePath));
+  for (const std::string& path : opts.portableProfilePaths) portable.push_back(forWorkload(loadDeviceProfileStage(path)));
+  LoadedInputs in = prepareInputs(std::move(rig), rules, fragment, opts, profile, portable);
   for (const auto& b : opts.bannedRules)  // a misspelt --ban would otherwise change nothing silently
     if (std::none_of(in.rules.rules.begin(), in.rules.rules.end(), [&](const Rule& r) { return r.name == b; }))
       throw InputError(SourceLoc{}, fmt::format("--ban {}: no rule of that name in the rules files", b));

@@ -59,6 +59,13 @@ struct GenerateOptions {
   // A device profile (docs/device-profiles.md): the plan is the cheapest in predicted time
   // on that device. "" = the instruction-slot model.
   std::string deviceProfilePath;
+  // A portable choice (docs/device-profiles.md, "Portable plans"): more devices' profiles; the
+  // plan then has the least worst-case regret (its predicted time over each device's best)
+  // across deviceProfilePath and these.
+  std::vector<std::string> portableProfilePaths;
+  // The mesh the program will draw, as the device sees it (search/workload.h): measured by the
+  // caller (measure/workload.h); a profile's weights read it. Unknown: the profile's defaults.
+  Workload workload;
   // Also translate the checked SPIR-V to HLSL / MSL (emit/cross_compile.h, docs/hlsl-msl.md).
   std::optional<HlslOptions> hlsl;
   std::optional<MslOptions> msl;
@@ -81,9 +88,10 @@ LoadedInputs loadInputs(const GenerateOptions& opts);
 // the error budgets (opts.maxError) take over-budget encodings out of the rig; a value the
 // rig stores both as itself and encoded is read in the form whose plan is cheapest; then
 // instantiation (opts.overrides, opts.conventions) and, with a profile, pricing. The
-// result's notes say what the budgets removed and which stored form is read.
+// result's notes say what the budgets removed and which stored form is read. `portable`: the
+// other devices of a portable choice (each plan is then priced by its worst regret).
 LoadedInputs prepareInputs(Rig rig, const RuleSet& rules, const FragmentInterface& fragment, const GenerateOptions& opts,
-                           const std::optional<DeviceProfile>& profile);
+                           const std::optional<DeviceProfile>& profile, const std::vector<DeviceProfile>& portable = {});
 
 // Throws InputError for bad inputs or unsatisfiable requests (naming the missing values).
 GenerateResult generate(const GenerateOptions& opts);

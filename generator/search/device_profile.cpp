@@ -56,9 +56,28 @@ void parseTermWeights(const YamlCtx& c, const YAML::Node& w, const char* section
 
 }  // namespace
 
+const char* featureName(int feature) {
+  static const char* const names[] = {"none", "joints_per_warp", "invocations_per_vertex", "active_morph_targets"};
+  return feature >= 0 && feature < kFeatureCount ? names[feature] : "?";
+}
+
+double DeviceProfile::feature(int f) const {
+  double v = -1;
+  switch (f) {
+    case kFeatureNone: return 1;
+    case kFeatureJointsPerWarp: v = workload.jointsPerWarp > 0 ? workload.jointsPerWarp : -1; break;
+    case kFeatureInvocationsPerVertex: v = workload.invocationsPerVertex > 0 ? workload.invocationsPerVertex : -1; break;
+    case kFeatureActiveMorphTargets: v = workload.activeMorphTargets; break;
+    default: break;
+  }
+  if (v >= 0) return v;
+  const double d = workloadDefaults[static_cast<size_t>(f)];
+  return d > 0 ? d : 1.0;
+}
+
 double DeviceProfile::perVertex(int term, double vertices) const {
   const size_t t = static_cast<size_t>(term);
-  return nanoseconds[t] + (drawNanoseconds[t] > 0 ? drawNanoseconds[t] / vertices : 0.0);
+  return (nanoseconds[t] + (drawNanoseconds[t] > 0 ? drawNanoseconds[t] / vertices : 0.0)) * feature(scaledBy[t]);
 }
 
 bool DeviceProfile::hasDrawWeights() const {
@@ -66,16 +85,22 @@ bool DeviceProfile::hasDrawWeights() const {
 }
 
 double DeviceProfile::predictNanoseconds(const TermAmounts& amounts, double vertices) const {
-  double ns = 0;
+  double ns = 0, slowest = 0;
   for (int t = 0; t < kTermCount; ++t) ns += perVertex(t, vertices) * double(amounts[static_cast<size_t>(t)]);
-  return ns;
+  for (const Pipe& pipe : pipes) {
+    double x = 0;
+    for (size_t t = 0; t < kTermCount; ++t) x += pipe.nanoseconds[t] * feature(scaledBy[t]) * double(amounts[t]);
+    slowest = std::max(slowest, x);
+  }
+  return ns + slowest;
 }
 
 DeviceProfile parseDeviceProfile(const std::string& text, const std::string& file) {
   YamlCtx c{file};
   YAML::Node root = parseYaml(text, file);
   c.expectMap(root, "device profile");
-  c.checkKeys(root, {"device", "unit", "weights", "draw_weights", "vertices_per_draw", "notes"});
+  c.checkKeys(root, {"device", "unit", "weights", "draw_weights", "vertices_per_draw", "pipes", "scaled_by",
+                     "workload_defaults", "notes"});
   DeviceProfile prof;
   prof.file = file;
   if (!root["device"]) c.fail(root, "device profile: missing 'device' (the device it was measured on)");
@@ -93,6 +118,46 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
     if (!root["vertices_per_draw"])
       c.fail(root["draw_weights"], "device profile: 'draw_weights' needs 'vertices_per_draw' (the workload they are spread over)");
   }
+  if (const YAML::Node pipes = root["pipes"]) {
+    c.expectMap(pipes, "pipes");
+    for (auto it = pipes.begin(); it != pipes.end(); ++it) {
+      DeviceProfile::Pipe pipe;
+      pipe.name = c.scalar(it->first, "pipe name");
+      parseTermWeights(c, it->second, "pipe", fmt::format("pipe '{}' weight", pipe.name).c_str(), kMaxProfileWeightNs,
+                       pipe.nanoseconds);
+      prof.pipes.push_back(std::move(pipe));
+    }
+    if (prof.pipes.size() > kMaxProfilePipes)
+      c.fail(pipes, fmt::format("device profile: {} pipes, more than the {} a profile may have", prof.pipes.size(), kMaxProfilePipes));
+  }
+  auto featureOf = [&](const YAML::Node& n) {
+    const std::string name = c.scalar(n, "workload feature");
+    for (int f = 1; f < kFeatureCount; ++f)
+      if (name == featureName(f)) return f;
+    std::string known;
+    for (int f = 1; f < kFeatureCount; ++f) known += fmt::format("{}{}", f > 1 ? ", " : "", featureName(f));
+    c.fail(n, fmt::format("unknown workload feature '{}' (known: {})", name, known));
+    return 0;
+  };
+  if (const YAML::Node scaled = root["scaled_by"]) {
+    c.expectMap(scaled, "scaled_by");
+    for (auto it = scaled.begin(); it != scaled.end(); ++it) {
+      const std::string key = c.scalar(it->first, "term name");
+      int term = -1;
+      for (int t = 0; t < kTermCount; ++t)
+        if (key == termName(t)) term = t;
+      if (term < 0) c.fail(it->first, fmt::format("scaled_by: unknown cost term '{}'", key));
+      prof.scaledBy[static_cast<size_t>(term)] = featureOf(it->second);
+    }
+  }
+  if (const YAML::Node defaults = root["workload_defaults"]) {
+    c.expectMap(defaults, "workload_defaults");
+    for (auto it = defaults.begin(); it != defaults.end(); ++it) {
+      const int f = featureOf(it->first);
+      prof.workloadDefaults[static_cast<size_t>(f)] =
+          parseNumber(c, it->second, fmt::format("workload default '{}'", featureName(f)), "units", "", 0, kMaxWorkloadFeature);
+    }
+  }
   return prof;
 }
 
@@ -103,7 +168,34 @@ TermWeights profileWeights(const DeviceProfile& profile) {
   return w;
 }
 
-void applyDeviceProfile(Problem& p, const DeviceProfile& profile) { priceProblem(p, profileWeights(profile)); }
+std::vector<TermWeights> profileComponents(const DeviceProfile& profile) {
+  const TermWeights additive = profileWeights(profile);
+  if (profile.pipes.empty()) return {additive};
+  std::vector<TermWeights> out;
+  for (const DeviceProfile::Pipe& pipe : profile.pipes) {
+    TermWeights w = additive;
+    for (size_t t = 0; t < kTermCount; ++t)
+      w[t] += std::llround(pipe.nanoseconds[t] * profile.feature(profile.scaledBy[t]) * kFemtosecondsPerNanosecond);
+    out.push_back(w);
+  }
+  return out;
+}
+
+void applyDeviceProfile(Problem& p, const DeviceProfile& profile) { priceProblemByMax(p, profileComponents(profile)); }
+
+void applyPortableProfiles(Problem& p, const std::vector<DeviceProfile>& profiles, const std::vector<int64_t>& best) {
+  std::vector<TermWeights> all;
+  for (size_t d = 0; d < profiles.size(); ++d) {
+    // fs on device d over its best fs, in parts per kRegretScale: weights scale by S / best.
+    const double scale = static_cast<double>(kRegretScale) / static_cast<double>(std::max<int64_t>(1, best[d]));
+    for (const TermWeights& w : profileComponents(profiles[d])) {
+      TermWeights r{};
+      for (size_t t = 0; t < kTermCount; ++t) r[t] = std::llround(static_cast<double>(w[t]) * scale);
+      all.push_back(r);
+    }
+  }
+  priceProblemByMax(p, all);
+}
 
 TermAmounts planTermAmounts(const Plan& plan, const Problem& p) { return planAmounts(p, plan.actions); }
 
@@ -115,6 +207,35 @@ PlanCostPrediction predictPlanCost(const Plan& plan, const Problem& p, const Dev
     out.nanoseconds[t] = static_cast<double>(w[t]) * static_cast<double>(out.amounts[t]) / kFemtosecondsPerNanosecond;
     out.totalNanoseconds += out.nanoseconds[t];
   }
+  if (profile.pipes.empty()) return out;
+  // Each pipe's share: its component less the additive part (exact in femtoseconds).
+  const std::vector<TermWeights> comps = profileComponents(profile);
+  const int64_t additive = weighTerms(w, out.amounts);
+  double slowest = 0;
+  for (size_t k = 0; k < comps.size(); ++k) {
+    const double ns = static_cast<double>(weighTerms(comps[k], out.amounts) - additive) / kFemtosecondsPerNanosecond;
+    out.pipeNanoseconds.push_back(ns);
+    if (out.slowestPipe < 0 || ns > slowest) {
+      slowest = ns;
+      out.slowestPipe = static_cast<int>(k);
+    }
+  }
+  out.totalNanoseconds += slowest;
+  return out;
+}
+
+std::string describePortable(const Plan& plan, const Problem& p, const std::vector<DeviceProfile>& devices,
+                             const std::vector<int64_t>& best) {
+  std::string out = "  portable plan: predicted per vertex on each device against its own best plan\n";
+  double worst = 0;
+  for (size_t d = 0; d < devices.size() && d < best.size(); ++d) {
+    const double ns = predictPlanCost(plan, p, devices[d]).totalNanoseconds;
+    const double bestNs = static_cast<double>(best[d]) / kFemtosecondsPerNanosecond;
+    const double regret = bestNs > 0 ? ns / bestNs : 1.0;
+    worst = std::max(worst, regret);
+    out += fmt::format("    {:<40} {:>9.3f} ns  best {:>9.3f} ns  {:.3f}x\n", devices[d].device, ns, bestNs, regret);
+  }
+  out += fmt::format("    worst regret {:.3f}x\n", worst);
   return out;
 }
 
@@ -128,6 +249,10 @@ std::string describePlanCost(const Plan& plan, const Problem& p, const DevicePro
   for (size_t t = 0; t < kTermCount; ++t)
     out += fmt::format("    {:<22} {:>8} {:>10.6f} {:>9.3f}\n", termName(static_cast<int>(t)), c.amounts[t],
                        static_cast<double>(w[t]) / kFemtosecondsPerNanosecond, c.nanoseconds[t]);
+  for (size_t k = 0; k < c.pipeNanoseconds.size(); ++k)
+    out += fmt::format("    {:<22} {:>8} {:>10} {:>9.3f}{}\n", "pipe " + profile.pipes[k].name, "", "", c.pipeNanoseconds[k],
+                       static_cast<int>(k) == c.slowestPipe ? "  (slowest: counted)" : "");
+  if (profile.workload.known()) out += fmt::format("    workload: {}\n", describeWorkload(profile.workload));
   out += fmt::format("    {:<22} {:>8} {:>10} {:>9.3f}\n", "total", "", "", c.totalNanoseconds);
   return out;
 }

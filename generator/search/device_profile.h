@@ -10,11 +10,18 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "search/plan.h"
 #include "search/problem.h"
+#include "search/workload.h"
 
 namespace sg {
+
+// What a workload feature (search/workload.h) a term's weight may be multiplied by.
+enum WorkloadFeature { kFeatureNone = 0, kFeatureJointsPerWarp, kFeatureInvocationsPerVertex, kFeatureActiveMorphTargets, kFeatureCount };
+// "joints_per_warp", ...: the keys of a profile's `scaled_by:` values and `workload_defaults:`.
+const char* featureName(int feature);
 
 struct DeviceProfile {
   std::string device;  // "NVIDIA H200 (Vulkan 580.159.04)"
@@ -22,17 +29,41 @@ struct DeviceProfile {
   std::array<double, kTermCount> nanoseconds{};  // per unit of each term, per vertex
   std::array<double, kTermCount> drawNanoseconds{};  // per unit of each term, per draw
   double verticesPerDraw = 0;  // the workload priced for; required when a draw weight is set
-  // ns per unit of `term` per vertex when a draw has `vertices`: nanoseconds + drawNanoseconds / vertices.
+  // A roofline (docs/device-profiles.md, "Roofline profiles"): pipes the device overlaps, each
+  // a weighted sum of terms (ns per unit per vertex); a program takes the additive part above
+  // plus its slowest pipe. None: the additive model alone (every profile before issue 33).
+  struct Pipe {
+    std::string name;  // "fetch", "memory", ...
+    std::array<double, kTermCount> nanoseconds{};
+  };
+  std::vector<Pipe> pipes;
+  // Per term, the workload feature its weights (additive and in every pipe) are multiplied by:
+  // an indexed uniform load costs per distinct address a warp reads (`joints_per_warp`).
+  std::array<int, kTermCount> scaledBy{};
+  // Feature values used where the workload does not say (none stated: 1).
+  std::array<double, kFeatureCount> workloadDefaults{};
+  // The workload priced for (search/workload.h): set by whoever generates for a known mesh.
+  Workload workload;
+
+  // ns per unit of `term` per vertex when a draw has `vertices`: nanoseconds + drawNanoseconds / vertices,
+  // times the term's workload feature.
   double perVertex(int term, double vertices) const;
   bool hasDrawWeights() const;
+  // The value of a feature for this profile's workload (the workload's, else the stated
+  // default, else 1); kFeatureNone is 1.
+  double feature(int f) const;
   // Predicted ns per vertex of these amounts on a mesh drawn `vertices` at a time (unrounded
-  // weights; the search's own figure is predictPlanCost's).
+  // weights; the search's own figure is predictPlanCost's): the additive part plus the slowest pipe.
   double predictNanoseconds(const TermAmounts& amounts, double vertices) const;
 };
 // Largest workload a profile may state (vertices per draw), and largest draw weight (a
 // millisecond per unit per draw).
 constexpr double kMaxVerticesPerDraw = 1e9;
 constexpr double kMaxProfileDrawWeightNs = 1e6;
+
+// Most pipes a roofline profile may have, and the largest workload default it may state.
+constexpr size_t kMaxProfilePipes = 8;
+constexpr double kMaxWorkloadFeature = 1e6;
 
 // Search cost units of a profile: femtoseconds (1e-6 ns); a weight is rounded to one.
 constexpr int64_t kFemtosecondsPerNanosecond = 1'000'000;
@@ -45,21 +76,36 @@ constexpr double kMaxProfileWeightNs = 1000;
 DeviceProfile loadDeviceProfile(const std::string& path);
 DeviceProfile parseDeviceProfile(const std::string& text, const std::string& file);
 
-// The profile's weights in femtoseconds per unit of each term, per vertex at its workload.
+// The profile's additive weights in femtoseconds per unit of each term, per vertex at its workload.
 TermWeights profileWeights(const DeviceProfile& profile);
-// Prices the problem's actions, inputs and fixed terms under the profile (priceProblem).
+// The search's components (Problem::componentWeights): one per pipe, each the additive
+// weights plus the pipe's; the additive weights alone for a profile without pipes.
+std::vector<TermWeights> profileComponents(const DeviceProfile& profile);
+// Prices the problem's actions, inputs and fixed terms under the profile (priceProblem, or
+// priceProblemByMax for a roofline).
 void applyDeviceProfile(Problem& p, const DeviceProfile& profile);
+// A portable choice (docs/device-profiles.md, "Portable plans"): prices the problem so a plan
+// costs its worst regret over the devices, max over d of (its predicted time on d) / best[d],
+// in parts per kRegretScale; `best` is each device's optimum in its own femtoseconds.
+constexpr int64_t kRegretScale = 1'000'000'000;
+void applyPortableProfiles(Problem& p, const std::vector<DeviceProfile>& profiles, const std::vector<int64_t>& best);
 
 // What a plan pays, term by term: its rules' terms, each input it reads once, and the
 // fixed terms. Plain data for explain, generate's report and bench's "predicted" column.
 struct PlanCostPrediction {
   TermAmounts amounts{};
-  std::array<double, kTermCount> nanoseconds{};  // rounded weight x amount, per term
+  std::array<double, kTermCount> nanoseconds{};  // rounded additive weight x amount, per term
+  std::vector<double> pipeNanoseconds;           // per pipe of a roofline profile
+  int slowestPipe = -1;                          // the pipe that bounds the program (-1: none)
   double totalNanoseconds = 0;                   // equals plan cost / kFemtosecondsPerNanosecond
 };
 TermAmounts planTermAmounts(const Plan& plan, const Problem& p);
 PlanCostPrediction predictPlanCost(const Plan& plan, const Problem& p, const DeviceProfile& profile);
 // The prediction as a table: term, amount, ns per unit, ns; then the total per vertex.
 std::string describePlanCost(const Plan& plan, const Problem& p, const DeviceProfile& profile);
+// A portable plan's regret per device: its predicted time, the device's best (`best`, fs per
+// vertex, from a search under that device alone) and their ratio; then the worst.
+std::string describePortable(const Plan& plan, const Problem& p, const std::vector<DeviceProfile>& devices,
+                             const std::vector<int64_t>& best);
 
 }  // namespace sg

@@ -22,6 +22,12 @@ struct LoadedInputs {
   Problem problem;
   // The device profile the problem is priced with (priceStage); none: instruction slots.
   std::optional<DeviceProfile> profile;
+  // A portable choice: the other devices' profiles (the plan's worst regret across `profile`
+  // and these is minimised; searchStage's caller prices it, pipeline/generate.cpp).
+  std::vector<DeviceProfile> portable;
+  // Each device's optimum (`profile` first, then `portable`), fs per vertex: set by the search
+  // of a portable choice, for the regret report (describePortable).
+  std::vector<int64_t> portableBest;
   // What loading left out and why (error budgets' removals): printed by the CLI, and
   // attached to an error when the request then cannot be met.
   std::vector<Diagnostic> notes;
