@@ -1,4 +1,4 @@
-#include "render/gpu_bench.h"
+#include "measure/gpu_bench.h"
 
 #include <fmt/format.h>
 
