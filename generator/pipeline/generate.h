@@ -59,6 +59,10 @@ struct GenerateOptions {
   // A device profile (docs/device-profiles.md): the plan is the cheapest in predicted time
   // on that device. "" = the instruction-slot model.
   std::string deviceProfilePath;
+  // What the mesh the program will draw looks like (search/workload.h): measured by the caller
+  // (measure/workload.h: the CLI, bench, calibrate), unknown by default. A device profile's
+  // weights may depend on it; explain shows it, the reflection records it with a profile.
+  Workload workload;
   // Also translate the checked SPIR-V to HLSL / MSL (emit/cross_compile.h, docs/hlsl-msl.md).
   std::optional<HlslOptions> hlsl;
   std::optional<MslOptions> msl;

@@ -11,6 +11,7 @@
 #include "rules/rules.h"
 #include "search/device_profile.h"
 #include "search/problem.h"
+#include "search/workload.h"
 
 namespace sg {
 
@@ -22,6 +23,8 @@ struct LoadedInputs {
   Problem problem;
   // The device profile the problem is priced with (priceStage); none: instruction slots.
   std::optional<DeviceProfile> profile;
+  // The workload the problem is priced for (GenerateOptions::workload): reports show it.
+  Workload workload;
   // What loading left out and why (error budgets' removals): printed by the CLI, and
   // attached to an error when the request then cannot be met.
   std::vector<Diagnostic> notes;
