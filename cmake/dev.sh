@@ -92,7 +92,7 @@ plain_build() {  # plain_build [target...]: only those targets; the suite is con
 # skip their data under sanitizers (tests/validate: `kSanitized`), which are built for it.
 full_scale_tests='^(Buffers\.Face52TargetsAt180kVerticesDenseAndSparse|Program\.AgreesWithTreeOnDawnSubset|Program\.AgreesWithTreeOnRandomDefinitions)$'
 product_build() {
-  SHADERGEN_SUITE=ON plain_build generator/all runtime/all generator/validate/all generator/render/all \
+  SHADERGEN_SUITE=ON plain_build generator/all runtime/all generator/validate/all generator/render/all generator/measure/all \
     generator/bake/all generator/cli/all bench/all test_validate_buffers test_validate_program
 }
 product_test() {

@@ -174,6 +174,7 @@ std::string formatExplanation(const LoadedInputs& in, const Explanation& e) {
   }
   out += fmt::format("total cost {} ({} rules, each paid once; {} A*)\n", sum, e.steps.size(), e.heuristic);
   if (in.profile) out += "\n" + describePlanCost(e.plan, p, *in.profile);
+  out += "workload priced for: " + describeWorkload(in.workload) + "\n";
   if (!in.rules.changes.empty()) out += "\n" + formatRuleChanges(in.rules);
   return out;
 }

@@ -5,7 +5,7 @@
 #include <iostream>
 
 #include "cli/commands.h"
-#include "render/calibrate.h"
+#include "measure/calibrate.h"
 
 namespace sg {
 namespace {

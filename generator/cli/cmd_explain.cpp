@@ -33,10 +33,12 @@ struct ExplainCommand {
   CLI::App* cmd = nullptr;
   GenerateArgs args;
   bool noAlternatives = false;
+  std::string mesh;
 
   int run() {
     refuseSearchAndEmitOptions(*cmd);
     GenerateOptions o = args.resolve();
+    measureWorkloadOf(o, mesh);
     auto [in, plan] = loadAndSearch(o);
     if (!plan) {
       std::cout << fmt::format("the request cannot be met for rig '{}' and fragment shader '{}':\n", in.rig.name,
@@ -90,6 +92,10 @@ void registerExplain(CLI::App& app, CliState& state) {
   ex->cmd = sub;
   ex->args.add(*sub);
   sub->add_flag("--no-alternatives", ex->noAlternatives, "Do not re-search for each choice's alternative");
+  sub->add_option("--mesh", ex->mesh,
+                  "YAML rig: the procedural mesh the program will draw (head, limb, dawn), whose workload is shown and "
+                  "priced by a device profile; a glTF rig is measured on its own mesh. Default: unknown")
+      ->check(CLI::IsMember({"head", "limb", "dawn"}));
   sub->callback([ex, &state] { state.run = [ex] { return ex->run(); }; });
 
   auto gr = std::make_shared<GraphCommand>();

@@ -11,6 +11,7 @@
 #include "cli/output_files.h"
 #include "cli/whole_model.h"
 #include "emit/reflection.h"
+#include "measure/workload.h"
 #include "rig/vertex_encoding.h"
 
 namespace sg {
@@ -151,9 +152,16 @@ std::vector<InputFile> inputFiles(const LoadedInputs& in, const std::vector<std:
   return files;
 }
 
+void measureWorkloadOf(GenerateOptions& o, const std::string& mesh) {
+  if (!mesh.empty() && isGltfPath(o.rigPath))
+    throw CLI::ValidationError("--mesh", "does not apply to a glTF rig (" + o.rigPath + "): it is measured on its own mesh");
+  o.workload = rigWorkload(o.rigPath, o.rigParams, mesh);
+}
+
 namespace {
 
 struct GenerateCommand {
+  CLI::App* cmd = nullptr;
   GenerateArgs args;
   std::string output;
   std::vector<std::string> emit{"glsl", "spv"};
@@ -163,6 +171,7 @@ struct GenerateCommand {
   bool quiet = false;
   bool capture = false;
   bool stats = false;
+  std::string mesh;
   CrossArgs cross;
 
   // The outputs of one generation: with one --emit kind and `exact`, `path` is that file
@@ -242,7 +251,11 @@ struct GenerateCommand {
     if (optimize && !kinds.count("spv") && !kinds.count("header") && !kinds.count("hlsl") && !kinds.count("msl"))
       throw CLI::ValidationError("-O", "does not apply: it optimises the SPIR-V, and --emit writes none (add spv or header)");
     cross.resolve(kinds.count("hlsl") > 0, kinds.count("msl") > 0, o);
+    // The workload prices nothing without a profile: outputs stay those of the slot model.
+    if (o.deviceProfilePath.empty())
+      refuseOption(*cmd, "--mesh", "without --device-profile: the workload it measures prices nothing under instruction slots");
     if (auto parts = wholeModelParts(o.rigPath)) return runModel(o, kinds, *parts);
+    if (!o.deviceProfilePath.empty()) measureWorkloadOf(o, mesh);
     bool single = kinds.size() == 1 && !output.empty();
     std::string path = output.empty() ? std::filesystem::path(o.fragmentPath).stem().string() : output;
     o.outputName = single && kinds.count("glsl") ? output : stemOf(path) + ".vert";
@@ -279,6 +292,7 @@ struct GenerateCommand {
       o.rigPath = part.ref;
       std::string stem = (std::filesystem::path(output) / part.name).string();
       o.outputName = stem + ".vert";
+      if (!o.deviceProfilePath.empty()) measureWorkloadOf(o, "");
       GenerateResult r = generate(o);
       std::vector<PendingFile> out = outputsOf(r, kinds, stem, false);
       nlohmann::ordered_json& e = entries[static_cast<size_t>(&part - parts.data())];
@@ -318,8 +332,14 @@ struct GenerateCommand {
 void registerGenerate(CLI::App& app, CliState& state) {
   auto cmd = std::make_shared<GenerateCommand>();
   CLI::App* sub = app.add_subcommand("generate", "Generate the cheapest vertex shader (GLSL + SPIR-V)");
+  cmd->cmd = sub;
   cmd->args.add(*sub);
   sub->add_option("-o", cmd->output, "Output path (a file if one --emit kind, else the stem for all)");
+  sub->add_option("--mesh", cmd->mesh,
+                  "With --device-profile and a YAML rig: the procedural mesh the program will draw (head, limb, dawn), "
+                  "whose workload the profile prices (docs/device-profiles.md, \"Workload\"); a glTF rig is measured on "
+                  "its own mesh. Default: unknown, the profile's defaults")
+      ->check(CLI::IsMember({"head", "limb", "dawn"}));
   sub->add_option("--emit", cmd->emit,
                    "What to write: glsl, spv, header, reflection, hlsl (Direct3D), msl (Metal) (comma-separated). "
                    "HLSL and MSL are translated from the SPIR-V by SPIRV-Cross; their bindings go into the "

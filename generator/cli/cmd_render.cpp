@@ -6,7 +6,7 @@
 
 #include "cli/commands.h"
 #include "cli/whole_model.h"
-#include "render/gpu_bench.h"
+#include "measure/gpu_bench.h"
 #include "render/render.h"
 
 namespace sg {

@@ -52,6 +52,10 @@ void refuseOption(const CLI::App& cmd, const std::string& option, const std::str
 // with NaN is false); this refuses them: "must be a finite number >= 0, got 'nan'".
 CLI::Validator finiteNumber(bool positive);
 
+// The workload a generation is priced for (measure/workload.h): a glTF rig's own mesh, or
+// for a YAML rig the procedural mesh `mesh` ("" = unknown). Sets o.workload.
+void measureWorkloadOf(GenerateOptions& o, const std::string& mesh);
+
 void registerCommands(CLI::App& app, CliState& state);
 void registerGenerate(CLI::App& app, CliState& state);
 void registerValidate(CLI::App& app, CliState& state);

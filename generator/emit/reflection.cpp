@@ -141,7 +141,7 @@ std::string buffersHeader(const EmittedGlsl& glsl, const std::string& symbol) {
 
 std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spirv,
                            const DeviceProfile* profile, const PlanCostPrediction* predicted, const CrossShader* hlsl,
-                           const CrossShader* msl) {
+                           const CrossShader* msl, const Workload* workload) {
   std::string j = "{\n  \"rig\": " + jsonQuote(rig.name) + ",\n  \"inputs\": [";
   for (size_t i = 0; i < glsl.inputs.size(); ++i) {
     const auto& in = glsl.inputs[i];
@@ -187,6 +187,12 @@ std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvM
       j += fmt::format("{}\n    {}: {{\"amount\": {}, \"ns\": {:.6f}}}", t ? "," : "", jsonQuote(termName(static_cast<int>(t))),
                        predicted->amounts[t], predicted->nanoseconds[t]);
     j += "\n  }},\n";
+    // What the prediction was priced for (search/workload.h; 0 or -1: unknown).
+    if (workload)
+      j += fmt::format("  \"workload\": {{\"vertices_per_draw\": {:g}, \"joints_per_warp\": {:.6g}, "
+                       "\"active_morph_targets\": {:g}, \"invocations_per_vertex\": {:.6g}, \"source\": {}}},\n",
+                       workload->verticesPerDraw, workload->jointsPerWarp, workload->activeMorphTargets,
+                       workload->invocationsPerVertex, jsonQuote(workload->source));
   }
   if (hlsl) j += crossJson(*hlsl);
   if (msl) j += crossJson(*msl);

@@ -8,14 +8,17 @@
 #include "emit/spirv.h"
 #include "rig/rig.h"
 #include "search/device_profile.h"
+#include "search/workload.h"
 
 namespace sg {
 
-// With a device profile, also the plan's predicted cost per term ("predicted_cost"); with
+// With a device profile, also the plan's predicted cost per term ("predicted_cost") and the
+// workload it was priced for ("workload", when given); with
 // translations, how a Direct3D ("hlsl") or Metal ("msl") host binds them (docs/hlsl-msl.md).
 std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spirv,
                            const DeviceProfile* profile = nullptr, const PlanCostPrediction* predicted = nullptr,
-                           const CrossShader* hlsl = nullptr, const CrossShader* msl = nullptr);
+                           const CrossShader* hlsl = nullptr, const CrossShader* msl = nullptr,
+                           const Workload* workload = nullptr);
 
 // A C/C++ header defining `static const uint32_t <symbol>[]` with the SPIR-V words.
 std::string spirvHeader(const std::vector<uint32_t>& words, const std::string& symbol);

@@ -259,6 +259,7 @@ LoadedInputs instantiateAndPrice(Rig rig, const RuleSet& rules, const FragmentIn
                                  const GenerateOptions& opts, const std::optional<DeviceProfile>& profile,
                                  const std::vector<DeviceProfile>& portable) {
   LoadedInputs in = instantiateStage(std::move(rig), rules, fragment, opts.overrides, opts.conventions);
+  in.workload = opts.workload;  // before pricing: a profile's weights may depend on it
   if (profile) priceStage(in, *profile);
   in.portable = portable;
   return in;
@@ -367,7 +368,7 @@ std::string reflectionOf(const GenerateResult& r) {
   const CrossShader* msl = r.msl ? &*r.msl : nullptr;
   if (!r.in.profile) return reflectionJson(r.in.rig, r.glsl, r.spirv, nullptr, nullptr, hlsl, msl);
   const PlanCostPrediction c = predictPlanCost(r.plan, r.in.problem, *r.in.profile);
-  return reflectionJson(r.in.rig, r.glsl, r.spirv, &*r.in.profile, &c, hlsl, msl);
+  return reflectionJson(r.in.rig, r.glsl, r.spirv, &*r.in.profile, &c, hlsl, msl, &r.in.workload);
 }
 
 std::string explainUnreachable(const Problem& p, const RuleSet& rules) {

@@ -63,8 +63,9 @@ struct GenerateOptions {
   // plan then has the least worst-case regret (its predicted time over each device's best)
   // across deviceProfilePath and these.
   std::vector<std::string> portableProfilePaths;
-  // The mesh the program will draw, as the device sees it (search/workload.h): measured by the
-  // caller (measure/workload.h); a profile's weights read it. Unknown: the profile's defaults.
+  // What the mesh the program will draw looks like (search/workload.h): measured by the caller
+  // (measure/workload.h: the CLI, bench, calibrate), unknown by default. A device profile's
+  // weights may depend on it; explain shows it, the reflection records it with a profile.
   Workload workload;
   // Also translate the checked SPIR-V to HLSL / MSL (emit/cross_compile.h, docs/hlsl-msl.md).
   std::optional<HlslOptions> hlsl;

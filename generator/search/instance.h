@@ -11,6 +11,7 @@
 #include "rules/rules.h"
 #include "search/device_profile.h"
 #include "search/problem.h"
+#include "search/workload.h"
 
 namespace sg {
 
@@ -28,6 +29,8 @@ struct LoadedInputs {
   // Each device's optimum (`profile` first, then `portable`), fs per vertex: set by the search
   // of a portable choice, for the regret report (describePortable).
   std::vector<int64_t> portableBest;
+  // The workload the problem is priced for (GenerateOptions::workload): reports show it.
+  Workload workload;
   // What loading left out and why (error budgets' removals): printed by the CLI, and
   // attached to an error when the request then cannot be met.
   std::vector<Diagnostic> notes;

@@ -14,7 +14,8 @@ set(layers
   variants   # manifests, the content cache, batch builds
   api        # the public shadergen::core facade
   validate   # lavapipe runs against the GLM reference
-  render     # images and GPU timing of generated shaders (runtime/vk_render)
+  render     # images of generated shaders (runtime/vk_render)
+  measure    # device measurement: GPU timing (bench), calibration of device profiles
   bake       # offline rig data (occlusion with Embree); poses glTF models as validation does
   cli)       # the command line
 set(external runtime)  # separate library (no generator dependency), usable from validate up

@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "render/gpu_bench.h"
+#include "measure/gpu_bench.h"
 #include "search/device_profile.h"
 
 namespace sg {

@@ -1,4 +1,4 @@
-#include "render/calibrate.h"
+#include "measure/calibrate.h"
 
 #include <fmt/format.h>
 

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <cstring>
 
-#include "render/gpu_bench.h"
 #include "common/input_file.h"
+#include "measure/gpu_bench.h"
 #include "runtime/procedural.h"
 #include "test_util.h"
 

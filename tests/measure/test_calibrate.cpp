@@ -9,8 +9,8 @@
 #include <map>
 #include <sstream>
 
-#include "render/calibrate.h"
-#include "render/gpu_bench.h"
+#include "measure/calibrate.h"
+#include "measure/gpu_bench.h"
 
 namespace sg {
 namespace {

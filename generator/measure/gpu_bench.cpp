@@ -1,4 +1,4 @@
-#include "render/gpu_bench.h"
+#include "measure/gpu_bench.h"
 
 #include <fmt/format.h>
 
@@ -12,6 +12,7 @@
 #include "analysis/cost.h"
 #include "common/glsl_compile.h"
 #include "common/input_file.h"
+#include "measure/workload.h"
 #include "rig/packed_fields.h"
 #include "rig/vertex_format.h"
 #include "runtime/procedural.h"
@@ -257,12 +258,12 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   LoadedInputs in = loadInputs(gen);
   RenderScene scene = renderScene(in.rig, opts.render);
   // As validate does: the buffer forms must fit this mesh (+1: the capture draws an even
-  // count), and a device profile's per-draw weights are spread over its vertices.
-  if (gen.maxVertices == 0) {
-    gen.maxVertices = static_cast<int64_t>(scene.mesh.vertexCount) + 1;
-    in = loadInputs(gen);
-    scene = renderScene(in.rig, opts.render);
-  }
+  // count), and a device profile's per-draw weights are spread over its vertices. The plans
+  // are priced for the workload of the mesh and pose timed (measure/workload.h).
+  if (gen.maxVertices == 0) gen.maxVertices = static_cast<int64_t>(scene.mesh.vertexCount) + 1;
+  gen.workload = sceneWorkload(scene, isGltfPath(gen.rigPath) ? gen.rigPath : "procedural mesh '" + opts.render.mesh + "'");
+  in = loadInputs(gen);
+  scene = renderScene(in.rig, opts.render);
   const Rig& rig = in.rig;
   FragmentProgram frag = compileFragmentFile(gen.fragmentPath, env);
   std::vector<rt::Texture> textures = texturesFor(frag, opts.render.lighting);
@@ -355,6 +356,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   rep.device = validator.harness().deviceName();
   rep.limits = limits;
   rep.driver = renderer.driver();
+  rep.workload = gen.workload;
   rep.vertices = scene.mesh.vertexCount;
   rep.triangles = scene.indices.size() / 3;
   rep.drawsPerFrame = opts.drawsPerFrame;
@@ -425,6 +427,7 @@ std::string formatGpuBench(const GpuBenchReport& r) {
                               "rasterization on: {}x{} target\n\n",
                               r.device, r.driver, r.limits.empty() ? "" : r.limits + "\n", r.vertices, r.triangles,
                               r.drawsPerFrame, r.frames, r.rounds, r.width, r.height);
+  s.insert(s.size() - 1, "workload: " + describeWorkload(r.workload) + "\n");
   const GpuBenchRow* gen = nullptr;
   for (const auto& row : r.rows)
     if (row.label == "generated") gen = &row;
