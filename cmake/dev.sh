@@ -23,6 +23,7 @@ packages=(
   libglm-dev libyaml-cpp-dev libfmt-dev libcli11-dev
   libtinygltf-dev nlohmann-json3-dev libmeshoptimizer-dev
   libglpk-dev
+  libceres-dev
   libembree-dev
   libpng-dev
   spirv-cross libspirv-cross-c-shared-dev

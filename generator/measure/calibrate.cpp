@@ -13,7 +13,8 @@
 
 #include "analysis/cost.h"
 #include "common/glsl_compile.h"
-#include "common/nnls.h"
+#include "measure/fit.h"
+#include "measure/workload.h"
 #include "runtime/procedural.h"
 #include "runtime/vk_render.h"
 #include "validate/program_inputs.h"
@@ -345,47 +346,26 @@ double medianOf(std::vector<double> v) {
 }  // namespace
 
 DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
-                               double workloadVertices, double nearBestPower) {
-  std::vector<const CalibrationSample*> rows;
-  std::set<double> sizes;
+                               double workloadVertices, double nearBestPower, ProfileForm form) {
   std::map<std::pair<std::string, std::string>, double> fastest;  // (rig, mesh) -> ns per vertex
+  std::vector<const CalibrationSample*> used;
   for (const auto& s : samples)
     if (s.fitted && s.validated && s.measuredNs > 0 && s.vertices > 0) {
-      rows.push_back(&s), sizes.insert(s.vertices);
+      used.push_back(&s);
       auto [it, added] = fastest.emplace(std::make_pair(s.rig, s.mesh), s.measuredNs);
       if (!added) it->second = std::min(it->second, s.measuredNs);
     }
-  if (rows.empty()) throw std::runtime_error("calibration: no validated timing to fit");
   // A probe varies one term and weighs 1; a rig's programs weigh more the nearer they come
   // to its fastest. The GPU hides some costs under others (a 16-location plan's palette loads
-  // under its fetch): no additive model fits both, so the fit favours the plans the search
-  // must order right, those near the fastest.
-  std::vector<double> rowWeight(rows.size(), 1.0);
-  for (size_t i = 0; i < rows.size(); ++i)
-    if (!rows[i]->rig.empty() && nearBestPower > 0)
-      rowWeight[i] = std::pow(fastest.at({rows[i]->rig, rows[i]->mesh}) / rows[i]->measuredNs, nearBestPower);
-  // Per-draw columns only when meshes of two sizes separate them from the per-vertex ones.
-  const size_t n = sizes.size() > 1 ? 2 * kTermCount : kTermCount;
-  // Relative errors weigh equally: row i divided by its measured time. Each column is scaled
-  // to a largest entry of 1 (per-draw amounts are ~1e-5 of per-vertex ones), then unscaled.
-  std::vector<double> a(rows.size() * n), b(rowWeight), scale(n, 0.0);
-  for (size_t i = 0; i < rows.size(); ++i)
-    for (size_t j = 0; j < n; ++j) {
-      const double amount = double(rows[i]->amounts[j % kTermCount]) / (j < kTermCount ? 1.0 : rows[i]->vertices);
-      a[i * n + j] = rowWeight[i] * amount / rows[i]->measuredNs;
-      scale[j] = std::max(scale[j], std::abs(a[i * n + j]));
-    }
-  for (size_t i = 0; i < rows.size(); ++i)
-    for (size_t j = 0; j < n; ++j)
-      if (scale[j] > 0) a[i * n + j] /= scale[j];
-  NnlsResult fit = nnls(a, rows.size(), n, b);
-  DeviceProfile profile;
-  profile.device = deviceName;
-  for (size_t j = 0; j < n; ++j) {
-    const double w = scale[j] > 0 ? fit.x[j] / scale[j] : 0.0;
-    if (j < kTermCount) profile.nanoseconds[j] = std::min(w, kMaxProfileWeightNs);
-    else profile.drawNanoseconds[j - kTermCount] = std::min(w, kMaxProfileDrawWeightNs);
+  // under its fetch): the fit favours the plans the search must order right, those near the fastest.
+  std::vector<FitRow> rows;
+  for (const CalibrationSample* s : used) {
+    FitRow r{s->amounts, s->vertices, s->workload, s->measuredNs, 1.0};
+    if (!s->rig.empty() && nearBestPower > 0) r.weight = std::pow(fastest.at({s->rig, s->mesh}) / s->measuredNs, nearBestPower);
+    rows.push_back(r);
   }
+  DeviceProfile profile = fitProfile(rows, form).profile;
+  profile.device = deviceName;
   if (profile.hasDrawWeights()) profile.verticesPerDraw = workloadVertices;
   return profile;
 }
@@ -444,11 +424,15 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   for (const auto& meshName : opts.meshes) {
     ProbeMesh m = probeMesh(meshName);
     std::vector<Probe> probes = opts.probes ? makeProbes(m) : std::vector<Probe>{};
+    const Workload probeWorkload = measureWorkload(m.mesh, m.indices, true, -1, "probe mesh '" + meshName + "'");
     for (auto& p : probes) {
       CalibrationSample s;
       s.label = p.label;
       s.mesh = meshName;
       s.vertices = double(m.mesh.vertexCount);
+      // The palette probe at a uniform index reads one address per warp, whatever the mesh.
+      s.workload = probeWorkload;
+      if (p.label.find("uniform index") != std::string::npos) s.workload.jointsPerWarp = 1;
       s.amounts = p.amounts;
       try {
         GlslShader renderShader = compileProbe(Stage::Vertex, probeGlsl(p, false), p.label);
@@ -541,6 +525,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           s.label = (row.hasCost ? prefix : "") + row.label;
           s.mesh = meshName;
           s.vertices = double(br.vertices);
+          s.workload = br.workload;
           s.rig = std::filesystem::path(rig).filename().string();
           s.fitted = fitted;
           s.amounts = row.amounts;
@@ -583,6 +568,37 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
 
 namespace {
 
+// A roofline's pipes, the workload scaling and its defaults (none for an additive profile
+// without scaling: the file then reads as every profile before them).
+std::string rooflineLines(const DeviceProfile& p) {
+  std::string s;
+  if (!p.pipes.empty()) {
+    s += "pipes:  # overlapped: a program takes the additive part plus its slowest pipe\n";
+    for (const auto& pipe : p.pipes) {
+      s += fmt::format("  {}:\n", pipe.name);
+      bool any = false;
+      for (int t = 0; t < kTermCount; ++t)
+        if (pipe.nanoseconds[size_t(t)] > 0) s += fmt::format("    {}: {:.6g}\n", termName(t), pipe.nanoseconds[size_t(t)]), any = true;
+      if (!any) s.replace(s.size() - 1, 1, " {}\n");
+    }
+  }
+  bool scaled = false;
+  for (int t = 0; t < kTermCount; ++t)
+    if (p.scaledBy[size_t(t)] != kFeatureNone) {
+      if (!scaled) s += "scaled_by:  # a term's weights times the mesh's workload feature\n";
+      s += fmt::format("  {}: {}\n", termName(t), featureName(p.scaledBy[size_t(t)]));
+      scaled = true;
+    }
+  bool defaults = false;
+  for (int f = 1; f < kFeatureCount; ++f)
+    if (p.workloadDefaults[size_t(f)] > 0) {
+      if (!defaults) s += "workload_defaults:  # where the mesh is unknown\n";
+      s += fmt::format("  {}: {:g}\n", featureName(f), p.workloadDefaults[size_t(f)]);
+      defaults = true;
+    }
+  return s;
+}
+
 std::string weightLines(const DeviceProfile& p) {
   std::string s = "weights:\n";
   for (int t = 0; t < kTermCount; ++t) s += fmt::format("  {}: {:.6g}\n", termName(t), p.nanoseconds[size_t(t)]);
@@ -590,7 +606,7 @@ std::string weightLines(const DeviceProfile& p) {
   s += fmt::format("vertices_per_draw: {:g}\ndraw_weights:\n", p.verticesPerDraw);
   for (int t = 0; t < kTermCount; ++t)
     if (p.drawNanoseconds[size_t(t)] > 0) s += fmt::format("  {}: {:.6g}\n", termName(t), p.drawNanoseconds[size_t(t)]);
-  return s;
+  return s + rooflineLines(p);
 }
 
 std::string fitLine(const CalibrationFit& f) {
@@ -626,8 +642,8 @@ std::string formatCalibration(const CalibrationReport& r) {
 
 std::string deviceProfileYaml(const CalibrationReport& r) {
   std::string s = "# Measured by `shadergen calibrate` (docs/device-profiles.md): ns per vertex per unit of each\n"
-                  "# term (and, under draw_weights, ns per draw), the non-negative least-squares fit of every\n"
-                  "# validated probe's, plan's and floor's time.\n";
+                  "# term (and, under draw_weights, ns per draw), the least-squares fit (Ceres Solver, weights >= 0)\n"
+                  "# of every validated probe's, plan's and floor's time.\n";
   if (r.nearBestPower > 0)
     s += fmt::format("# A rig's plans and floors weighed (its fastest on that mesh / their time)^{:g}.\n", r.nearBestPower);
   s += fmt::format("# clock: {}; driver: {}\n", r.clock, r.driver);

@@ -9,7 +9,7 @@
 // values it must compute (computed here on the CPU from the same data); only a probe that
 // agrees is timed. Generated plans (each rig's plan and its forced alternatives, bench's
 // rows) and bench's floors join the probes as samples. The weights are the non-negative
-// least-squares fit (common/nnls.h) of ns per vertex on the terms' amounts, relative errors
+// least-squares fit (measure/fit.h, Ceres Solver) of ns per vertex on the terms' amounts, relative errors
 // weighted equally; with meshes of different sizes, each term also gets a per-draw weight
 // (the fit: ns per vertex = sum of (w + d / vertices per draw) x amount). Then each rig's
 // plans under the fitted profile, which join the samples for a refit (the plans a profile
@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "measure/gpu_bench.h"
+#include "measure/fit.h"
 #include "search/device_profile.h"
 
 namespace sg {
@@ -56,6 +57,7 @@ struct CalibrationSample {
   std::string rig;      // the rig of a plan or floor ("" for a probe)
   bool fitted = true;   // false: a plan of the check, which the fit did not see
   TermAmounts amounts{};
+  Workload workload;  // of the mesh it was timed on (measure/workload.h); the fit scales terms by it
   bool validated = false;
   std::string failure;      // why it was not timed (its outputs disagreed, or it did not run)
   double measuredNs = -1;   // per vertex, raster on, timestamps
@@ -97,7 +99,8 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts);
 // weights too when the samples' meshes differ in size. The profile prices draws of
 // `workloadVertices`.
 DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
-                               double workloadVertices, double nearBestPower = 0);
+                               double workloadVertices, double nearBestPower = 0,
+                               ProfileForm form = ProfileForm::Additive);
 // Fills predictedNs of every sample and the fit statistics per mesh.
 std::vector<CalibrationFit> evaluateFit(std::vector<CalibrationSample>& samples, const DeviceProfile& profile,
                                         const std::vector<std::string>& meshes);

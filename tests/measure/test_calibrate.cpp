@@ -4,6 +4,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -225,6 +227,84 @@ TEST(Calibrate, WeightingThePlansNearTheFastestOrdersTheH200PlansTheSearchCompar
   // all programs still rank with the measurements on both meshes.
   std::vector<CalibrationSample> all = samples;
   for (const auto& f : evaluateFit(all, nearBest, {"dawn", "head"})) EXPECT_GT(f.spearmanAll, 0.85) << f.mesh;
+}
+
+// A device that overlaps its pipes (fetch, memory, alu, output: the slowest wins) on top of a
+// per-vertex and a per-draw fixed cost, whose palette loads cost per distinct joint a warp
+// reads. Rows are drawn at random over two draw sizes and several meshes' joints per warp;
+// the roofline fit must predict rows it never saw, and the additive form cannot.
+namespace roofline {
+struct Device {
+  double vertexNs = 0.3, drawNs = 400;
+  double location = 0.35, byte = 0.002, load = 0.07, address = 0.2, slot = 0.002, output = 0.04;
+  double ns(const TermAmounts& a, double vertices, double jointsPerWarp) const {
+    const double fetch = location * double(a[kTermLocations]) + byte * double(a[kTermAttributeBytes]);
+    const double memory = load * double(a[kTermBufferLoads]) + address * jointsPerWarp * double(a[kTermIndexedUniformLoads]);
+    const double alu = slot * double(a[kTermArithmetic]), out = output * double(a[kTermOutputs]);
+    return vertexNs + drawNs / vertices + std::max({fetch, memory, alu, out});
+  }
+};
+std::vector<CalibrationSample> rows(uint32_t seed, int n) {
+  std::mt19937 rng(seed);
+  auto pick = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+  Device d;
+  std::vector<CalibrationSample> out;
+  for (int i = 0; i < n; ++i) {
+    CalibrationSample s;
+    s.label = fmt::format("row {}", i);
+    s.vertices = pick(0, 1) ? 180000 : 2009;
+    s.mesh = s.vertices > 10000 ? "dawn" : "head";
+    s.validated = true;
+    s.amounts[kTermLocations] = pick(1, 16);
+    s.amounts[kTermAttributeBytes] = s.amounts[kTermLocations] * 4 * pick(1, 4);
+    s.amounts[kTermBufferLoads] = pick(0, 3) ? 0 : pick(1, 12);
+    s.amounts[kTermIndexedUniformLoads] = pick(0, 2) ? 0 : 4 * pick(1, 4);
+    s.amounts[kTermArithmetic] = pick(20, 600);
+    s.amounts[kTermOutputs] = 4 * pick(1, 12);
+    s.amounts[kTermVertices] = 1;
+    s.workload.jointsPerWarp = 1 + pick(0, 28) / 4.0;
+    s.measuredNs = d.ns(s.amounts, s.vertices, s.workload.jointsPerWarp);
+    out.push_back(s);
+  }
+  return out;
+}
+}  // namespace roofline
+
+TEST(Calibrate, TheRooflineFitPredictsRowsItNeverSawWhereTheAdditiveCannot) {
+  const std::vector<CalibrationSample> train = roofline::rows(1, 160), test = roofline::rows(2, 80);
+  auto heldOutRms = [&](const DeviceProfile& p) {
+    double sq = 0;
+    for (const auto& s : test) {
+      DeviceProfile at = p;
+      at.workload = s.workload;
+      const double e = at.predictNanoseconds(s.amounts, s.vertices) / s.measuredNs - 1;
+      sq += e * e;
+    }
+    return std::sqrt(sq / double(test.size()));
+  };
+  const DeviceProfile roof = fitDeviceProfile(train, "roofline device", 180000, 0, ProfileForm::Roofline);
+  const DeviceProfile sum = fitDeviceProfile(train, "roofline device", 180000, 0, ProfileForm::Additive);
+  ASSERT_EQ(roof.pipes.size(), 4u);
+  EXPECT_EQ(roof.scaledBy[kTermIndexedUniformLoads], kFeatureJointsPerWarp);
+  EXPECT_LT(heldOutRms(roof), 0.01);
+  EXPECT_GT(heldOutRms(sum), 0.05);
+  // The weights themselves: each pipe's, the per-vertex and the per-draw fixed costs.
+  const roofline::Device d;
+  EXPECT_NEAR(roof.pipes[0].nanoseconds[kTermLocations], d.location, 0.02);
+  EXPECT_NEAR(roof.pipes[1].nanoseconds[kTermIndexedUniformLoads], d.address, 0.02);
+  EXPECT_NEAR(roof.pipes[3].nanoseconds[kTermOutputs], d.output, 0.005);
+  EXPECT_NEAR(roof.nanoseconds[kTermVertices], d.vertexNs, 0.05);
+  EXPECT_NEAR(roof.drawNanoseconds[kTermVertices], d.drawNs, 40);
+  // Written and read back, it predicts the same (pipes, scaling and defaults included).
+  CalibrationReport r;
+  r.profile = roof;
+  DeviceProfile back = parseDeviceProfile(deviceProfileYaml(r), "roofline.yaml");
+  for (const auto& s : test) {
+    DeviceProfile a = roof, b = back;
+    a.workload = b.workload = s.workload;
+    EXPECT_NEAR(b.predictNanoseconds(s.amounts, s.vertices), a.predictNanoseconds(s.amounts, s.vertices),
+                1e-5 * s.measuredNs);
+  }
 }
 
 TEST(Calibrate, SpearmanTreatsTimesWithinTheSpreadAsTies) {

@@ -1,0 +1,46 @@
+// Fitting a device profile to timings (docs/device-profiles.md, "Calibration"): the weights
+// >= 0 that minimise the weighted relative error of predicted against measured ns per vertex,
+// solved by Ceres Solver (bounded nonlinear least squares). Two forms of model:
+//   additive  ns = sum_t (w_t + d_t / V) x_t                      (every profile before issue 33)
+//   roofline  ns = sum_t (w_t + d_t / V) x_t  +  max_p sum_{t in p} w_pt x_t
+// where x_t is the amount of term t, scaled by a workload feature where the form says so
+// (indexed uniform loads by the joints a warp reads), and V the vertices per draw. In the
+// roofline form the additive part holds the per-vertex fixed cost and the per-draw weights;
+// the pipes hold the rest (fetch: locations and attribute bytes; memory: storage-buffer and
+// indexed uniform loads; alu: arithmetic; output: outputs), which the device overlaps.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "search/device_profile.h"
+#include "search/workload.h"
+
+namespace sg {
+
+struct FitRow {
+  TermAmounts amounts{};
+  double vertices = 0;  // per draw
+  Workload workload;    // of the mesh it was timed on
+  double measuredNs = 0;
+  double weight = 1;  // of its squared relative error
+};
+
+enum class ProfileForm { Additive, Roofline };
+const char* profileFormName(ProfileForm form);  // "additive", "roofline"
+
+struct FitResult {
+  DeviceProfile profile;       // device and file left empty
+  double rmsRelativeError = 0;  // over the rows, unweighted
+  double maxRelativeError = 0;
+  bool converged = false;
+};
+
+// Per-draw weights only when the rows' draws differ in size (else they cannot be told apart
+// from per-vertex ones). Deterministic: same rows, same weights. Throws std::runtime_error
+// without rows.
+FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form);
+
+// The form's skeleton: pipes (empty for additive) and the workload scaling, weights zero.
+DeviceProfile profileForm(ProfileForm form);
+
+}  // namespace sg
