@@ -184,7 +184,8 @@ std::optional<ValidationResult> parseValidation(const std::string& body) {
   return r;
 }
 
-// What `generate` is given to make this variant (the validator regenerates its capture build).
+// What `generate` is given to make this variant (the build loads the files once and
+// prepares from them; the validator regenerates the capture build from these).
 GenerateOptions generateOptionsOf(const Manifest& m, const Variant& v) {
   GenerateOptions o;
   o.rigPath = v.rig->path;
@@ -214,17 +215,10 @@ void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v,
       break;
     }
   Rig rig = v.params.empty() ? base : rigWithParameters(base, v.params, paramsAt);
-  GenerateOptions o;
-  o.overrides = v.pass->maps;
-  o.conventions = v.pass->conventions;
-  o.maxError = m.maxError;
-  LoadedInputs in = prepareInputs(std::move(rig), s.rules, s.fragments.at(v.pass->fragment), o, s.profile);
-  o.heuristic = m.heuristic;
-  o.targetEnv = m.targetEnv;
-  o.optimize = m.optimize;
-  o.outputName = (fs::path(m.outputDir) / (v.name + ".vert")).string();
+  GenerateOptions o = generateOptionsOf(m, v);
   if (m.emits("hlsl")) o.hlsl = m.hlsl;
   if (m.emits("msl")) o.msl = m.msl;
+  LoadedInputs in = prepareInputs(std::move(rig), s.rules, s.fragments.at(v.pass->fragment), o, s.profile);
   GenerateResult r = generateWith(std::move(in), s.templates, o);
   out.cost = r.plan.cost;
   for (int a : r.plan.actions) out.rules.push_back(r.in.problem.actions[a].name);
