@@ -156,7 +156,6 @@ server_killed)  # the server dies mid-build: the build completes from local work
   ;;
 
 corrupt | truncated)  # a damaged entry on the server: rejected, rebuilt, overwritten
-  reference
   start_nginx
   small_manifest m.yaml
   "$SG" build m.yaml -o a --cache-dir cache-a --cache-url "$URL" >a.out 2>a.err ||
@@ -164,8 +163,9 @@ corrupt | truncated)  # a damaged entry on the server: rejected, rebuilt, overwr
   victim=$(server_entries | head -1)
   key=$(basename "$victim")
   if [ "$case_name" = corrupt ]; then
-    size=$(stat -c %s "$victim")
-    printf 'X' | dd of="$victim" bs=1 seek=$((size / 2)) conv=notrunc status=none
+    at=$(($(stat -c %s "$victim") / 2))  # one byte changed: its value plus one
+    byte=$(dd if="$victim" bs=1 skip=$at count=1 status=none | od -An -tu1 | tr -d ' ')
+    printf "\\x$(printf %02x $(((byte + 1) % 256)))" | dd of="$victim" bs=1 seek=$at conv=notrunc status=none
   else
     truncate -s $(($(stat -c %s "$victim") * 2 / 3)) "$victim"
   fi
@@ -173,7 +173,7 @@ corrupt | truncated)  # a damaged entry on the server: rejected, rebuilt, overwr
   check "build with a $case_name entry succeeds" [ $? -eq 0 ]
   check "the entry is reported" grep -q "warning: remote cache entry $key rejected: its SHA-256 does not match" b.err
   check "summary counts it" grep -q "3 hits, 1 stored, 1 entries rejected" b.out
-  check "outputs as without a cache" same_outputs ref b
+  check "outputs as the undamaged cache gave" same_outputs a b
   check "the server's entry was rewritten" all_entries_verify "$T/nginx/root"
   "$SG" build m.yaml -o c --cache-dir cache-c --cache-url "$URL" >c.out 2>c.err
   check "a third tree finds all 4 intact" grep -q "4 hits, 0 stored, 0 entries rejected" c.out
