@@ -3,11 +3,12 @@
 # with WebDAV PUT, listening on 127.0.0.1 only, everything it writes (configuration, pid,
 # logs, temporaries, the entries) under one directory, run as a child of the caller.
 #
-#   nginx_dav_start DIR   sets NGINX_PID, PORT and URL (http://127.0.0.1:PORT/cache)
+#   nginx_dav_start DIR [DIRECTIVES]   sets NGINX_PID, PORT and URL (http://127.0.0.1:PORT/cache);
+#                                      DIRECTIVES go into the cache's location (auth_basic ...)
 #   nginx_dav_stop        SIGKILL and reap it (nothing to do when it is not running)
 NGINX_PID=""
 nginx_dav_start() {
-  local dir=$1 nginx attempt
+  local dir=$1 extra=${2:-} nginx attempt
   nginx=$(command -v nginx || echo /usr/sbin/nginx)
   mkdir -p "$dir/root" "$dir/tmp"
   for attempt in 1 2 3 4 5 6 7 8; do  # a random free port; another on "address in use"
@@ -31,6 +32,7 @@ http {
       dav_methods PUT;           # the body goes to a temporary file, renamed into place
       create_full_put_path on;   # ab/abcd...: the two-hex-digit folder on first use
       dav_access user:rw;
+      $extra
     }
   }
 }

@@ -34,7 +34,7 @@ check() {  # check <description> <command...>: passes when the command succeeds
 
 # ---- the server (tests/support/nginx_dav.sh) ---------------------------------------------
 source "$SRC/tests/support/nginx_dav.sh"
-start_nginx() { nginx_dav_start "$T/nginx"; }
+start_nginx() { nginx_dav_start "$T/nginx" "${1:-}"; }
 stop_nginx() { nginx_dav_stop; }
 server_entries() { find "$T/nginx/root" -type f | sort; }
 
@@ -243,11 +243,22 @@ credentials)  # credentials only from the environment, never printed
   "$SG" build m2.yaml -o a >b.out 2>b.err
   check "a manifest with credentials is refused" [ $? -ne 0 ]
   check "  ... naming the line" grep -q "m2.yaml: error: line 12: .cache_url. .http://\*\*\*@127.0.0.1:9/c. holds credentials" b.err
+  # A server that wants them (HTTP basic authentication, nginx's {PLAIN} password scheme).
+  printf 'builder:{PLAIN}pw0rd\n' >"$T/htpasswd"
+  start_nginx "auth_basic cache; auth_basic_user_file $T/htpasswd;"
+  "$SG" build m.yaml -o c --cache-dir cache-c --cache-url "$URL" >c.out 2>c.err
+  check "without credentials: built, one warning (HTTP 401)" \
+    [ $? -eq 0 -a "$(grep -c 'answered HTTP 401' c.err)" -eq 1 ]
+  SHADERGEN_CACHE_AUTH=builder:pw0rd "$SG" build m.yaml -o d --cache-dir cache-d --cache-url "$URL" >d.out 2>d.err
+  check "SHADERGEN_CACHE_AUTH: entries stored" grep -q "0 hits, 4 stored" d.out
+  SHADERGEN_CACHE_URL=${URL/http:\/\//http://builder:pw0rd@} "$SG" build m.yaml -o e --cache-dir cache-e >e.out 2>e.err
+  check "credentials in SHADERGEN_CACHE_URL: entries read" grep -q "remote cache http://\*\*\*@127.0.0.1:$PORT/cache: 4 hits" e.out
+  stop_nginx
   SHADERGEN_CACHE_URL=http://user:s3cret@127.0.0.1:9/c SHADERGEN_CACHE_AUTH=u:pw0rd \
-    "$SG" build m.yaml -o a >c.out 2>c.err
-  check "credentials from the environment are taken" [ $? -eq 0 ]
-  check "  ... and the warning redacts them" grep -q "remote cache http://\*\*\*@127.0.0.1:9/c unreachable" c.err
-  check "no secret in any output" bash -c "! grep -q -e s3cret -e pw0rd a.out a.err b.out b.err c.out c.err"
+    "$SG" build m.yaml -o f >f.out 2>f.err
+  check "unreachable with credentials: built" [ $? -eq 0 ]
+  check "  ... and the warning redacts them" grep -q "remote cache http://\*\*\*@127.0.0.1:9/c unreachable" f.err
+  check "no secret in any output" bash -c "! grep -q -e s3cret -e pw0rd ?.out ?.err"
   ;;
 
 validate_dawn | validate_model)  # a planted wrong rule fails the build and names the variants
