@@ -27,8 +27,10 @@ packages=(
   libembree-dev
   libpng-dev
   spirv-cross libspirv-cross-c-shared-dev
+  libssl-dev libcurl4-openssl-dev  # `build`: SHA-256 (libcrypto), the shared cache's HTTP client
 )
-test_packages=(libgtest-dev libgmock-dev libbenchmark-dev graphviz)
+# nginx: the shared cache's server in tests/variants (Debian's nginx has http_dav_module).
+test_packages=(libgtest-dev libgmock-dev libbenchmark-dev graphviz nginx)
 sanitize_packages=(clang-14 libclang-rt-14-dev)
 case "$what" in
   dawn) ;;

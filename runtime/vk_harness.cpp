@@ -35,6 +35,7 @@ struct DeviceInfo {
   VkPhysicalDevice pd = VK_NULL_HANDLE;
   VkPhysicalDeviceProperties props{};
   VkDriverId driverID{};
+  std::string driver;  // "llvmpipe Mesa 22.3.6 (LLVM 15.0.6)": driver name and version
   bool xfb = false;
   VkPhysicalDeviceTransformFeedbackPropertiesEXT xfbProps{};
 };
@@ -61,6 +62,8 @@ DeviceInfo describe(VkPhysicalDevice pd) {
   vkGetPhysicalDeviceProperties2(pd, &p2);
   info.xfbProps.pNext = nullptr;
   info.driverID = drv.driverID;
+  info.driver = drv.driverName[0] ? fmt::format("{} {}", drv.driverName, drv.driverInfo)
+                                  : fmt::format("driver version {:#x}", info.props.driverVersion);
 
   VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
   VkPhysicalDeviceTransformFeedbackFeaturesEXT xfbFeat{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_TRANSFORM_FEEDBACK_FEATURES_EXT};
@@ -283,6 +286,7 @@ Harness::~Harness() {
 
 const std::vector<std::string>& Harness::validationMessages() const { return impl_->messages; }
 std::string Harness::deviceName() const { return impl_->dev.props.deviceName; }
+std::string Harness::driver() const { return impl_->dev.driver; }
 bool Harness::validationEnabled() const { return impl_->validation; }
 const VkPhysicalDeviceLimits& Harness::limits() const { return impl_->dev.props.limits; }
 Harness::Handles Harness::handles() const { return {impl_->dev.pd, impl_->device, impl_->queueFamily, impl_->queue}; }

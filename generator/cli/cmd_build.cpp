@@ -12,6 +12,7 @@
 
 #include "cli/commands.h"
 #include "cli/output_files.h"
+#include "validate/variant_validation.h"
 #include "variants/builder.h"
 
 namespace sg {
@@ -38,6 +39,8 @@ struct BuildCommand {
   bool quiet = false;
   bool progress = false;
   bool list = false;
+  bool validate = false;
+  std::string cacheUrl;
 
   int run() {
     if (noCache && !cacheDir.empty())
@@ -55,7 +58,29 @@ struct BuildCommand {
     }
     BuildOptions bo;
     bo.jobs = jobs;
-    if (!noCache) bo.cacheDir = cacheDir.empty() ? (std::filesystem::path(m.outputDir) / ".shadergen-cache").string() : cacheDir;
+    if (!noCache) {
+      bo.cacheDir = cacheDir.empty() ? (std::filesystem::path(m.outputDir) / ".shadergen-cache").string() : cacheDir;
+      try {
+        bo.cacheUrl = chooseCacheUrl(cacheUrl, m.cacheUrl);
+      } catch (const std::invalid_argument& e) {
+        throw CLI::ValidationError("--cache-url", e.what());
+      }
+      if (const char* auth = std::getenv("SHADERGEN_CACHE_AUTH")) bo.cacheAuth = auth;
+    } else if (!cacheUrl.empty()) {
+      throw CLI::ValidationError("--cache-url", "does not apply with --no-cache");
+    }
+    bo.warn = [](const std::string& w) { std::cerr << "shadergen: warning: " << w << "\n"; };
+    // Validation opens the device once (its name and driver are part of every result's key).
+    std::unique_ptr<DeviceVariantValidator> validator;
+    if (validate || m.validate.enabled) {
+      try {
+        validator = std::make_unique<DeviceVariantValidator>(m.validate);
+      } catch (const std::runtime_error& e) {
+        throw InputError(m.validate.loc.file.empty() ? SourceLoc{m.file, 0, 0} : m.validate.loc,
+                         fmt::format("cannot validate: {}", e.what()));
+      }
+      bo.validator = validator.get();
+    }
     // Progress on a terminal, quiet in CI and in logs.
     bool showProgress = progress || (!quiet && isatty(STDERR_FILENO) && !std::getenv("CI"));
     if (showProgress)
@@ -76,12 +101,27 @@ struct BuildCommand {
       if (f.path == r.indexPath || f.path == r.indexPath + ".d" || !sameContents(f.path, f.contents))
         changed.push_back({f.path, f.contents});
     if (!changed.empty()) writeFilesAtomically(changed);
+    if (r.failed) {  // an index left from an earlier build must not vouch for this one's outputs
+      std::error_code ec;
+      const std::string index = (std::filesystem::path(m.outputDir) / "index.json").string();
+      std::filesystem::remove(index, ec);
+      std::filesystem::remove(index + ".d", ec);
+    }
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!quiet)
       std::cout << fmt::format("{} variants: {} generated, {} from the cache, {} failed; {} share another's SPIR-V; "
                                "{} files written ({:.2f} s)\n",
                                r.variants.size(), r.generated, r.cached, r.failed, r.sharedSpirv, changed.size(),
                                seconds);
+    if (!quiet && bo.validator)
+      std::cout << fmt::format("validated on {}: {} run, {} from the cache\n", validator->deviceName(), r.validated,
+                               r.validationsCached);
+    if (!quiet && !bo.cacheUrl.empty())
+      std::cout << fmt::format("remote cache {}: {} hits, {} stored, {} entries rejected{}\n", redactUrl(bo.cacheUrl),
+                               r.cache.remoteHits, r.cache.remoteStores, r.cache.rejected,
+                               r.cache.remoteFailed ? " (unreachable: built without it)" : "");
+    else if (!quiet && r.cache.rejected)
+      std::cout << fmt::format("cache: {} entries rejected (corrupt), rebuilt\n", r.cache.rejected);
     return r.failed ? 1 : 0;
   }
 };
@@ -103,6 +143,13 @@ void registerBuild(CLI::App& app, CliState& state) {
   sub->add_flag("-q,--quiet", cmd->quiet, "No progress and no summary");
   sub->add_flag("--progress", cmd->progress, "Show progress even when standard error is not a terminal");
   sub->add_flag("--list", cmd->list, "Print the variant names (one a line) and build nothing");
+  sub->add_flag("--validate", cmd->validate,
+                "Validate every variant on a Vulkan device (lavapipe by default) with the manifest's 'validate' "
+                "settings; results are cached");
+  sub->add_option("--cache-url", cmd->cacheUrl,
+                  "Shared cache server (HTTP GET/PUT, e.g. nginx WebDAV) over the local cache (default: "
+                  "$SHADERGEN_CACHE_URL, then the manifest's 'cache_url'); credentials only from the environment "
+                  "(SHADERGEN_CACHE_AUTH=user:password)");
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }
 

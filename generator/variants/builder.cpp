@@ -1,11 +1,9 @@
 #include "variants/builder.h"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <atomic>
 #include <filesystem>
-#include <fstream>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -109,15 +107,18 @@ std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v,
   return h.hex();
 }
 
-// ---- the cache: one file per key, written to a temporary and renamed into place ---------
+// ---- cache entries (cache_store.h seals, stores and verifies them) ---------------------
 
-std::string entryPath(const std::string& dir, const std::string& key) {
-  return (fs::path(dir) / key.substr(0, 2) / key).string();
+std::string generatedBody(const BuiltVariant& v) {
+  std::string rules;
+  for (const auto& r : v.rules) rules += " " + r;
+  return fmt::format("{}\ncost {}\nrules{}\nglsl {}\n{}spirv {}\n{}reflection {}\n{}hlsl {}\n{}msl {}\n{}", kCacheFormat,
+                     v.cost, rules, v.glsl.size(), v.glsl, v.spirv.size(), v.spirv, v.reflection.size(),
+                     v.reflection, v.hlsl.size(), v.hlsl, v.msl.size(), v.msl);
 }
 
-bool readEntry(const std::string& path, BuiltVariant& out) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
+bool parseGenerated(const std::string& body, BuiltVariant& out) {
+  std::istringstream in(body);
   std::string line;
   if (!std::getline(in, line) || line != kCacheFormat) return false;
   if (!std::getline(in, line) || line.rfind("cost ", 0) != 0) return false;
@@ -138,36 +139,69 @@ bool readEntry(const std::string& path, BuiltVariant& out) {
     } catch (const std::exception&) {
       return false;
     }
-    if (n > (64u << 20)) return false;
+    if (n > body.size()) return false;
     blob->assign(n, '\0');
     if (!in.read(blob->data(), static_cast<std::streamsize>(n))) return false;
   }
   return in.peek() == std::char_traits<char>::eof() && out.spirv.size() % 4 == 0;
 }
 
-void writeEntry(const std::string& path, const BuiltVariant& v) {
-  std::string rules;
-  for (const auto& r : v.rules) rules += " " + r;
-  std::string text = fmt::format("{}\ncost {}\nrules{}\nglsl {}\n{}spirv {}\n{}reflection {}\n{}hlsl {}\n{}msl {}\n{}",
-                                 kCacheFormat, v.cost, rules, v.glsl.size(), v.glsl, v.spirv.size(), v.spirv,
-                                 v.reflection.size(), v.reflection, v.hlsl.size(), v.hlsl, v.msl.size(), v.msl);
-  static std::atomic<unsigned> counter{0};
-  std::error_code ec;
-  fs::create_directories(fs::path(path).parent_path(), ec);
-  // Unique per process and write: two builds sharing the cache never see a partial entry.
-  std::string tmp = fmt::format("{}.tmp.{}.{}", path, static_cast<int>(getpid()), counter++);
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return;  // a read-only cache only costs speed
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    if (!out) {
-      out.close();
-      fs::remove(tmp, ec);
-      return;
-    }
+// A passing validation result (failures are never cached: the next build runs them again).
+constexpr const char* kValidationFormat = "shadergen-validation 1";
+
+std::string validationBody(const ValidationResult& r) {
+  return fmt::format("{}\ndevice {}\ndriver {}\ntool {}\nmade {}\nruns {}\nworst {}\nmax_abs_error {:.17g}\n"
+                     "max_rel_error {:.17g}\n",
+                     kValidationFormat, r.device, r.driver, r.tool, r.made, r.runs, r.worstOutput, r.maxAbsError,
+                     r.maxRelError);
+}
+
+std::optional<ValidationResult> parseValidation(const std::string& body) {
+  std::istringstream in(body);
+  std::string line;
+  if (!std::getline(in, line) || line != kValidationFormat) return std::nullopt;
+  ValidationResult r;
+  r.pass = true;
+  std::map<std::string, std::string> fields;
+  while (std::getline(in, line)) {
+    size_t sp = line.find(' ');
+    fields[line.substr(0, sp)] = sp == std::string::npos ? "" : line.substr(sp + 1);
   }
-  fs::rename(tmp, path, ec);
-  if (ec) fs::remove(tmp, ec);
+  for (const char* k : {"device", "driver", "tool", "made", "runs", "worst", "max_abs_error", "max_rel_error"})
+    if (!fields.count(k)) return std::nullopt;
+  try {
+    r.runs = std::stoul(fields["runs"]);
+    r.maxAbsError = std::stod(fields["max_abs_error"]);
+    r.maxRelError = std::stod(fields["max_rel_error"]);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  r.device = fields["device"];
+  r.driver = fields["driver"];
+  r.tool = fields["tool"];
+  r.made = fields["made"];
+  r.worstOutput = fields["worst"];
+  return r;
+}
+
+// What `generate` is given to make this variant (the build loads the files once and
+// prepares from them; the validator regenerates the capture build from these).
+GenerateOptions generateOptionsOf(const Manifest& m, const Variant& v) {
+  GenerateOptions o;
+  o.rigPath = v.rig->path;
+  o.fragmentPath = v.pass->fragment;
+  o.rulesPaths = m.rules;
+  o.overrides = v.pass->maps;
+  o.conventions = v.pass->conventions;
+  o.rigParams = v.params;
+  o.maxError = m.maxError;
+  o.heuristic = m.heuristic;
+  o.templateDir = m.templates;
+  o.targetEnv = m.targetEnv;
+  o.optimize = m.optimize;
+  o.deviceProfilePath = m.deviceProfile;
+  o.outputName = (fs::path(m.outputDir) / (v.name + ".vert")).string();
+  return o;
 }
 
 // ---- one variant ------------------------------------------------------------------------
@@ -181,17 +215,10 @@ void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v,
       break;
     }
   Rig rig = v.params.empty() ? base : rigWithParameters(base, v.params, paramsAt);
-  GenerateOptions o;
-  o.overrides = v.pass->maps;
-  o.conventions = v.pass->conventions;
-  o.maxError = m.maxError;
-  LoadedInputs in = prepareInputs(std::move(rig), s.rules, s.fragments.at(v.pass->fragment), o, s.profile);
-  o.heuristic = m.heuristic;
-  o.targetEnv = m.targetEnv;
-  o.optimize = m.optimize;
-  o.outputName = (fs::path(m.outputDir) / (v.name + ".vert")).string();
+  GenerateOptions o = generateOptionsOf(m, v);
   if (m.emits("hlsl")) o.hlsl = m.hlsl;
   if (m.emits("msl")) o.msl = m.msl;
+  LoadedInputs in = prepareInputs(std::move(rig), s.rules, s.fragments.at(v.pass->fragment), o, s.profile);
   GenerateResult r = generateWith(std::move(in), s.templates, o);
   out.cost = r.plan.cost;
   for (int a : r.plan.actions) out.rules.push_back(r.in.problem.actions[a].name);
@@ -202,13 +229,14 @@ void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v,
   if (r.msl) out.msl = r.msl->text;
 }
 
-void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts, BuiltVariant& out) {
+void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts, CacheStore& store,
+              const std::string& validatorIdentity, BuiltVariant& out) {
   const Variant& v = *out.variant;
   out.inputs = inputsOf(s, v);
   out.key = cacheKey(m, s, v, out.inputs);
-  std::string entry = opts.cacheDir.empty() ? "" : entryPath(opts.cacheDir, out.key);
-  BuiltVariant fromCache;
-  if (!entry.empty() && readEntry(entry, fromCache)) {
+  BuiltVariant fromCache;  // read into its own record, so nothing leaks from a damaged entry
+  std::optional<std::string> body = store.enabled() ? store.get(out.key) : std::nullopt;
+  if (body && parseGenerated(*body, fromCache)) {
     out.cost = fromCache.cost;
     out.rules = std::move(fromCache.rules);
     out.glsl = std::move(fromCache.glsl);
@@ -217,11 +245,11 @@ void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts
     out.hlsl = std::move(fromCache.hlsl);
     out.msl = std::move(fromCache.msl);
     out.ok = out.cached = true;
-  } else {  // a miss, or a damaged entry (read into its own record, so nothing leaks from it)
+  } else {
     try {
       generateVariant(m, s, v, out);
       out.ok = true;
-      if (!entry.empty()) writeEntry(entry, out);
+      if (store.enabled()) store.put(out.key, generatedBody(out));
     } catch (const InputError& e) {
       out.errors.push_back(e.diagnostic());
       out.errors.insert(out.errors.end(), e.related.begin(), e.related.end());
@@ -230,6 +258,36 @@ void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts
     }
   }
   if (out.ok) out.spirvHash = sha256Hex(out.spirv);
+  if (!out.ok || !opts.validator) return;
+  // The result's key: the outputs' key, the validation settings, the device and driver.
+  const std::string key = Sha256().field(kValidationFormat).field(out.key).field(validatorIdentity).hex();
+  if (auto cached = store.enabled() ? store.get(key) : std::nullopt) {
+    if (auto r = parseValidation(*cached)) {
+      out.validation = std::move(r);
+      out.validationCached = true;
+      return;
+    }
+  }
+  try {
+    out.validation = opts.validator->validate(v, generateOptionsOf(m, v));
+  } catch (const InputError& e) {
+    out.validation = ValidationResult{};
+    out.validation->errors.push_back(e.diagnostic());
+    out.validation->errors.insert(out.validation->errors.end(), e.related.begin(), e.related.end());
+  } catch (const std::exception& e) {
+    out.validation = ValidationResult{};
+    out.validation->errors.push_back(Diagnostic{Severity::Error, SourceLoc{m.file, 0, 0}, e.what()});
+  }
+  if (out.validation->pass) {
+    if (store.enabled()) store.put(key, validationBody(*out.validation));
+    return;
+  }
+  // A variant that does not validate fails the build: its outputs are not written.
+  out.ok = false;
+  out.errors.push_back(Diagnostic{Severity::Error, m.validate.loc.file.empty() ? SourceLoc{m.file, 0, 0} : m.validate.loc,
+                                  fmt::format("variant '{}' does not validate{}", v.name,
+                                              out.validation->device.empty() ? "" : " on " + out.validation->device)});
+  out.errors.insert(out.errors.end(), out.validation->errors.begin(), out.validation->errors.end());
 }
 
 // ---- the index --------------------------------------------------------------------------
@@ -292,6 +350,12 @@ std::string indexJson(const Manifest& m, const BuildReport& r) {
     for (const auto& rule : b.rules) rules += (rules.empty() ? "" : ", ") + jsonString(rule);
     out += fmt::format("      \"rules\": [{}],\n", rules);
     out += fmt::format("      \"spirv_sha256\": {},\n", jsonString(b.spirvHash));
+    out += fmt::format("      \"validated\": {},\n", b.validation ? "true" : "false");
+    if (const auto& val = b.validation)  // where and when the result was made (cached with it)
+      out += fmt::format("      \"validation\": {{\"device\": {}, \"driver\": {}, \"shadergen\": {}, \"made\": {}, "
+                         "\"runs\": {}, \"worst_output\": {}, \"max_abs_error\": {:.17g}, \"max_rel_error\": {:.17g}}},\n",
+                         jsonString(val->device), jsonString(val->driver), jsonString(val->tool), jsonString(val->made),
+                         val->runs, jsonString(val->worstOutput), val->maxAbsError, val->maxRelError);
     std::string outputs;
     for (const auto& [kind, path] : b.outputs)
       outputs += fmt::format("{}{}: {}", outputs.empty() ? "" : ", ", jsonString(kind),
@@ -307,6 +371,8 @@ std::string indexJson(const Manifest& m, const BuildReport& r) {
 
 BuildReport buildVariants(const Manifest& m, const std::vector<Variant>& variants, const BuildOptions& opts) {
   SharedInputs shared = loadShared(m, variants);
+  CacheStore store({opts.cacheDir, opts.cacheUrl, opts.cacheAuth, 1500, 20000, opts.warn});
+  const std::string identity = opts.validator ? opts.validator->identity() : "";
   BuildReport report;
   report.variants.resize(variants.size());
   for (size_t i = 0; i < variants.size(); ++i) report.variants[i].variant = &variants[i];
@@ -318,7 +384,7 @@ BuildReport buildVariants(const Manifest& m, const std::vector<Variant>& variant
   size_t done = 0;
   auto work = [&] {
     for (size_t i; (i = next++) < variants.size();) {
-      buildOne(m, shared, opts, report.variants[i]);
+      buildOne(m, shared, opts, store, identity, report.variants[i]);
       if (opts.progress) {
         std::lock_guard<std::mutex> lock(progressLock);
         opts.progress(++done, variants.size(), variants[i].name, report.variants[i].cached);
@@ -335,7 +401,9 @@ BuildReport buildVariants(const Manifest& m, const std::vector<Variant>& variant
   // Outputs, identical SPIR-V once (content-addressed), a depfile per variant, the index.
   std::set<std::string> spirvWritten;
   std::set<std::string> allInputs{m.file};
+  report.cache = store.stats();
   for (auto& b : report.variants) {
+    if (b.validation && b.validation->pass) ++(b.validationCached ? report.validationsCached : report.validated);
     if (!b.ok) {
       ++report.failed;
       continue;

@@ -7,16 +7,48 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/diagnostics.h"
+#include "pipeline/generate.h"
+#include "variants/cache_store.h"
 #include "variants/manifest.h"
 
 namespace sg {
 
+// What validating a variant found. A passing result is cached (docs/variants.md,
+// "Validated variants"), with the time it was made: a cache hit reproduces the index's bytes.
+struct ValidationResult {
+  bool pass = false;
+  std::string device, driver;  // where it ran
+  std::string tool;            // the shadergen version that made it
+  std::string made;            // UTC, ISO 8601: when the result was made
+  size_t runs = 0;             // plans run (with cross-check, every alternative too)
+  std::string worstOutput;     // the output with the largest relative error, and its errors
+  double maxAbsError = 0, maxRelError = 0;
+  std::vector<Diagnostic> errors;  // when !pass: why, the variant's failing outputs
+};
+
+// Runs built variants on a device (validate/variant_validation.h implements it with the
+// `validate` command's Validator): the variants stage only calls it.
+class VariantValidator {
+ public:
+  virtual ~VariantValidator() = default;
+  // Everything a result depends on besides the variant's inputs (its cache key): the
+  // settings, the device and its driver, the tool version. Hashed into the result's key.
+  virtual std::string identity() const = 0;
+  // Validates the plan `gen` makes for `v` (the variant as built). Called from worker threads.
+  virtual ValidationResult validate(const Variant& v, const GenerateOptions& gen) = 0;
+};
+
 struct BuildOptions {
-  std::string cacheDir;  // "" = no cache
+  std::string cacheDir;  // "" = no local cache
+  std::string cacheUrl;  // "" = no remote cache (cache_store.h); credentials from cacheAuth only
+  std::string cacheAuth;
+  std::function<void(const std::string&)> warn;  // cache warnings (under a lock)
+  VariantValidator* validator = nullptr;         // validate every variant (nullptr = do not)
   unsigned jobs = 0;     // 0 = every hardware thread
   // Called (under a lock) as each variant finishes.
   std::function<void(size_t done, size_t total, const std::string& variant, bool cached)> progress;
@@ -35,6 +67,8 @@ struct BuiltVariant {
   std::string spirvHash;               // SHA-256 of the SPIR-V
   std::vector<std::string> inputs;     // every file it was made from (depfile)
   std::map<std::string, std::string> outputs;  // kind -> path written
+  std::optional<ValidationResult> validation;  // when validated (passing, or why it failed)
+  bool validationCached = false;                // the result came from the cache
 };
 
 struct OutputFile {
@@ -47,6 +81,8 @@ struct BuildReport {
   std::vector<OutputFile> files;       // to write; deterministic order and bytes
   std::string indexPath;
   size_t cached = 0, generated = 0, failed = 0, sharedSpirv = 0;
+  size_t validated = 0, validationsCached = 0;  // validations run, and taken from the cache
+  CacheStoreStats cache;
 };
 
 // Builds every variant. Throws InputError when a shared input (rig, rules, fragment shader,

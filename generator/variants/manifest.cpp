@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -10,6 +11,7 @@
 #include "common/yaml_util.h"
 #include "rig/gltf_import.h"
 #include "rig/vertex_encoding.h"
+#include "variants/cache_store.h"
 
 namespace sg {
 namespace {
@@ -42,6 +44,63 @@ bool safeStem(const std::string& s) {
   return true;
 }
 
+double finiteNonNegative(const YamlCtx& y, const YAML::Node& n, const char* what) {
+  const std::string text = y.scalar(n, what);
+  size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || !std::isfinite(v) || v < 0)
+    y.fail(n, fmt::format("{} '{}' is not a finite non-negative number", what, text));
+  return v;
+}
+
+// `validate: true`, or a map of the `validate` command's options.
+ManifestValidation parseValidation(const YamlCtx& y, const YAML::Node& n) {
+  ManifestValidation v;
+  v.loc = locOf(n, y.file);
+  if (n.IsScalar()) {
+    v.enabled = y.boolean(n, "'validate' (true, false or a map of settings)");
+    return v;
+  }
+  y.expectMap(n, "'validate' (true, false or a map of settings)");
+  y.checkKeys(n, {"mesh", "seed", "poses", "time", "animation", "morph_weight", "tolerance_abs", "tolerance_rel",
+                  "cross_check", "strict", "float_check", "validation_layers", "device"});
+  v.enabled = true;
+  if (n["mesh"]) {
+    v.mesh = y.scalar(n["mesh"], "'mesh'");
+    if (v.mesh != "head" && v.mesh != "limb" && v.mesh != "dawn")
+      y.fail(n["mesh"], fmt::format("unknown mesh '{}' (head, limb, dawn)", v.mesh));
+  }
+  if (n["seed"]) {
+    long long s = y.integer(n["seed"], "'seed'");
+    if (s < 0 || s > 0xffffffffll) y.fail(n["seed"], "'seed' is 0..4294967295");
+    v.seed = static_cast<uint32_t>(s);
+  }
+  if (n["poses"]) {
+    long long p = y.integer(n["poses"], "'poses'");
+    if (p < 1 || p > 100) y.fail(n["poses"], "a count of poses is 1..100");
+    v.poses = static_cast<int>(p);
+  }
+  if (n["time"] && n["time"].IsSequence())
+    for (const auto& t : n["time"]) v.times.push_back(finiteNonNegative(y, t, "a time"));
+  else if (n["time"])
+    v.times.push_back(finiteNonNegative(y, n["time"], "a time"));
+  if (n["animation"]) v.animation = y.scalar(n["animation"], "'animation'");
+  if (n["morph_weight"]) v.morphWeight = finiteNonNegative(y, n["morph_weight"], "'morph_weight'");
+  if (n["tolerance_abs"]) v.toleranceAbs = finiteNonNegative(y, n["tolerance_abs"], "'tolerance_abs'");
+  if (n["tolerance_rel"]) v.toleranceRel = finiteNonNegative(y, n["tolerance_rel"], "'tolerance_rel'");
+  if (n["cross_check"]) v.crossCheck = y.boolean(n["cross_check"], "'cross_check'");
+  if (n["strict"]) v.strict = y.boolean(n["strict"], "'strict'");
+  if (n["float_check"]) v.floatCheck = y.boolean(n["float_check"], "'float_check'");
+  if (n["validation_layers"]) v.validationLayers = y.boolean(n["validation_layers"], "'validation_layers'");
+  if (n["device"]) v.device = y.scalar(n["device"], "'device'");
+  return v;
+}
+
 }  // namespace
 
 bool Manifest::emits(const std::string& kind) const { return std::find(emit.begin(), emit.end(), kind) != emit.end(); }
@@ -56,7 +115,7 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
   y.expectMap(root, "a manifest");
   y.checkKeys(root, {"output", "rules", "templates", "target_env", "optimize", "heuristic", "emit", "rigs", "passes",
                      "axes", "exclude", "name", "device_profile", "max_error", "hlsl_shader_model", "msl_version",
-                     "msl_platform"});
+                     "msl_platform", "validate", "cache_url"});
   m.outputDir = resolvePath(file, root["output"] ? y.scalar(root["output"], "'output'") : "shaders");
   if (!root["rules"]) y.fail(root, "the manifest needs 'rules' (a rules file or a list of them)");
   for (const auto& r : scalarOrList(y, root["rules"], "'rules'")) m.rules.push_back(resolvePath(file, r));
@@ -104,6 +163,18 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
     y.fail(root["msl_version"], fmt::format("unsupported Metal Shading Language version '{}' (supported: {})", v, kMslVersions));
   if (std::string v = translation("msl_platform", "msl"); !v.empty() && !parseMslPlatform(v, m.msl.platform))
     y.fail(root["msl_platform"], fmt::format("unknown Metal platform '{}' (macos, ios)", v));
+
+  if (root["validate"]) m.validate = parseValidation(y, root["validate"]);
+  if (root["cache_url"]) {
+    m.cacheUrl = y.scalar(root["cache_url"], "'cache_url'");
+    // A manifest is a file in the repository. The error gives the line in its text, not as a
+    // location: a located error quotes the line, and with it the secret, into the log.
+    if (redactUrl(m.cacheUrl) != m.cacheUrl)
+      throw InputError(SourceLoc{file, 0, 0},
+                       fmt::format("line {}: 'cache_url' '{}' holds credentials; they come only from the environment "
+                                   "(SHADERGEN_CACHE_AUTH=user:password, or the URL in SHADERGEN_CACHE_URL)",
+                                   locOf(root["cache_url"], file).line, redactUrl(m.cacheUrl)));
+  }
 
   std::map<std::string, std::vector<std::string>> wholeModels;  // rig name -> its primitives' rig names
   if (!root["rigs"]) y.fail(root, "the manifest needs 'rigs' (name: rig file)");

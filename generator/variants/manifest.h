@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,25 @@ struct ManifestExclusion {
   SourceLoc loc;
 };
 
+// `validate:` (docs/variants.md, "Validated variants"): how `build --validate` runs each
+// variant, as the `validate` command's options say it for one shader.
+struct ManifestValidation {
+  bool enabled = false;        // the manifest asks for it (`build --validate` also turns it on)
+  std::string mesh = "head";   // YAML rigs: procedural mesh (head, limb, dawn)
+  uint32_t seed = 1;           // YAML rigs: seed of the random poses
+  int poses = 2;               // YAML rigs: how many (1..100)
+  std::vector<double> times;   // glTF rigs: animation times (empty: validate's default)
+  std::string animation;       // glTF rigs: name or index ("" = the first)
+  std::optional<double> morphWeight;  // glTF rigs: every morph target at this weight
+  double toleranceAbs = 1e-6, toleranceRel = 1e-5;
+  bool crossCheck = false;
+  bool strict = false;
+  bool floatCheck = true;
+  bool validationLayers = true;
+  std::string device;          // Vulkan device name (substring); "" = lavapipe
+  SourceLoc loc;
+};
+
 struct Manifest {
   std::string file;
   std::string outputDir;               // relative paths resolved against the manifest
@@ -63,6 +83,8 @@ struct Manifest {
   std::string deviceProfile;  // `device_profile:` (docs/device-profiles.md); "" = instruction slots
   HlslOptions hlsl;           // `hlsl_shader_model:`, when emit has hlsl (docs/hlsl-msl.md)
   MslOptions msl;             // `msl_version:`, `msl_platform:`, when emit has msl
+  ManifestValidation validate;  // `validate:`
+  std::string cacheUrl;         // `cache_url:`, the shared cache (no credentials here)
   bool emits(const std::string& kind) const;
 };
 

@@ -4,6 +4,7 @@
 // whatever the thread count, and failures that leave the index out.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -14,6 +15,7 @@
 #include "emit/reflection.h"
 #include "pipeline/generate.h"
 #include "variants/builder.h"
+#include "variants/cache_store.h"
 #include "variants/content_hash.h"
 #include "variants/manifest.h"
 
@@ -57,7 +59,13 @@ std::map<std::string, std::string> filesOf(const BuildReport& r) {
 
 }  // namespace
 
+// NIST's examples (FIPS 180-2, appendix B; the CAVS SHA256ShortMsg 8-bit message): the
+// keys are SHA-256, whichever implementation computes them (OpenSSL's libcrypto).
 TEST(Sha256, KnownVectors) {
+  EXPECT_EQ(sha256Hex("\xd3"), "28969cdfa74a12c82f3bad960b0b000aca2ac329deea5c2328ebc6f2ba9802c1");
+  EXPECT_EQ(sha256Hex("abcdefghbcdefghicdefghijdefghijkefghijklfghijklmghijklmnhijklmnoijklmnopjklmnopqklmnopqrlmnopqrsmnop"
+                      "qrstnopqrstu"),
+            "cf5b16a778af8380036ce59e7b0492370b249b11e8f07a51afac45037afee9d1");
   EXPECT_EQ(sha256Hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
   EXPECT_EQ(sha256Hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
   // 56 bytes: the padding spills into a second block.
@@ -69,6 +77,110 @@ TEST(Sha256, KnownVectors) {
   Sha256 h;
   for (size_t i = 0; i < million.size(); i += 777) h.update(std::string_view(million).substr(i, 777));
   EXPECT_EQ(h.hex(), sha256Hex(million));
+  // A field is its length (8 bytes, little-endian) and its bytes.
+  EXPECT_EQ(Sha256().field("abc").hex(), sha256Hex(std::string("\x03\0\0\0\0\0\0\0abc", 11)));
+}
+
+// An entry carries the SHA-256 of its key and body: any changed, missing or added byte, and
+// the right bytes under another key, are refused.
+TEST(CacheEntry, VerifiedOnOpen) {
+  const std::string key(64, 'a'), other(64, 'b'), body = "shadergen-variant-cache 3\ncost 7\nrules x\n";
+  const std::string entry = sealEntry(key, body);
+  std::string why;
+  ASSERT_EQ(openEntry(key, entry, why), body);
+  for (size_t i = 0; i < entry.size(); i += 7) {
+    std::string flipped = entry;
+    flipped[i] ^= 0x20;
+    EXPECT_FALSE(openEntry(key, flipped, why)) << i;
+  }
+  for (size_t n = 0; n < entry.size(); n += 5) EXPECT_FALSE(openEntry(key, entry.substr(0, n), why)) << n;
+  EXPECT_FALSE(openEntry(key, entry + "x", why));
+  EXPECT_FALSE(openEntry(other, entry, why));
+  EXPECT_NE(why.find("does not match"), std::string::npos) << why;
+  EXPECT_FALSE(openEntry(key, body, why));  // an entry of the earlier layout: a miss
+}
+
+TEST(CacheUrl, CredentialsOnlyFromTheEnvironmentAndNeverShown) {
+  EXPECT_EQ(redactUrl("http://user:pw@host:8080/c/x"), "http://***@host:8080/c/x");
+  EXPECT_EQ(redactUrl("https://host/c@d"), "https://host/c@d");
+  EXPECT_EQ(redactUrl("http://host:1/c"), "http://host:1/c");
+  unsetenv("SHADERGEN_CACHE_URL");
+  EXPECT_EQ(chooseCacheUrl("", "http://m/c"), "http://m/c");
+  EXPECT_EQ(chooseCacheUrl("http://f/c", "http://m/c"), "http://f/c");
+  setenv("SHADERGEN_CACHE_URL", "http://u:secret@e/c", 1);
+  EXPECT_EQ(chooseCacheUrl("", "http://m/c"), "http://u:secret@e/c");  // the environment may hold them
+  EXPECT_EQ(chooseCacheUrl("http://f/c", ""), "http://f/c");            // the flag wins
+  unsetenv("SHADERGEN_CACHE_URL");
+  try {
+    chooseCacheUrl("http://u:secret@f/c", "");
+    ADD_FAILURE() << "accepted credentials on the command line";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()).find("secret"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("SHADERGEN_CACHE_AUTH"), std::string::npos) << e.what();
+  }
+  // In a manifest (a file in the repository): refused, naming the line without quoting it.
+  auto d = errorOf([] {
+    loadManifestText("rules: r.yaml\nrigs:\n  face: f.rig.yaml\npasses:\n  color: c.frag\n"
+                     "cache_url: http://u:secret@m/c\n",
+                     "m.yaml");
+  });
+  EXPECT_EQ(d.loc.line, 0);
+  EXPECT_NE(d.message.find("line 6: 'cache_url'"), std::string::npos) << d.message;
+  EXPECT_EQ(d.message.find("secret"), std::string::npos) << d.message;
+  EXPECT_NE(d.message.find("http://***@m/c"), std::string::npos) << d.message;
+}
+
+// A local cache entry damaged on disk is reported, rebuilt to the same bytes and rewritten.
+TEST(Build, DamagedEntriesAreReportedAndRebuilt) {
+  auto dir = freshDir("dmg");
+  Manifest m = loadManifest(smallManifest(dir).string());
+  std::vector<Variant> variants = expandVariants(m);
+  std::vector<std::string> warnings;
+  BuildOptions bo;
+  bo.cacheDir = (dir / "cache").string();
+  bo.warn = [&](const std::string& w) { warnings.push_back(w); };
+  BuildReport cold = buildVariants(m, variants, bo);
+  fs::path victim = fs::path(bo.cacheDir) / cold.variants[0].key.substr(0, 2) / cold.variants[0].key;
+  std::string bytes = readAll(victim);
+  bytes[bytes.size() / 2] ^= 1;
+  writeText(victim, bytes);
+  BuildReport warm = buildVariants(m, variants, bo);
+  EXPECT_EQ(warm.generated, 1u);
+  EXPECT_EQ(warm.cache.rejected, 1u);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find(cold.variants[0].key + " rejected"), std::string::npos) << warnings[0];
+  EXPECT_EQ(filesOf(warm), filesOf(cold));
+  EXPECT_EQ(buildVariants(m, variants, bo).cached, variants.size());  // rewritten
+}
+
+TEST(Manifest, ValidationSettings) {
+  const std::string head = "rules: r.yaml\nrigs:\n  face: f.rig.yaml\npasses:\n  color: c.frag\n";
+  Manifest m = loadManifestText(head + "validate: { mesh: limb, poses: 3, seed: 9, time: [0, 0.5], tolerance_abs: 1e-5, "
+                                       "cross_check: true, device: llvmpipe }\ncache_url: http://h/c\n",
+                                "m.yaml");
+  EXPECT_TRUE(m.validate.enabled);
+  EXPECT_EQ(m.validate.mesh, "limb");
+  EXPECT_EQ(m.validate.poses, 3);
+  EXPECT_EQ(m.validate.seed, 9u);
+  EXPECT_EQ(m.validate.times, (std::vector<double>{0, 0.5}));
+  EXPECT_EQ(m.validate.toleranceAbs, 1e-5);
+  EXPECT_TRUE(m.validate.crossCheck);
+  EXPECT_EQ(m.validate.device, "llvmpipe");
+  EXPECT_EQ(m.cacheUrl, "http://h/c");
+  EXPECT_FALSE(loadManifestText(head + "validate: false\n", "m.yaml").validate.enabled);
+  EXPECT_FALSE(loadManifestText(head, "m.yaml").validate.enabled);
+  auto fail = [&](const std::string& text) {
+    return errorOf([&] { loadManifestText(head + text, "m.yaml"); });
+  };
+  auto d = fail("validate: { poses: 0 }\n");
+  EXPECT_NE(d.message.find("1..100"), std::string::npos) << d.message;
+  EXPECT_EQ(d.loc.line, 6);
+  d = fail("validate: { mesh: cube }\n");
+  EXPECT_NE(d.message.find("unknown mesh 'cube'"), std::string::npos) << d.message;
+  d = fail("validate: { tolerance_rel: -1 }\n");
+  EXPECT_NE(d.message.find("not a finite non-negative number"), std::string::npos) << d.message;
+  d = fail("validate: { posse: 2 }\n");
+  EXPECT_NE(d.message.find("posse"), std::string::npos) << d.message;
 }
 
 TEST(Manifest, ProductMinusExclusionsInOrder) {
