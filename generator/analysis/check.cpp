@@ -14,6 +14,7 @@
 #include "analysis/probe.h"
 #include "common/yaml_util.h"
 #include "interface/fragment_interface.h"
+#include "rig/gltf_import.h"
 #include "rig/rig.h"
 #include "rules/instantiate.h"
 #include "rules/rules.h"
@@ -83,7 +84,7 @@ class Checker {
     try {
       rules_ = loadRules(opts_.rulesPaths);
       if (!opts_.rigPath.empty()) {
-        rig_ = loadRigFile(opts_.rigPath);
+        rig_ = loadRig(opts_.rigPath);  // a YAML rig or a glTF primitive (MODEL.glb#M/P)
         hasRig_ = true;
       }
     } catch (const InputError& e) {

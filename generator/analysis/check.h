@@ -13,7 +13,7 @@ namespace sg {
 
 struct CheckOptions {
   std::vector<std::string> rulesPaths;
-  std::string rigPath;          // "" = probe snippets against the default rigs
+  std::string rigPath;          // YAML or MODEL.glb#M/P; "" = probe snippets against the default rigs
   bool compileSnippets = true;  // compile each snippet alone (and measure its cost)
   bool all = false;     // also report warnings and notes located in included files
   bool werror = false;  // warnings count as errors

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <set>
 
+#include "analysis/explain.h"
 #include "pipeline/stages.h"
 #include "rules/instantiate.h"
 #include "validate/interpreter.h"
@@ -72,6 +73,40 @@ std::vector<CheckRig> checkRigs(const Rig& rig) {
     out.push_back({r, name + " + morph.active_targets (3 active)"});
   }
   return out;
+}
+
+// Why each rule can appear in no plan for `rig` (""  where some plan can contain it, or
+// where the rule has no instance: its `when` is false, or the rig provides its product,
+// which the caller says). A rule can appear in a plan when every need of one of its
+// instances is reachable from the rig's inputs: the search's own analysis
+// (reachableFacts) over the problem of every rule with nothing requested. Run alone, such
+// a rule would be fed needs the rig cannot have (an occlusion for a rig without one),
+// and its disagreement would say nothing about any program generated for the rig.
+std::vector<std::string> unreachableRules(const Rig& rig, RuleSet rules) {
+  // Costs play no part in reachability: `cost: auto` need not be measured for it.
+  for (auto& r : rules.rules)
+    if (r.costAuto && r.cost.empty()) r.cost = Expr::parse("0", r.loc);
+  Problem p = buildProblem(rig, rules, {});
+  const std::vector<bool> reach = reachableFacts(p);
+  std::vector<std::string> why(rules.rules.size());
+  std::vector<bool> fires(rules.rules.size(), false);
+  for (const auto& a : p.actions)
+    if (a.rule >= 0) fires[a.rule] = fires[a.rule] || std::all_of(a.pre.begin(), a.pre.end(), [&](int f) { return reach[f]; });
+  for (const auto& a : p.actions) {
+    if (a.rule < 0 || fires[a.rule] || !why[a.rule].empty()) continue;
+    const auto need = std::find_if(a.pre.begin(), a.pre.end(), [&](int f) { return !reach[f]; });
+    // The rig inputs that would make the need derivable (explain's analysis of a goal).
+    p.goals = {*need};
+    const std::vector<UnreachableGoal> u = analyzeUnreachable(p, rules, {});
+    std::string with;
+    int shown = 0;
+    const std::vector<std::string> itself{p.facts[*need].name};
+    for (const auto& set : u.empty() ? std::vector<std::vector<std::string>>{} : u.front().missingInputs)
+      if (set != itself && shown++ < 3) with += fmt::format("{}{{{}}}", with.empty() ? "; a rig providing " : " or ", compactFactList(set));
+    if (!with.empty()) with += " could";
+    why[a.rule] = fmt::format("needs '{}', which the rig neither provides nor derives{}", p.facts[*need].name, with);
+  }
+  return why;
 }
 
 void setAt(rt::Mesh& m, const std::string& sem, size_t v, glm::vec4 x) {
@@ -396,6 +431,7 @@ RuleCheckReport checkRulesOnDevice(const RuleCheckOptions& opts) {
   }
   for (const CheckRig& cr : checkRigs(rig)) {
     const RigShape shape = shapeOfRig(cr.rig, rules);
+    const std::vector<std::string> unreachable = unreachableRules(cr.rig, rules);
     ValidationScene scene = proceduralScene(cr.rig, "head", opts.seed, 1);
     // The first vertices of the head are enough besides the hostile ones, and keep the
     // reference (per vertex, per pose, per rule) quick.
@@ -420,8 +456,18 @@ RuleCheckReport checkRulesOnDevice(const RuleCheckOptions& opts) {
         if (whyNot[i].empty()) whyNot[i] = fmt::format("when '{}' is false for {}", rules.rules[i].when.text(), cr.name);
         continue;
       }
+      if (!unreachable[i].empty()) {
+        if (whyNot[i].empty()) {
+          whyNot[i] = unreachable[i];
+          report.results[i].status = RuleCheckResult::Status::InNoPlan;
+        }
+        continue;
+      }
       RuleCheckResult& res = report.results[i];
-      if (!checker.check(static_cast<int>(i), cr, shape, scene.mesh, poses, res, whyNot[i])) continue;
+      if (!checker.check(static_cast<int>(i), cr, shape, scene.mesh, poses, res, whyNot[i])) {
+        res.status = RuleCheckResult::Status::NotApplicable;
+        continue;
+      }
       res.rig = cr.name;
       done[i] = true;
     }
@@ -440,21 +486,26 @@ RuleCheckReport checkRulesOnDevice(const RuleCheckOptions& opts) {
 }
 
 std::string formatRuleCheckSummary(const RuleCheckReport& r) {
-  size_t agree = 0;
-  std::string unchecked, notApplicable;
+  size_t agree = 0, inNoPlan = 0;
+  std::string unchecked, notApplicable, noPlan;
   for (const auto& x : r.results) {
     switch (x.status) {
       case RuleCheckResult::Status::Agrees: ++agree; break;
       case RuleCheckResult::Status::Disagrees: break;
       case RuleCheckResult::Status::Unchecked: unchecked += fmt::format("  {}: {}\n", x.rule, x.detail); break;
       case RuleCheckResult::Status::NotApplicable: notApplicable += fmt::format("  {}: {}\n", x.rule, x.detail); break;
+      case RuleCheckResult::Status::InNoPlan:
+        ++inNoPlan;
+        noPlan += fmt::format("  {}: {}\n", x.rule, x.detail);
+        break;
     }
   }
   std::string s = fmt::format("rules run alone on {} against their definitions ({} vertices, {} poses): "
-                              "{} agree, {} disagree\n",
-                              r.device, r.vertices, r.poses, agree, r.errors.size());
+                              "{} agree, {} disagree; {} skipped: in no plan for the rig\n",
+                              r.device, r.vertices, r.poses, agree, r.errors.size(), inNoPlan);
   if (!unchecked.empty()) s += "unchecked:\n" + unchecked;
   if (!notApplicable.empty()) s += "not applicable to the rig:\n" + notApplicable;
+  if (!noPlan.empty()) s += "skipped, in no plan for the rig:\n" + noPlan;
   return s;
 }
 

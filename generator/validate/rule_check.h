@@ -1,10 +1,10 @@
 // Rule-level checking (`shadergen check --rig R RULES`, docs/rules-authoring.md "Checking
-// rules on a device"): every rule that applies to the rig runs ALONE on the device, its
-// computed needs fed as vertex attributes whose values are their definitions evaluated on a
-// hostile mesh, over poses drawn to break rules; its product is compared with its
-// semantic's definition. One way to feed a program to a device: each check is an ordinary
-// generation (the product as the only varying, every other producer of it banned) run by
-// the Validator.
+// rules on a device"): every rule that can appear in a plan for the rig runs ALONE on the
+// device, its computed needs fed as vertex attributes whose values are their definitions
+// evaluated on a hostile mesh, over poses drawn to break rules; its product is compared
+// with its semantic's definition. One way to feed a program to a device: each check is an
+// ordinary generation (the product as the only varying, every other producer of it banned)
+// run by the Validator.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -26,7 +26,10 @@ struct RuleCheckOptions {
 };
 
 struct RuleCheckResult {
-  enum class Status { Agrees, Disagrees, Unchecked, NotApplicable };
+  // InNoPlan: the rule applies, but a need of it cannot be derived from the rig's inputs,
+  // so no program generated for the rig contains it; it is not run (its needs would be
+  // values the rig does not have).
+  enum class Status { Agrees, Disagrees, Unchecked, NotApplicable, InNoPlan };
   std::string rule;
   std::string produces;
   SourceLoc loc;        // the rule's name
@@ -47,8 +50,8 @@ struct RuleCheckReport {
 // Throws InputError for a rig or rules file that does not load.
 RuleCheckReport checkRulesOnDevice(const RuleCheckOptions& opts);
 
-// "rules checked on lavapipe ...: N agree, M disagree" and the unchecked and
-// not-applicable rules with why.
+// "rules run alone on lavapipe ...: N agree, M disagree; K skipped: in no plan for the
+// rig" and the unchecked, not-applicable and skipped rules with why.
 std::string formatRuleCheckSummary(const RuleCheckReport& r);
 
 }  // namespace sg

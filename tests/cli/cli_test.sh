@@ -321,7 +321,7 @@ search)
 check_rig)
   # `check --rig`: every rule run alone on lavapipe against its definition (docs/rules-authoring.md).
   expect 0 "check --rig (rules run alone)" -- "$SG" check --rig "$E/face.rig.yaml" "$SRC/rules/standard.yaml"
-  grep -q '^rules run alone on .* against their definitions (.* vertices, 5 poses): [0-9]* agree, 0 disagree$' last.err &&
+  grep -q '^rules run alone on .* against their definitions (.* vertices, 5 poses): [0-9]* agree, 0 disagree; [0-9]* skipped: in no plan for the rig$' last.err &&
     ok "summary: agree, 0 disagree" || fail "check --rig printed: $(head -3 last.err)"
   grep -q '^  object_position_unmorphed: when .!has(morph.position) && !has(morph.position_scaled). is false' last.err && ok "lists rules not applicable" ||
     fail "no not-applicable list: $(cat last.err)"
@@ -335,6 +335,25 @@ check_rig)
     ok "the disagreement is located at the rule, with its input" || fail "check printed: $(head -5 last.err)"
   grep -q "^drift/buffers.yaml:[0-9]*:[0-9]*: error: rule 'object_tangent_morphed_sparse_gram_schmidt' disagrees" last.err &&
     ok "and the sparse form too" || fail "check printed: $(head -5 last.err)"
+  # A rig without an occlusion (issue 34): the rules reading one are in no plan for it, so
+  # they are skipped and listed with why, not fed an occlusion the rig does not have.
+  PBR=$SRC/tests/validate/data/pbr_character.rig.yaml
+  expect 0 "check --rig, a rig without occlusion" -- "$SG" check --rig "$PBR" "$SRC/rules/standard.yaml"
+  grep -q '^rules run alone on .*: [0-9]* agree, 0 disagree; 6 skipped: in no plan for the rig$' last.err &&
+    grep -q "^  object_occlusion_from_normal_occlusion: needs 'morph.normal_occlusion', which the rig neither provides nor derives$" last.err &&
+    ok "the occlusion rules are skipped, with why" || fail "check printed: $(cat last.err)"
+  # A wrong rule the rig can use still fails; the wrong rule it cannot use is skipped.
+  expect 1 "check --rig, planted wrong rules" -- "$SG" check --rig "$PBR" "$SRC/tests/validate/data/planted_wrong.rules.yaml"
+  grep -q "planted_wrong.rules.yaml:8:11: error: rule 'object_normal_morphed' disagrees" last.err &&
+    ! grep -q "error: rule 'object_occlusion_from_normal_occlusion'" last.err &&
+    ok "the usable wrong rule fails, the unusable one is skipped" || fail "check printed: $(cat last.err)"
+  # A glTF primitive as the rig: MorphStressTest's targets move position and normal, no occlusion.
+  MST=$SRC/../shared/models/MorphStressTest/MorphStressTest.gltf
+  if [ -f "$MST" ]; then
+    expect 0 "check --rig MODEL.gltf#0/1" -- "$SG" check --rig "$MST#0/1" "$SRC/rules/standard.yaml"
+    grep -q "^  object_occlusion_from_normal_occlusion: needs 'morph.normal_occlusion'" last.err &&
+      ok "a glTF rig: the occlusion rules are skipped" || fail "check printed: $(cat last.err)"
+  fi
   ;;
 
 device_limits)

@@ -90,8 +90,10 @@ TEST(RuleCheck, StandardLibraryOverSeveralRigsChecksEveryRule) {
       dataPath("unskinned_model.rig.yaml"),              dataPath("unskinned_identity.rig.yaml"),
       sourcePath("tests/examples/data/binormal.rig.yaml"), dataPath("bounds.rig.yaml"),  // encoded position and frame
       dataPath("qtangent.rig.yaml"), dataPath("morph_scaled.rig.yaml"),  // the frame as a QTangent, scaled deltas
+      dataPath("pbr_character.rig.yaml"),  // view, projection and their product: clip_from_view_projection
+      sourcePath("examples/threejs/mesh.rig.yaml"),  // a model-view and a normal matrix: the eye_* forms
       std::string(SG_SHARED_DIR) + "/models/SimpleSkin/SimpleSkin.gltf#0/0"};
-  std::map<std::string, Status> best;  // Agrees < Disagrees < Unchecked < NotApplicable
+  std::map<std::string, Status> best;  // Agrees < Disagrees < Unchecked < NotApplicable < InNoPlan
   for (const auto& rig : rigs) {
     if (rig.find("SimpleSkin") != std::string::npos && !std::filesystem::exists(std::string(SG_SHARED_DIR) + "/models"))
       continue;
@@ -111,6 +113,58 @@ TEST(RuleCheck, StandardLibraryOverSeveralRigsChecksEveryRule) {
   EXPECT_GT(best.size(), 40u);
   for (const auto& [rule, status] : best)
     EXPECT_EQ(status, Status::Agrees) << rule << " is never checked";
+}
+
+// Issue 34: a glTF-style PBR character (40 bones, 2 influences, 8 targets moving position
+// and normal, no occlusion attribute). The rules reading an occlusion can be in no plan
+// for it; run alone they were fed an occlusion the rig does not have (the procedural
+// head's), and object_occlusion_from_normal_occlusion "disagreed" (0.734 against 0.725: the
+// fed morph.normal_occlusion summed the head's occlusion deltas, which object.occlusion's
+// definition leaves out for a rig without morph.occlusion). They are skipped, with why;
+// the rules the rig's plans can contain still run.
+TEST(RuleCheck, ARigWithoutOcclusionChecksOnlyTheRulesItsPlansCanContain) {
+  const std::vector<std::string> rules = {"object_occlusion_from_normal_occlusion", "object_normal_from_normal_occlusion",
+                                          "object_visibility", "object_normal_morphed", "object_position_morphed",
+                                          "skin_matrix_blend"};
+  RuleCheckReport r = checkOn(dataPath("pbr_character.rig.yaml"), sourcePath("rules/standard.yaml"), rules);
+  EXPECT_TRUE(r.errors.empty()) << errorsOf(r);
+  ASSERT_EQ(r.results.size(), rules.size());
+  for (const char* rule : {"object_occlusion_from_normal_occlusion", "object_normal_from_normal_occlusion"}) {
+    EXPECT_EQ(find(r, rule)->status, Status::InNoPlan) << rule;
+    EXPECT_EQ(find(r, rule)->detail, "needs 'morph.normal_occlusion', which the rig neither provides nor derives");
+  }
+  // A need behind another: the inputs that would make it derivable are named.
+  EXPECT_EQ(find(r, "object_visibility")->status, Status::InNoPlan);
+  EXPECT_NE(find(r, "object_visibility")->detail.find("needs 'object.occlusion'"), std::string::npos);
+  EXPECT_NE(find(r, "object_visibility")->detail.find("a rig providing {vertex.occlusion} or {morph.normal_occlusion} could"),
+            std::string::npos)
+      << find(r, "object_visibility")->detail;
+  for (const char* rule : {"object_normal_morphed", "object_position_morphed", "skin_matrix_blend"})
+    EXPECT_EQ(find(r, rule)->status, Status::Agrees) << rule << ": " << find(r, rule)->detail;
+  const std::string summary = formatRuleCheckSummary(r);
+  EXPECT_NE(summary.find(": 3 agree, 0 disagree; 3 skipped: in no plan for the rig\n"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("skipped, in no plan for the rig:\n  object_normal_from_normal_occlusion: needs"), std::string::npos)
+      << summary;
+}
+
+// The skip is the rig's, not the rule's: a wrong rule the rig can use still fails, and
+// the same wrong rule the rig cannot use fails for a rig that can (the Dawn face stores its
+// occlusion in normal.w).
+TEST(RuleCheck, APlantedWrongRuleFailsWhereTheRigCanUseIt) {
+  const std::string planted = dataPath("planted_wrong.rules.yaml");
+  const std::vector<std::string> rules = {"object_normal_morphed", "object_occlusion_from_normal_occlusion"};
+  RuleCheckReport pbr = checkOn(dataPath("pbr_character.rig.yaml"), planted, rules);
+  ASSERT_EQ(pbr.errors.size(), 1u) << errorsOf(pbr);
+  EXPECT_EQ(pbr.errors[0].loc.file, planted);
+  EXPECT_EQ(pbr.errors[0].loc.line, 8);  // the overriding rule's name
+  EXPECT_NE(pbr.errors[0].message.find("rule 'object_normal_morphed' disagrees with the definition of 'object.normal'"),
+            std::string::npos)
+      << pbr.errors[0].message;
+  EXPECT_EQ(find(pbr, "object_occlusion_from_normal_occlusion")->status, Status::InNoPlan);
+
+  RuleCheckReport dawn = checkOn(sourcePath("examples/dawn/face.rig.yaml"), planted, rules);
+  EXPECT_EQ(dawn.errors.size(), 2u) << errorsOf(dawn);
+  for (const auto& rule : rules) EXPECT_EQ(find(dawn, rule)->status, Status::Disagrees) << rule;
 }
 
 // The drift of issue 23: one tangent rule computing Gram-Schmidt without the fallback
