@@ -22,6 +22,12 @@ ldd "$build/generator/cli/shadergen" | awk '$3 ~ /^\// {print $3}' | while read 
 done
 cp -r "$root/rules" "$root/templates" "$root/devices" "$stage/sg/"
 cp -r "$root/examples/dawn" "$stage/sg/examples/"
-cp "$root/bench/gpu_env.sh" "$root/bench/gpu_run.sh" "$root/bench/gpu_calibrate.sh" "$root/bench/gpu_layouts.sh" "$stage/sg/"
+# Rigs and requests the calibration never saw, for the held-out check (gpu_collect.sh).
+mkdir -p "$stage/sg/examples/heldout"
+cp "$root"/tests/validate/data/*.rig.yaml "$root"/tests/validate/data/*.frag "$root"/examples/threejs/*.frag \
+  "$stage/sg/examples/heldout/"
+cp "$root/examples/threejs/mesh.rig.yaml" "$stage/sg/examples/heldout/threejs-mesh.rig.yaml"
+cp "$root/bench/gpu_env.sh" "$root/bench/gpu_run.sh" "$root/bench/gpu_calibrate.sh" "$root/bench/gpu_layouts.sh" \
+  "$root/bench/gpu_collect.sh" "$stage/sg/"
 tar -C "$stage" -czf "$out" sg
 echo "$out: $(du -h "$out" | cut -f1)"

@@ -16,6 +16,8 @@ struct CalibrateCommand {
   std::string meshes = "dawn,head";
   bool noLayers = false;
   bool noCheck = false;
+  bool noProbes = false;
+  std::string form = "additive";
 
   int run() {
     co.validationLayers = !noLayers;
@@ -33,6 +35,8 @@ struct CalibrateCommand {
     if (!co.rigs.empty() && (co.plans.fragmentPath.empty() || co.plans.rulesPaths.empty()))
       throw CLI::ValidationError("--rig", "plans need --rig, --fragment and --rules together");
     co.check = !noCheck;
+    co.probes = !noProbes;
+    co.form = form == "roofline" ? ProfileForm::Roofline : ProfileForm::Additive;
     if (!output.empty()) {
       std::vector<InputFile> inputs;
       for (const auto& r : co.rigs) inputs.push_back({r, "a rig"});
@@ -81,6 +85,9 @@ void registerCalibrate(CLI::App& app, CliState& state) {
                   "With --rig: a plan's row in the fit weighs (its rig's fastest / its time)^P (default 4; 0: all alike)")
       ->check(CLI::Range(0.0, 16.0));
   sub->add_flag("--no-check", cmd->noCheck, "With --rig: do not time the rigs' plans under the fitted profile afterwards");
+  sub->add_flag("--no-probes", cmd->noProbes, "With --rig: time only the rigs' programs (samples for another fit)");
+  sub->add_option("--form", cmd->form, "The model fitted: additive (default) or roofline (docs/device-profiles.md)")
+      ->check(CLI::IsMember({"additive", "roofline"}));
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer (use for timings)");
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }

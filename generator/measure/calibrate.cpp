@@ -548,7 +548,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   for (const auto& s : rep.samples)
     if (s.mesh == opts.meshes.front()) workload = s.vertices;
   rep.nearBestPower = opts.rigs.empty() ? 0 : opts.nearBestPower;
-  rep.profile = fitDeviceProfile(rep.samples, rep.device + " (" + rep.driver + ")", workload, opts.nearBestPower);
+  rep.profile = fitDeviceProfile(rep.samples, rep.device + " (" + rep.driver + ")", workload, opts.nearBestPower, opts.form);
   // The check: each rig's plans under the fitted profile. The plans a profile chooses are
   // where its errors cost time, so each refit adds them to the fit; the last check's plans
   // are never fitted.
@@ -560,7 +560,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
     benchRigs(fitted, false, last ? "checked plan: " : fmt::format("plan under fit {}: ", round + 1));
     if (last) break;
     for (auto& s : rep.samples) s.fitted = true;
-    rep.profile = fitDeviceProfile(rep.samples, rep.profile.device, workload, opts.nearBestPower);
+    rep.profile = fitDeviceProfile(rep.samples, rep.profile.device, workload, opts.nearBestPower, opts.form);
   }
   rep.fits = evaluateFit(rep.samples, rep.profile, opts.meshes);
   return rep;

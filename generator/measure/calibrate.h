@@ -48,6 +48,7 @@ struct CalibrationOptions {
   // the search only compares plans of one rig, and the ones near the fastest are where a
   // wrong order costs time (docs/device-profiles.md, "Where the fit looks"). 0: all alike.
   double nearBestPower = 4;
+  ProfileForm form = ProfileForm::Additive;  // the model fitted (measure/fit.h)
 };
 
 struct CalibrationSample {
