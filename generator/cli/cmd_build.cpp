@@ -12,6 +12,7 @@
 
 #include "cli/commands.h"
 #include "cli/output_files.h"
+#include "measure/workload.h"
 #include "variants/builder.h"
 
 namespace sg {
@@ -55,6 +56,24 @@ struct BuildCommand {
     }
     BuildOptions bo;
     bo.jobs = jobs;
+    // With a device profile each variant is priced for the workload of its mesh: a glTF rig's
+    // own, the manifest's `mesh:` for YAML rigs (measure/workload.h); measured once per rig
+    // and parameters.
+    if (!m.deviceProfile.empty()) {
+      std::map<std::pair<std::string, std::map<std::string, int64_t>>, Workload> measured;
+      for (const auto& v : variants) {
+        auto key = std::make_pair(v.rig->path, v.params);
+        auto it = measured.find(key);
+        if (it == measured.end()) {
+          try {
+            it = measured.emplace(key, rigWorkload(v.rig->path, v.params, isGltfPath(v.rig->path) ? "" : m.mesh)).first;
+          } catch (const InputError&) {
+            continue;  // the variant's own generation reports what is wrong with its rig
+          }
+        }
+        bo.workloads[v.name] = it->second;
+      }
+    }
     if (!noCache) bo.cacheDir = cacheDir.empty() ? (std::filesystem::path(m.outputDir) / ".shadergen-cache").string() : cacheDir;
     // Progress on a terminal, quiet in CI and in logs.
     bool showProgress = progress || (!quiet && isatty(STDERR_FILENO) && !std::getenv("CI"));

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "cli/commands.h"
+#include "cli/whole_model.h"
 #include "measure/calibrate.h"
 
 namespace sg {
@@ -32,10 +33,20 @@ struct CalibrateCommand {
     }
     if (!co.rigs.empty() && (co.plans.fragmentPath.empty() || co.plans.rulesPaths.empty()))
       throw CLI::ValidationError("--rig", "plans need --rig, --fragment and --rules together");
+    // MODEL.glb#*: each primitive is a rig of its own, timed on its own mesh.
+    std::vector<std::string> rigs;
+    for (const auto& r : co.rigs) {
+      if (auto parts = wholeModelParts(r)) {
+        for (const auto& p : *parts) rigs.push_back(p.ref);
+      } else {
+        rigs.push_back(r);
+      }
+    }
+    co.rigs = rigs;
     co.check = !noCheck;
     if (!output.empty()) {
       std::vector<InputFile> inputs;
-      for (const auto& r : co.rigs) inputs.push_back({r, "a rig"});
+      for (const auto& r : co.rigs) inputs.push_back({isGltfPath(r) ? parseGltfRef(r).file : r, "a rig"});
       if (!co.rigs.empty()) inputs.push_back({co.plans.fragmentPath, "the fragment shader"});
       for (const auto& r : co.plans.rulesPaths) inputs.push_back({r, "a rules file"});
       refuseClobbering({output}, inputs);
@@ -65,7 +76,8 @@ void registerCalibrate(CLI::App& app, CliState& state) {
                                            "weights, the first one's size is the profile's vertices_per_draw "
                                            "(default dawn,head: 180,000 and 2,009 vertices)");
   sub->add_option("--rig", cmd->co.rigs, "Also time the plan of this rig, its forced alternatives and bench's floors; "
-                                         "repeat for several rigs (a packed layout beside the float one)");
+                                         "repeat for several rigs (a packed layout beside the float one). A glTF rig "
+                                         "(MODEL.glb#m/p, or MODEL.glb#* for every primitive) is timed on its own mesh");
   sub->add_option("--fragment,-f", cmd->co.plans.fragmentPath, "With --rig: the fragment shader");
   sub->add_option("--rules,-r", cmd->co.plans.rulesPaths, "With --rig: rules file(s)");
   sub->add_option("--max-attributes", cmd->co.plans.maxAttributes, "With --rig: vertex input attributes (default 16)")

@@ -14,6 +14,7 @@
 #include "analysis/cost.h"
 #include "common/glsl_compile.h"
 #include "common/nnls.h"
+#include "rig/gltf_import.h"
 #include "runtime/procedural.h"
 #include "runtime/vk_render.h"
 #include "validate/program_inputs.h"
@@ -421,6 +422,11 @@ std::vector<CalibrationFit> evaluateFit(std::vector<CalibrationSample>& samples,
   return fits;
 }
 
+std::vector<std::string> rigMeshes(const std::string& rig, const std::vector<std::string>& meshes) {
+  if (isGltfPath(rig)) return {kOwnMesh};
+  return meshes;
+}
+
 CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   if (opts.meshes.empty()) throw std::invalid_argument("calibration: no mesh");
   rt::HarnessOptions ho;
@@ -508,7 +514,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   } remove;
   auto benchRigs = [&](const std::string& profilePath, bool fitted, const std::string& prefix) {
     for (const auto& rig : opts.rigs)
-      for (const auto& meshName : opts.meshes) {
+      for (const auto& meshName : rigMeshes(rig, opts.meshes)) {
         GpuBenchOptions bo;
         bo.render.gen = opts.plans;
         bo.render.gen.rigPath = rig;
@@ -542,6 +548,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           s.mesh = meshName;
           s.vertices = double(br.vertices);
           s.rig = std::filesystem::path(rig).filename().string();
+          s.workload = br.workload;
           s.fitted = fitted;
           s.amounts = row.amounts;
           s.validated = row.validation == "pass" || (!row.hasCost && row.*clock > 0);
@@ -577,7 +584,11 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
     for (auto& s : rep.samples) s.fitted = true;
     rep.profile = fitDeviceProfile(rep.samples, rep.profile.device, workload, opts.nearBestPower);
   }
-  rep.fits = evaluateFit(rep.samples, rep.profile, opts.meshes);
+  std::vector<std::string> fitMeshes = opts.meshes;
+  for (const auto& rig : opts.rigs)
+    if (isGltfPath(rig) && std::find(fitMeshes.begin(), fitMeshes.end(), kOwnMesh) == fitMeshes.end())
+      fitMeshes.push_back(kOwnMesh);
+  rep.fits = evaluateFit(rep.samples, rep.profile, fitMeshes);
   return rep;
 }
 

@@ -26,6 +26,12 @@
 
 namespace sg {
 
+// The mesh of a glTF rig's samples: the model's own primitive (its vertices and index
+// order), not a procedural mesh.
+inline constexpr const char* kOwnMesh = "own";
+// The meshes a rig's plans are timed on: a glTF rig's own, a YAML rig's procedural ones.
+std::vector<std::string> rigMeshes(const std::string& rig, const std::vector<std::string>& meshes);
+
 struct CalibrationOptions {
   std::string device;               // "" = lavapipe
   bool validationLayers = true;
@@ -36,7 +42,8 @@ struct CalibrationOptions {
   uint32_t width = 256, height = 256;  // the target of every draw (bench's default)
   bool probes = true;
   // For each rig: the generated plan and every forced alternative (bench's programs), with
-  // plans' fragment shader, rules and limits, and bench's floors.
+  // plans' fragment shader, rules and limits, and bench's floors. A glTF rig (MODEL.glb#m/p)
+  // is timed once, on its own mesh (kOwnMesh); a YAML rig on each of `meshes`.
   std::vector<std::string> rigs;
   GenerateOptions plans;
   bool check = true;  // then the same rigs' plans under the fitted profile
@@ -54,6 +61,7 @@ struct CalibrationSample {
   std::string mesh;
   double vertices = 0;  // per draw (the mesh's)
   std::string rig;      // the rig of a plan or floor ("" for a probe)
+  Workload workload;    // of the mesh and pose a plan or floor was timed on (measure/workload.h)
   bool fitted = true;   // false: a plan of the check, which the fit did not see
   TermAmounts amounts{};
   bool validated = false;

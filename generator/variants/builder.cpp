@@ -83,7 +83,8 @@ std::vector<std::string> inputsOf(const SharedInputs& s, const Variant& v) {
 // Every byte that can change a variant's outputs: the tool, the options, the variant's
 // parameters and mappings, and each input file's path (outputs name them) and contents
 // (through the SHA-256 of the file).
-std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v, const std::vector<std::string>& inputs) {
+std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v, const std::vector<std::string>& inputs,
+                     const Workload* workload) {
   Sha256 h;
   h.field(kCacheFormat).field(shadergenVersion()).field(targetEnvName(m.targetEnv)).field(m.heuristic);
   h.field(m.optimize ? "optimize" : "no-optimize");
@@ -103,6 +104,11 @@ std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v,
   if (!v.pass->conventions.empty()) {  // only then: earlier manifests keep their cache keys
     h.field("conventions");
     for (const auto& c : v.pass->conventions) h.field(c);
+  }
+  if (workload && workload->known()) {  // only then: earlier manifests keep their cache keys
+    h.field("workload").field(fmt::format("{:.17g} {:.17g} {:.17g} {:.17g}", workload->verticesPerDraw, workload->jointsPerWarp,
+                                          workload->activeMorphTargets, workload->invocationsPerVertex));
+    h.field(workload->source);
   }
   h.field("inputs");
   for (const auto& f : inputs) h.field(f).field(s.digests.at(f));
@@ -172,7 +178,7 @@ void writeEntry(const std::string& path, const BuiltVariant& v) {
 
 // ---- one variant ------------------------------------------------------------------------
 
-void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v, BuiltVariant& out) {
+void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v, const Workload* workload, BuiltVariant& out) {
   const Rig& base = s.rigs.at(v.rig->path);
   SourceLoc paramsAt{m.file, 0, 0};
   for (const auto& a : m.axes)
@@ -185,6 +191,7 @@ void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v,
   o.overrides = v.pass->maps;
   o.conventions = v.pass->conventions;
   o.maxError = m.maxError;
+  if (workload) o.workload = *workload;
   LoadedInputs in = prepareInputs(std::move(rig), s.rules, s.fragments.at(v.pass->fragment), o, s.profile);
   o.heuristic = m.heuristic;
   o.targetEnv = m.targetEnv;
@@ -205,7 +212,9 @@ void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v,
 void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts, BuiltVariant& out) {
   const Variant& v = *out.variant;
   out.inputs = inputsOf(s, v);
-  out.key = cacheKey(m, s, v, out.inputs);
+  auto w = opts.workloads.find(v.name);
+  const Workload* workload = w == opts.workloads.end() ? nullptr : &w->second;
+  out.key = cacheKey(m, s, v, out.inputs, workload);
   std::string entry = opts.cacheDir.empty() ? "" : entryPath(opts.cacheDir, out.key);
   BuiltVariant fromCache;
   if (!entry.empty() && readEntry(entry, fromCache)) {
@@ -219,7 +228,7 @@ void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts
     out.ok = out.cached = true;
   } else {  // a miss, or a damaged entry (read into its own record, so nothing leaks from it)
     try {
-      generateVariant(m, s, v, out);
+      generateVariant(m, s, v, workload, out);
       out.ok = true;
       if (!entry.empty()) writeEntry(entry, out);
     } catch (const InputError& e) {
