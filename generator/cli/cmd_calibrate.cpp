@@ -33,6 +33,8 @@ struct CalibrateCommand {
     }
     if (!co.rigs.empty() && (co.plans.fragmentPath.empty() || co.plans.rulesPaths.empty()))
       throw CLI::ValidationError("--rig", "plans need --rig, --fragment and --rules together");
+    if (co.corpus > 0 && co.plans.rulesPaths.empty())
+      throw CLI::ValidationError("--corpus", "needs --rules whose vocabulary the random requests use (examples/dawn/rules.yaml)");
     // MODEL.glb#*: each primitive is a rig of its own, timed on its own mesh.
     std::vector<std::string> rigs;
     for (const auto& r : co.rigs) {
@@ -92,6 +94,11 @@ void registerCalibrate(CLI::App& app, CliState& state) {
   sub->add_option("--near-best-weight", cmd->co.nearBestPower,
                   "With --rig: a plan's row in the fit weighs (its rig's fastest / its time)^P (default 4; 0: all alike)")
       ->check(CLI::Range(0.0, 16.0));
+  sub->add_option("--corpus", cmd->co.corpus,
+                  "Also time N random rigs, each with a random request (generator/measure/corpus.h), over --rules "
+                  "(examples/dawn/rules.yaml has their vocabulary), as --rig does")
+      ->check(CLI::Range(0, 1000));
+  sub->add_option("--seed", cmd->co.corpusSeed, "The corpus's seed (default 1): the same seed, the same rigs");
   sub->add_flag("--no-check", cmd->noCheck, "With --rig: do not time the rigs' plans under the fitted profile afterwards");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer (use for timings)");
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
