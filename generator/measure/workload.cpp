@@ -13,7 +13,7 @@
 namespace sg {
 
 Workload measureWorkload(const rt::Mesh& mesh, const std::vector<uint32_t>& indices, bool triangles,
-                         double activeMorphTargets, const std::string& source) {
+                         double activeMorphTargets, const std::string& source, int influences) {
   Workload w;
   w.source = source;
   w.activeMorphTargets = activeMorphTargets;
@@ -43,7 +43,7 @@ Workload measureWorkload(const rt::Mesh& mesh, const std::vector<uint32_t>& indi
     auto wt = mesh.streams.find(fmt::format("skin.weights[{}]", set));
     if (j == mesh.streams.end() || wt == mesh.streams.end()) break;
     if (j->second.size() < n || wt->second.size() < n) break;
-    for (int c = 0; c < 4; ++c)
+    for (int c = 0; c < 4 && (influences < 0 || 4 * set + c < influences); ++c)
       for (size_t g = 0; g < order.size(); g += kWorkloadWarp) {
         std::set<float> joints;
         for (size_t k = g; k < std::min(order.size(), g + kWorkloadWarp); ++k)
@@ -132,7 +132,9 @@ Workload rigWorkload(const std::string& rigPath, const std::map<std::string, int
     const std::string source = fmt::format("{} mesh {} primitive {} ({} vertices{})", d.stem, d.mesh, d.primitive, d.vertexCount,
                                            d.indicesError.empty() ? "" : "; its indices could not be read");
     if (!d.indicesError.empty()) indices.clear();
-    Workload w = measureWorkload(vs.mesh, indices, triangles, gltfActiveMorphTargets(d), source);
+    const auto lod = params.find("influences");
+    Workload w = measureWorkload(vs.mesh, indices, triangles, gltfActiveMorphTargets(d), source,
+                                 lod == params.end() ? -1 : int(lod->second));
     if (!d.indicesError.empty()) w.jointsPerWarp = 0;  // no shading order known
     return w;
   }
