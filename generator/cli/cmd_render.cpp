@@ -103,6 +103,7 @@ struct RenderCommand {
 };
 
 struct BenchCommand {
+  CLI::App* cmd = nullptr;
   GenerateArgs args;
   GpuBenchOptions bo;
   std::string size = "256x256";
@@ -112,6 +113,8 @@ struct BenchCommand {
 
   int run() {
     bo.render.gen = args.resolve();
+    if (isGltfPath(bo.render.gen.rigPath))
+      refuseOption(*cmd, "--mesh", "to a glTF rig (" + bo.render.gen.rigPath + "): it is timed on its own mesh");
     bo.render.limits = {!bo.render.device.empty(), args.maxAttributes->count() > 0, args.maxUniformBytes->count() > 0};
     bo.render.validationLayers = !noLayers;
     unsigned w = 0, h = 0;
@@ -198,6 +201,7 @@ void registerRender(CLI::App& app, CliState& state) {
   CLI::App* b = app.add_subcommand("bench", "Time the generated vertex program, its forced alternatives, a hand-written "
                                             "port and a pass-through floor on the GPU (timestamp queries), each validated on that "
                                             "device first (one that fails is not timed; exit status 1)");
+  bench->cmd = b;
   bench->args.add(*b);
   b->add_option("--hand-port", bench->bo.handPortPath, "A hand-written vertex shader with the same interface "
                                                        "(a_<attribute>, u_<uniform>), e.g. examples/dawn/listing-3-3.vert");

@@ -677,7 +677,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
         if (!fitted) {  // the plans' predicted against measured time, by this calibration's clock
           const PredictionCheck pc = checkPredictions(br.rows, clock);
           CalibrationCheck c;
-          c.rig = rig;
+          c.rig = rigLabel(rig);
           c.mesh = meshName;
           c.plans = pc.plans;
           c.spearman = pc.spearman;
