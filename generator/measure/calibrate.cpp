@@ -16,6 +16,7 @@
 #include "common/glsl_compile.h"
 #include "common/nnls.h"
 #include "measure/corpus.h"
+#include "measure/workload.h"
 #include "rig/gltf_import.h"
 #include "runtime/procedural.h"
 #include "runtime/vk_render.h"
@@ -571,11 +572,15 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   for (const auto& meshName : opts.meshes) {
     ProbeMesh m = probeMesh(meshName);
     std::vector<Probe> probes = opts.probes ? makeProbes(m) : std::vector<Probe>{};
+    // The probes' per-vertex palette indices are this mesh's skin: its workload is theirs.
+    const Workload probeWorkload =
+        measureWorkload(m.mesh, m.indices, true, -1, fmt::format("probe mesh '{}' ({} vertices)", meshName, m.mesh.vertexCount));
     for (auto& p : probes) {
       CalibrationSample s;
       s.label = p.label;
       s.mesh = meshName;
       s.vertices = double(m.mesh.vertexCount);
+      s.workload = probeWorkload;
       s.amounts = p.amounts;
       try {
         GlslShader renderShader = compileProbe(Stage::Vertex, probeGlsl(p, false), p.label);

@@ -69,7 +69,7 @@ struct CalibrationSample {
   std::string mesh;
   double vertices = 0;  // per draw (the mesh's)
   std::string rig;      // the rig of a plan or floor ("" for a probe)
-  Workload workload;    // of the mesh and pose a plan or floor was timed on (measure/workload.h)
+  Workload workload;    // of the mesh and pose it was timed on (measure/workload.h); a probe's: its mesh's
   bool fitted = true;   // false: a plan of the check, which the fit did not see
   TermAmounts amounts{};
   bool validated = false;

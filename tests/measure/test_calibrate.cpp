@@ -33,6 +33,9 @@ TEST(Calibrate, EveryProbeAgreesWithItsExpectedOutputsOnLavapipeAndVariesOneTerm
     EXPECT_TRUE(s.validated) << s.label << ": " << s.failure;
     EXPECT_GT(s.measuredNs, 0) << s.label;
     EXPECT_EQ(s.amounts[kTermVertices], 1) << s.label;
+    // The workload of the probe mesh, whose skin (the Dawn face's) indexes the palette probes.
+    EXPECT_EQ(s.workload.verticesPerDraw, s.vertices) << s.label;
+    EXPECT_GE(s.workload.jointsPerWarp, 1.0) << s.label;
   }
   // Locations at fixed bytes and bytes at fixed locations, as built.
   const CalibrationSample* f16 = find(r, "locations 16 (float32x4 after the position)");
