@@ -122,10 +122,21 @@ Workload rigWorkload(const std::string& rigPath, const std::map<std::string, int
     io.mesh = ref.mesh;
     io.primitive = ref.primitive;
     const GltfImport model = importGltf(ref.file, io);
+    const GltfModelData& d = model.data;
     GltfSceneOptions so;
     so.times = {0.0};
-    const ValidationScene vs = gltfScene(model, so);
-    const GltfModelData& d = model.data;
+    ValidationScene vs;
+    int active = 0;
+    try {  // posing reads the animations, which generation itself never needs
+      vs = gltfScene(model, so);
+      active = gltfActiveMorphTargets(d);
+    } catch (const InputError& e) {
+      Workload w;
+      w.verticesPerDraw = double(d.vertexCount);
+      w.source = fmt::format("{} mesh {} primitive {} ({} vertices; the rest not measured: {})", d.stem, d.mesh, d.primitive,
+                             d.vertexCount, e.diagnostic().message);
+      return w;
+    }
     const bool triangles = d.indicesError.empty() && d.mode >= 4 && d.mode <= 6;
     std::vector<uint32_t> indices = d.indices;
     if (triangles) indices = triangleList(d.indices, d.mode, vs.mesh.vertexCount, ref.file);
@@ -133,7 +144,7 @@ Workload rigWorkload(const std::string& rigPath, const std::map<std::string, int
                                            d.indicesError.empty() ? "" : "; its indices could not be read");
     if (!d.indicesError.empty()) indices.clear();
     const auto lod = params.find("influences");
-    Workload w = measureWorkload(vs.mesh, indices, triangles, gltfActiveMorphTargets(d), source,
+    Workload w = measureWorkload(vs.mesh, indices, triangles, active, source,
                                  lod == params.end() ? -1 : int(lod->second));
     if (!d.indicesError.empty()) w.jointsPerWarp = 0;  // no shading order known
     return w;
