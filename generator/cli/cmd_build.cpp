@@ -13,6 +13,7 @@
 #include "cli/commands.h"
 #include "cli/output_files.h"
 #include "validate/variant_validation.h"
+#include "measure/workload.h"
 #include "variants/builder.h"
 
 namespace sg {
@@ -80,6 +81,24 @@ struct BuildCommand {
                          fmt::format("cannot validate: {}", e.what()));
       }
       bo.validator = validator.get();
+    }
+    // With a device profile each variant is priced for the workload of its mesh: a glTF rig's
+    // own, the manifest's `mesh:` for YAML rigs (measure/workload.h); measured once per rig
+    // and parameters.
+    if (!m.deviceProfile.empty()) {
+      std::map<std::pair<std::string, std::map<std::string, int64_t>>, Workload> measured;
+      for (const auto& v : variants) {
+        auto key = std::make_pair(v.rig->path, v.params);
+        auto it = measured.find(key);
+        if (it == measured.end()) {
+          try {
+            it = measured.emplace(key, rigWorkload(v.rig->path, v.params, isGltfPath(v.rig->path) ? "" : m.mesh)).first;
+          } catch (const InputError&) {
+            continue;  // the variant's own generation reports what is wrong with its rig
+          }
+        }
+        bo.workloads[v.name] = it->second;
+      }
     }
     // Progress on a terminal, quiet in CI and in logs.
     bool showProgress = progress || (!quiet && isatty(STDERR_FILENO) && !std::getenv("CI"));

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "cli/commands.h"
+#include "cli/whole_model.h"
 #include "measure/calibrate.h"
 
 namespace sg {
@@ -34,12 +35,24 @@ struct CalibrateCommand {
     }
     if (!co.rigs.empty() && (co.plans.fragmentPath.empty() || co.plans.rulesPaths.empty()))
       throw CLI::ValidationError("--rig", "plans need --rig, --fragment and --rules together");
+    if (co.corpus > 0 && co.plans.rulesPaths.empty())
+      throw CLI::ValidationError("--corpus", "needs --rules whose vocabulary the random requests use (examples/dawn/rules.yaml)");
+    // MODEL.glb#*: each primitive is a rig of its own, timed on its own mesh.
+    std::vector<std::string> rigs;
+    for (const auto& r : co.rigs) {
+      if (auto parts = wholeModelParts(r)) {
+        for (const auto& p : *parts) rigs.push_back(p.ref);
+      } else {
+        rigs.push_back(r);
+      }
+    }
+    co.rigs = rigs;
     co.check = !noCheck;
     co.probes = !noProbes;
     co.form = form == "roofline" ? ProfileForm::Roofline : ProfileForm::Additive;
     if (!output.empty()) {
       std::vector<InputFile> inputs;
-      for (const auto& r : co.rigs) inputs.push_back({r, "a rig"});
+      for (const auto& r : co.rigs) inputs.push_back({isGltfPath(r) ? parseGltfRef(r).file : r, "a rig"});
       if (!co.rigs.empty()) inputs.push_back({co.plans.fragmentPath, "the fragment shader"});
       for (const auto& r : co.plans.rulesPaths) inputs.push_back({r, "a rules file"});
       refuseClobbering({output}, inputs);
@@ -69,7 +82,8 @@ void registerCalibrate(CLI::App& app, CliState& state) {
                                            "weights, the first one's size is the profile's vertices_per_draw "
                                            "(default dawn,head: 180,000 and 2,009 vertices)");
   sub->add_option("--rig", cmd->co.rigs, "Also time the plan of this rig, its forced alternatives and bench's floors; "
-                                         "repeat for several rigs (a packed layout beside the float one)");
+                                         "repeat for several rigs (a packed layout beside the float one). A glTF rig "
+                                         "(MODEL.glb#m/p, or MODEL.glb#* for every primitive) is timed on its own mesh");
   sub->add_option("--fragment,-f", cmd->co.plans.fragmentPath, "With --rig: the fragment shader");
   sub->add_option("--rules,-r", cmd->co.plans.rulesPaths, "With --rig: rules file(s)");
   sub->add_option("--max-attributes", cmd->co.plans.maxAttributes, "With --rig: vertex input attributes (default 16)")
@@ -84,6 +98,11 @@ void registerCalibrate(CLI::App& app, CliState& state) {
   sub->add_option("--near-best-weight", cmd->co.nearBestPower,
                   "With --rig: a plan's row in the fit weighs (its rig's fastest / its time)^P (default 4; 0: all alike)")
       ->check(CLI::Range(0.0, 16.0));
+  sub->add_option("--corpus", cmd->co.corpus,
+                  "Also time N random rigs, each with a random request (generator/measure/corpus.h), over --rules "
+                  "(examples/dawn/rules.yaml has their vocabulary), as --rig does")
+      ->check(CLI::Range(0, 1000));
+  sub->add_option("--seed", cmd->co.corpusSeed, "The corpus's seed (default 1): the same seed, the same rigs");
   sub->add_flag("--no-check", cmd->noCheck, "With --rig: do not time the rigs' plans under the fitted profile afterwards");
   sub->add_flag("--no-probes", cmd->noProbes, "With --rig: time only the rigs' programs (samples for another fit)");
   sub->add_option("--form", cmd->form, "The model fitted: additive (default) or roofline (docs/device-profiles.md)")

@@ -103,6 +103,7 @@ struct RenderCommand {
 };
 
 struct BenchCommand {
+  CLI::App* cmd = nullptr;
   GenerateArgs args;
   GpuBenchOptions bo;
   std::string size = "256x256";
@@ -112,6 +113,8 @@ struct BenchCommand {
 
   int run() {
     bo.render.gen = args.resolve();
+    if (isGltfPath(bo.render.gen.rigPath))
+      refuseOption(*cmd, "--mesh", "to a glTF rig (" + bo.render.gen.rigPath + "): it is timed on its own mesh");
     bo.render.limits = {!bo.render.device.empty(), args.maxAttributes->count() > 0, args.maxUniformBytes->count() > 0};
     bo.render.validationLayers = !noLayers;
     unsigned w = 0, h = 0;
@@ -124,7 +127,29 @@ struct BenchCommand {
     bo.rasterOff = raster != "on";
     bo.alternatives = !noAlternatives;
     bo.floor = !noFloor;
-    GpuBenchReport rep = runGpuBench(bo);
+    // MODEL.glb#*: every primitive timed on its own mesh (its vertices, its index order), one
+    // table each; a primitive that cannot be generated is reported and the others still run.
+    if (auto parts = wholeModelParts(bo.render.gen.rigPath)) {
+      if (!bo.handPortPath.empty())
+        throw CLI::ValidationError("--hand-port", "does not apply to a whole model: one hand port cannot stand in for every primitive");
+      const std::string model = bo.render.gen.rigPath;
+      int failed = 0;
+      std::vector<std::string> broken = forEachPart(*parts, [&](const GltfPart& part) {
+        GpuBenchOptions one = bo;
+        one.render.gen.rigPath = part.ref;
+        GpuBenchReport rep = runGpuBench(one);
+        std::cout << fmt::format("## {} ({})\n\n", part.name, part.ref);
+        failed += report(rep);
+        std::cout << "\n";
+      });
+      failIfPartsFailed(model, parts->size(), broken, "the others were timed");
+      return failed ? 1 : 0;
+    }
+    return report(runGpuBench(bo)) ? 1 : 0;
+  }
+
+  // Prints the report; returns how many programs failed on the device.
+  static int report(const GpuBenchReport& rep) {
     for (const auto& n : rep.notes) std::cerr << formatDiagnostic(n) << "\n";
     std::cout << formatGpuBench(rep);
     int failed = 0;
@@ -133,7 +158,7 @@ struct BenchCommand {
         std::cerr << "shadergen: error: " << row.label << " fails on " << rep.device << " (not timed): " << row.validation << "\n";
         ++failed;
       }
-    return failed ? 1 : 0;
+    return failed;
   }
 };
 
@@ -176,10 +201,12 @@ void registerRender(CLI::App& app, CliState& state) {
   CLI::App* b = app.add_subcommand("bench", "Time the generated vertex program, its forced alternatives, a hand-written "
                                             "port and a pass-through floor on the GPU (timestamp queries), each validated on that "
                                             "device first (one that fails is not timed; exit status 1)");
+  bench->cmd = b;
   bench->args.add(*b);
   b->add_option("--hand-port", bench->bo.handPortPath, "A hand-written vertex shader with the same interface "
                                                        "(a_<attribute>, u_<uniform>), e.g. examples/dawn/listing-3-3.vert");
-  b->add_option("--mesh", bench->bo.render.mesh, "Procedural mesh: dawn (default, 180k vertices), head, limb")
+  b->add_option("--mesh", bench->bo.render.mesh, "Procedural mesh for a YAML rig: dawn (default, 180k vertices), head, limb "
+                                                 "(a glTF rig, MODEL.glb#m/p or the whole MODEL.glb#*, draws its own mesh)")
       ->check(CLI::IsMember({"head", "limb", "dawn"}));
   b->add_option("--size", bench->size, "Render target WIDTHxHEIGHT with rasterization on (default 256x256)");
   b->add_option("--draws", bench->bo.drawsPerFrame, "Draws of the mesh between two timestamps (default 8)")

@@ -10,11 +10,14 @@
 #include <unistd.h>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include "analysis/cost.h"
 #include "common/glsl_compile.h"
+#include "measure/corpus.h"
 #include "measure/fit.h"
 #include "measure/workload.h"
+#include "rig/gltf_import.h"
 #include "runtime/procedural.h"
 #include "runtime/vk_render.h"
 #include "validate/program_inputs.h"
@@ -401,6 +404,130 @@ std::vector<CalibrationFit> evaluateFit(std::vector<CalibrationSample>& samples,
   return fits;
 }
 
+namespace {
+
+bool isPlanSample(const CalibrationSample& s) { return !s.rig.empty() && s.label.find("floor") == std::string::npos; }
+
+double medianOfFinite(std::vector<double> v) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+std::string heldOutSummary(const LeaveOneRigOut& loo) {
+  return fmt::format("leave-one-rig-out over {} (rig, mesh) pairs: median Spearman {:.3f}, worst chosen / fastest {:.3f}, "
+                     "RMS relative error median {:.1f} %, max {:.1f} %",
+                     loo.rows.size(), loo.medianSpearman, loo.worstChosenOverFastest, 100 * loo.medianRms, 100 * loo.maxRms);
+}
+
+}  // namespace
+
+LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
+                              double workloadVertices, double nearBestPower, ProfileForm form) {
+  LeaveOneRigOut out;
+  std::set<std::string> rigs;
+  for (const auto& s : samples)
+    if (!s.rig.empty()) rigs.insert(s.rig);
+  if (rigs.size() < 2) return out;
+  for (const auto& rig : rigs) {
+    std::vector<CalibrationSample> rest;
+    for (const auto& s : samples)
+      if (s.rig != rig) rest.push_back(s);
+    const DeviceProfile profile = fitDeviceProfile(rest, deviceName, workloadVertices, nearBestPower, form);
+    std::vector<std::string> meshes;  // in the samples' order
+    for (const auto& s : samples)
+      if (s.rig == rig && std::find(meshes.begin(), meshes.end(), s.mesh) == meshes.end()) meshes.push_back(s.mesh);
+    for (const auto& mesh : meshes) {
+      HeldOutRig h;
+      h.rig = rig;
+      h.mesh = mesh;
+      std::set<TermAmounts> seen;  // a plan timed twice (chosen by two profiles) counts once
+      for (const auto& s : samples) {
+        if (s.rig != rig || s.mesh != mesh || !isPlanSample(s) || !s.validated || s.measuredNs <= 0) continue;
+        if (!seen.insert(s.amounts).second) continue;
+        h.predicted.push_back(profile.predictNanoseconds(s.amounts, s.vertices));
+        h.measured.push_back(s.measuredNs);
+      }
+      h.plans = h.measured.size();
+      if (h.plans == 0) continue;
+      double sq = 0;
+      size_t best = 0;
+      for (size_t i = 0; i < h.plans; ++i) {
+        const double rel = (h.predicted[i] - h.measured[i]) / h.measured[i];
+        sq += rel * rel;
+        if (h.predicted[i] < h.predicted[best]) best = i;
+      }
+      h.rmsRelativeError = std::sqrt(sq / double(h.plans));
+      h.chosenOverFastest = h.measured[best] / *std::min_element(h.measured.begin(), h.measured.end());
+      h.spearman = spearmanWithinSpread(h.predicted, h.measured, 0.005);
+      out.rows.push_back(std::move(h));
+    }
+  }
+  std::vector<double> rho, rms;
+  for (const auto& h : out.rows) {
+    rho.push_back(h.spearman);
+    rms.push_back(h.rmsRelativeError);
+    if (!(out.worstChosenOverFastest >= h.chosenOverFastest)) out.worstChosenOverFastest = h.chosenOverFastest;
+    if (!(out.maxRms >= h.rmsRelativeError)) out.maxRms = h.rmsRelativeError;
+  }
+  out.medianSpearman = medianOfFinite(rho);
+  out.medianRms = medianOfFinite(rms);
+  return out;
+}
+
+std::string formatLeaveOneRigOut(const LeaveOneRigOut& loo) {
+  if (loo.rows.empty()) return "";
+  std::string s = "\nleave-one-rig-out: each rig's plans predicted by the profile fitted without that rig\n\n"
+                  "| held-out rig | mesh | plans | Spearman | chosen / fastest | RMS relative error |\n|---|---|---:|---:|---:|---:|\n";
+  for (const auto& h : loo.rows)
+    s += fmt::format("| {} | {} | {} | {:.3f} | {:.3f} | {:.1f} % |\n", h.rig, h.mesh, h.plans, h.spearman, h.chosenOverFastest,
+                     100 * h.rmsRelativeError);
+  return s + heldOutSummary(loo) + "\n";
+}
+
+std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, const std::map<std::string, double>& meshVertices) {
+  std::vector<CalibrationSample> samples;
+  std::string line;
+  while (std::getline(table, line)) {
+    std::vector<std::string> cells;
+    std::stringstream row(line);
+    for (std::string cell; std::getline(row, cell, '|');) {
+      const size_t a = cell.find_first_not_of(' '), b = cell.find_last_not_of(' ');
+      cells.push_back(a == std::string::npos ? "" : cell.substr(a, b - a + 1));
+    }
+    // "| mesh | rig | program | amounts... | measured | predicted |", with the empty first cell.
+    if (cells.size() != 6 + size_t(kTermCount) || !meshVertices.count(cells[1])) continue;
+    CalibrationSample s;
+    s.mesh = cells[1];
+    s.vertices = meshVertices.at(s.mesh);
+    s.rig = cells[2] == "—" ? "" : cells[2];
+    s.label = cells[3];
+    s.fitted = s.label.rfind("checked plan", 0) != 0;
+    try {
+      for (int t = 0; t < kTermCount; ++t) s.amounts[size_t(t)] = std::stoll(cells[4 + size_t(t)]);
+      s.measuredNs = std::stod(cells[4 + size_t(kTermCount)]);
+    } catch (const std::exception&) {
+      continue;  // a row that failed ("FAILED, not timed")
+    }
+    s.validated = true;
+    samples.push_back(s);
+  }
+  return samples;
+}
+
+// A rig as the samples name it: its file name, with a glTF rig's "#mesh/primitive".
+std::string rigLabel(const std::string& rig) {
+  const size_t hash = isGltfPath(rig) ? rig.rfind('#') : std::string::npos;
+  const std::string file = hash == std::string::npos ? rig : rig.substr(0, hash);
+  return std::filesystem::path(file).filename().string() + (hash == std::string::npos ? "" : rig.substr(hash));
+}
+
+std::vector<std::string> rigMeshes(const std::string& rig, const std::vector<std::string>& meshes) {
+  if (isGltfPath(rig)) return {kOwnMesh};
+  return meshes;
+}
+
 CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   if (opts.meshes.empty()) throw std::invalid_argument("calibration: no mesh");
   rt::HarnessOptions ho;
@@ -424,7 +551,9 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   for (const auto& meshName : opts.meshes) {
     ProbeMesh m = probeMesh(meshName);
     std::vector<Probe> probes = opts.probes ? makeProbes(m) : std::vector<Probe>{};
-    const Workload probeWorkload = measureWorkload(m.mesh, m.indices, true, -1, "probe mesh '" + meshName + "'");
+    // The probes' per-vertex palette indices are this mesh's skin: its workload is theirs.
+    const Workload probeWorkload =
+        measureWorkload(m.mesh, m.indices, true, -1, fmt::format("probe mesh '{}' ({} vertices)", meshName, m.mesh.vertexCount));
     for (auto& p : probes) {
       CalibrationSample s;
       s.label = p.label;
@@ -487,15 +616,29 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   struct Remove {
     std::vector<std::string> paths;
     ~Remove() {
-      for (const auto& p : paths) std::filesystem::remove(p);
+      for (const auto& p : paths) std::filesystem::remove_all(p);
     }
   } remove;
+  // The rigs: the given ones, then the corpus's random rigs, each with its own request.
+  std::vector<std::string> rigs = opts.rigs;
+  std::map<std::string, std::string> fragmentOf;
+  if (opts.corpus > 0) {
+    const std::string dir =
+        (std::filesystem::temp_directory_path() / fmt::format("shadergen-corpus-{}", ::getpid())).string();
+    remove.paths.push_back(dir);
+    for (const CorpusCase& c : randomCorpus(opts.corpus, opts.corpusSeed)) {
+      const CorpusFiles f = writeCorpusCase(c, dir);
+      rigs.push_back(f.rig);
+      fragmentOf[f.rig] = f.fragment;
+    }
+  }
   auto benchRigs = [&](const std::string& profilePath, bool fitted, const std::string& prefix) {
-    for (const auto& rig : opts.rigs)
-      for (const auto& meshName : opts.meshes) {
+    for (const auto& rig : rigs)
+      for (const auto& meshName : rigMeshes(rig, opts.meshes)) {
         GpuBenchOptions bo;
         bo.render.gen = opts.plans;
         bo.render.gen.rigPath = rig;
+        if (fragmentOf.count(rig)) bo.render.gen.fragmentPath = fragmentOf.at(rig);
         bo.render.gen.deviceProfilePath = profilePath;
         bo.render.device = opts.device;
         bo.render.validationLayers = opts.validationLayers;
@@ -508,11 +651,19 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
         bo.drawsPerFrame = opts.drawsPerFrame;
         bo.frames = opts.frames;
         bo.rounds = opts.rounds;
-        GpuBenchReport br = runGpuBench(bo);
+        GpuBenchReport br;
+        try {
+          br = runGpuBench(bo);
+        } catch (const InputError& e) {
+          if (!fragmentOf.count(rig)) throw;  // a given rig's error is the user's to see
+          rep.notes.push_back(fmt::format("{} on '{}' left out: {}", std::filesystem::path(rig).filename().string(),
+                                          meshName, e.what()));
+          continue;
+        }
         if (!fitted) {  // the plans' predicted against measured time, by this calibration's clock
           const PredictionCheck pc = checkPredictions(br.rows, clock);
           CalibrationCheck c;
-          c.rig = rig;
+          c.rig = rigLabel(rig);
           c.mesh = meshName;
           c.plans = pc.plans;
           c.spearman = pc.spearman;
@@ -525,8 +676,8 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           s.label = (row.hasCost ? prefix : "") + row.label;
           s.mesh = meshName;
           s.vertices = double(br.vertices);
+          s.rig = rigLabel(rig);
           s.workload = br.workload;
-          s.rig = std::filesystem::path(rig).filename().string();
           s.fitted = fitted;
           s.amounts = row.amounts;
           s.validated = row.validation == "pass" || (!row.hasCost && row.*clock > 0);
@@ -536,7 +687,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
         }
       }
   };
-  if (!opts.rigs.empty()) {
+  if (!rigs.empty()) {
     std::string slots = opts.plans.deviceProfilePath;
     if (slots.empty()) {
       slots = temporaryProfile("slots", "device: instruction slots\nweights:\n  arithmetic: 0.000001\n");
@@ -547,12 +698,12 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   double workload = 0;
   for (const auto& s : rep.samples)
     if (s.mesh == opts.meshes.front()) workload = s.vertices;
-  rep.nearBestPower = opts.rigs.empty() ? 0 : opts.nearBestPower;
+  rep.nearBestPower = rigs.empty() ? 0 : opts.nearBestPower;
   rep.profile = fitDeviceProfile(rep.samples, rep.device + " (" + rep.driver + ")", workload, opts.nearBestPower, opts.form);
   // The check: each rig's plans under the fitted profile. The plans a profile chooses are
   // where its errors cost time, so each refit adds them to the fit; the last check's plans
   // are never fitted.
-  for (uint32_t round = 0; opts.check && !opts.rigs.empty(); ++round) {
+  for (uint32_t round = 0; opts.check && !rigs.empty(); ++round) {
     const std::string fitted = temporaryProfile(fmt::format("fit{}", round + 1), deviceProfileYaml(rep));
     remove.paths.push_back(fitted);
     rep.checks.clear();
@@ -562,7 +713,12 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
     for (auto& s : rep.samples) s.fitted = true;
     rep.profile = fitDeviceProfile(rep.samples, rep.profile.device, workload, opts.nearBestPower, opts.form);
   }
-  rep.fits = evaluateFit(rep.samples, rep.profile, opts.meshes);
+  std::vector<std::string> fitMeshes = opts.meshes;
+  for (const auto& rig : rigs)
+    if (isGltfPath(rig) && std::find(fitMeshes.begin(), fitMeshes.end(), kOwnMesh) == fitMeshes.end())
+      fitMeshes.push_back(kOwnMesh);
+  rep.fits = evaluateFit(rep.samples, rep.profile, fitMeshes);
+  rep.heldOut = leaveOneRigOut(rep.samples, rep.profile.device, workload, rep.nearBestPower, opts.form);
   return rep;
 }
 
@@ -637,6 +793,8 @@ std::string formatCalibration(const CalibrationReport& r) {
     s += fmt::format("check of {} on '{}' under the fitted profile: {} plans, predicted vs measured Spearman {:.3f}; "
                      "the chosen plan takes {:.3f}x the fastest\n",
                      c.rig, c.mesh, c.plans, c.spearman, c.generatedOverFastest);
+  s += formatLeaveOneRigOut(r.heldOut);
+  for (const auto& n : r.notes) s += "note: " + n + "\n";
   return s;
 }
 
@@ -651,6 +809,7 @@ std::string deviceProfileYaml(const CalibrationReport& r) {
   for (const auto& c : r.checks)
     s += fmt::format("# check of {} on '{}': {} plans, Spearman {:.3f}, chosen plan {:.3f}x the fastest\n", c.rig, c.mesh, c.plans,
                      c.spearman, c.generatedOverFastest);
+  if (!r.heldOut.rows.empty()) s += "# " + heldOutSummary(r.heldOut) + "\n";
   s += fmt::format("device: \"{}\"\nunit: ns\n", r.profile.device);
   return s + weightLines(r.profile);
 }

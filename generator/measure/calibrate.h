@@ -18,6 +18,8 @@
 #pragma once
 #include <cmath>
 #include <cstdint>
+#include <istream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -26,6 +28,14 @@
 #include "search/device_profile.h"
 
 namespace sg {
+
+// The mesh of a glTF rig's samples: the model's own primitive (its vertices and index
+// order), not a procedural mesh.
+inline constexpr const char* kOwnMesh = "own";
+// The meshes a rig's plans are timed on: a glTF rig's own, a YAML rig's procedural ones.
+std::vector<std::string> rigMeshes(const std::string& rig, const std::vector<std::string>& meshes);
+// A rig as samples and reports name it: "face.rig.yaml", "Fox.glb#0/0".
+std::string rigLabel(const std::string& rig);
 
 struct CalibrationOptions {
   std::string device;               // "" = lavapipe
@@ -37,9 +47,14 @@ struct CalibrationOptions {
   uint32_t width = 256, height = 256;  // the target of every draw (bench's default)
   bool probes = true;
   // For each rig: the generated plan and every forced alternative (bench's programs), with
-  // plans' fragment shader, rules and limits, and bench's floors.
+  // plans' fragment shader, rules and limits, and bench's floors. A glTF rig (MODEL.glb#m/p)
+  // is timed once, on its own mesh (kOwnMesh); a YAML rig on each of `meshes`.
   std::vector<std::string> rigs;
   GenerateOptions plans;
+  // Random rigs and requests of the corpus (measure/corpus.h) added to `rigs`, each with its
+  // own fragment shader, over plans.rulesPaths (examples/dawn/rules.yaml has the vocabulary).
+  size_t corpus = 0;
+  uint32_t corpusSeed = 1;
   bool check = true;  // then the same rigs' plans under the fitted profile
   // Refits: each adds the plans the profile chose to the samples and fits again; the last
   // profile's plans are the check, which no fit saw.
@@ -56,9 +71,9 @@ struct CalibrationSample {
   std::string mesh;
   double vertices = 0;  // per draw (the mesh's)
   std::string rig;      // the rig of a plan or floor ("" for a probe)
+  Workload workload;    // of the mesh and pose it was timed on (measure/workload.h); a probe's: its mesh's
   bool fitted = true;   // false: a plan of the check, which the fit did not see
   TermAmounts amounts{};
-  Workload workload;  // of the mesh it was timed on (measure/workload.h); the fit scales terms by it
   bool validated = false;
   std::string failure;      // why it was not timed (its outputs disagreed, or it did not run)
   double measuredNs = -1;   // per vertex, raster on, timestamps
@@ -82,6 +97,25 @@ struct CalibrationCheck {
   double generatedOverFastest = NAN;  // the chosen plan's time over the fastest plan's
 };
 
+// Leave-one-rig-out (docs/device-profiles.md, "Held-out error"): for each rig, the profile
+// fitted without any of that rig's samples (fitDeviceProfile on the rest: the probes and the
+// other rigs), predicting that rig's plans on each mesh it was timed on.
+struct HeldOutRig {
+  std::string rig, mesh;
+  size_t plans = 0;                  // distinct validated plans (by their term amounts)
+  std::vector<double> predicted, measured;  // ns per vertex, per plan
+  double spearman = NAN;             // predicted against measured (within 0.5 %: ties)
+  double chosenOverFastest = NAN;    // measured time of the least-predicted plan / the fastest
+  double rmsRelativeError = NAN;
+};
+struct LeaveOneRigOut {
+  std::vector<HeldOutRig> rows;  // by rig, then mesh
+  double medianSpearman = NAN, worstChosenOverFastest = NAN, medianRms = NAN, maxRms = NAN;
+};
+LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
+                              double workloadVertices, double nearBestPower, ProfileForm form = ProfileForm::Additive);
+std::string formatLeaveOneRigOut(const LeaveOneRigOut& loo);
+
 struct CalibrationReport {
   std::string device, driver;
   std::string clock;  // what measured the samples: GPU timestamps, or host time on a CPU device
@@ -90,6 +124,8 @@ struct CalibrationReport {
   DeviceProfile profile;
   std::vector<CalibrationFit> fits;  // one per mesh
   std::vector<CalibrationCheck> checks;
+  LeaveOneRigOut heldOut;  // with two rigs or more
+  std::vector<std::string> notes;  // corpus cases left out, and why
 };
 
 CalibrationReport calibrateDevice(const CalibrationOptions& opts);
@@ -105,6 +141,11 @@ DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, co
 // Fills predictedNs of every sample and the fit statistics per mesh.
 std::vector<CalibrationFit> evaluateFit(std::vector<CalibrationSample>& samples, const DeviceProfile& profile,
                                         const std::vector<std::string>& meshes);
+
+// The samples of formatCalibration's table read back (recorded logs, bench/data/*.log):
+// rows whose mesh is in `meshVertices` (its vertices per draw). Rows "checked plan" are not
+// fitted; a rig of "—" is a probe's.
+std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, const std::map<std::string, double>& meshVertices);
 
 // The report as text (samples table, weights, fit errors), and the profile as a documented
 // YAML file that loadDeviceProfile reads back.

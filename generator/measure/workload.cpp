@@ -13,7 +13,7 @@
 namespace sg {
 
 Workload measureWorkload(const rt::Mesh& mesh, const std::vector<uint32_t>& indices, bool triangles,
-                         double activeMorphTargets, const std::string& source) {
+                         double activeMorphTargets, const std::string& source, int influences) {
   Workload w;
   w.source = source;
   w.activeMorphTargets = activeMorphTargets;
@@ -43,7 +43,7 @@ Workload measureWorkload(const rt::Mesh& mesh, const std::vector<uint32_t>& indi
     auto wt = mesh.streams.find(fmt::format("skin.weights[{}]", set));
     if (j == mesh.streams.end() || wt == mesh.streams.end()) break;
     if (j->second.size() < n || wt->second.size() < n) break;
-    for (int c = 0; c < 4; ++c)
+    for (int c = 0; c < 4 && (influences < 0 || 4 * set + c < influences); ++c)
       for (size_t g = 0; g < order.size(); g += kWorkloadWarp) {
         std::set<float> joints;
         for (size_t k = g; k < std::min(order.size(), g + kWorkloadWarp); ++k)
@@ -122,17 +122,30 @@ Workload rigWorkload(const std::string& rigPath, const std::map<std::string, int
     io.mesh = ref.mesh;
     io.primitive = ref.primitive;
     const GltfImport model = importGltf(ref.file, io);
+    const GltfModelData& d = model.data;
     GltfSceneOptions so;
     so.times = {0.0};
-    const ValidationScene vs = gltfScene(model, so);
-    const GltfModelData& d = model.data;
+    ValidationScene vs;
+    int active = 0;
+    try {  // posing reads the animations, which generation itself never needs
+      vs = gltfScene(model, so);
+      active = gltfActiveMorphTargets(d);
+    } catch (const InputError& e) {
+      Workload w;
+      w.verticesPerDraw = double(d.vertexCount);
+      w.source = fmt::format("{} mesh {} primitive {} ({} vertices; the rest not measured: {})", d.stem, d.mesh, d.primitive,
+                             d.vertexCount, e.diagnostic().message);
+      return w;
+    }
     const bool triangles = d.indicesError.empty() && d.mode >= 4 && d.mode <= 6;
     std::vector<uint32_t> indices = d.indices;
     if (triangles) indices = triangleList(d.indices, d.mode, vs.mesh.vertexCount, ref.file);
     const std::string source = fmt::format("{} mesh {} primitive {} ({} vertices{})", d.stem, d.mesh, d.primitive, d.vertexCount,
                                            d.indicesError.empty() ? "" : "; its indices could not be read");
     if (!d.indicesError.empty()) indices.clear();
-    Workload w = measureWorkload(vs.mesh, indices, triangles, gltfActiveMorphTargets(d), source);
+    const auto lod = params.find("influences");
+    Workload w = measureWorkload(vs.mesh, indices, triangles, active, source,
+                                 lod == params.end() ? -1 : int(lod->second));
     if (!d.indicesError.empty()) w.jointsPerWarp = 0;  // no shading order known
     return w;
   }

@@ -41,9 +41,10 @@ constexpr uint32_t kWorkloadPrimGroup = 32;     // its primgroup_size
 
 // The figures of one mesh: `indices` in draw order (empty: 0..vertexCount-1), a triangle list
 // when `triangles` (else only the order is read). Influences come from the streams
-// skin.joints[s] / skin.weights[s]; indices past the mesh are ignored.
+// skin.joints[s] / skin.weights[s], the first `influences` slots (-1: all; a level-of-detail
+// rig reads fewer than its mesh stores); indices past the mesh are ignored.
 Workload measureWorkload(const rt::Mesh& mesh, const std::vector<uint32_t>& indices, bool triangles,
-                         double activeMorphTargets, const std::string& source);
+                         double activeMorphTargets, const std::string& source, int influences = -1);
 
 // The most morph weights that are non-zero at once over the model's animations (see above).
 // 0 for a primitive without morph targets.

@@ -81,7 +81,8 @@ std::vector<std::string> inputsOf(const SharedInputs& s, const Variant& v) {
 // Every byte that can change a variant's outputs: the tool, the options, the variant's
 // parameters and mappings, and each input file's path (outputs name them) and contents
 // (through the SHA-256 of the file).
-std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v, const std::vector<std::string>& inputs) {
+std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v, const std::vector<std::string>& inputs,
+                     const Workload* workload) {
   Sha256 h;
   h.field(kCacheFormat).field(shadergenVersion()).field(targetEnvName(m.targetEnv)).field(m.heuristic);
   h.field(m.optimize ? "optimize" : "no-optimize");
@@ -101,6 +102,11 @@ std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v,
   if (!v.pass->conventions.empty()) {  // only then: earlier manifests keep their cache keys
     h.field("conventions");
     for (const auto& c : v.pass->conventions) h.field(c);
+  }
+  if (workload && workload->known()) {  // only then: earlier manifests keep their cache keys
+    h.field("workload").field(fmt::format("{:.17g} {:.17g} {:.17g} {:.17g}", workload->verticesPerDraw, workload->jointsPerWarp,
+                                          workload->activeMorphTargets, workload->invocationsPerVertex));
+    h.field(workload->source);
   }
   h.field("inputs");
   for (const auto& f : inputs) h.field(f).field(s.digests.at(f));
@@ -206,7 +212,7 @@ GenerateOptions generateOptionsOf(const Manifest& m, const Variant& v) {
 
 // ---- one variant ------------------------------------------------------------------------
 
-void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v, BuiltVariant& out) {
+void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v, const Workload* workload, BuiltVariant& out) {
   const Rig& base = s.rigs.at(v.rig->path);
   SourceLoc paramsAt{m.file, 0, 0};
   for (const auto& a : m.axes)
@@ -216,6 +222,7 @@ void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v,
     }
   Rig rig = v.params.empty() ? base : rigWithParameters(base, v.params, paramsAt);
   GenerateOptions o = generateOptionsOf(m, v);
+  if (workload) o.workload = *workload;
   if (m.emits("hlsl")) o.hlsl = m.hlsl;
   if (m.emits("msl")) o.msl = m.msl;
   LoadedInputs in = prepareInputs(std::move(rig), s.rules, s.fragments.at(v.pass->fragment), o, s.profile);
@@ -233,7 +240,9 @@ void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts
               const std::string& validatorIdentity, BuiltVariant& out) {
   const Variant& v = *out.variant;
   out.inputs = inputsOf(s, v);
-  out.key = cacheKey(m, s, v, out.inputs);
+  auto w = opts.workloads.find(v.name);
+  const Workload* workload = w == opts.workloads.end() ? nullptr : &w->second;
+  out.key = cacheKey(m, s, v, out.inputs, workload);
   BuiltVariant fromCache;  // read into its own record, so nothing leaks from a damaged entry
   std::optional<std::string> body = store.enabled() ? store.get(out.key) : std::nullopt;
   if (body && parseGenerated(*body, fromCache)) {
@@ -247,7 +256,7 @@ void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts
     out.ok = out.cached = true;
   } else {
     try {
-      generateVariant(m, s, v, out);
+      generateVariant(m, s, v, workload, out);
       out.ok = true;
       if (store.enabled()) store.put(out.key, generatedBody(out));
     } catch (const InputError& e) {
@@ -269,7 +278,9 @@ void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts
     }
   }
   try {
-    out.validation = opts.validator->validate(v, generateOptionsOf(m, v));
+    GenerateOptions o = generateOptionsOf(m, v);  // priced as it was generated
+    if (workload) o.workload = *workload;
+    out.validation = opts.validator->validate(v, o);
   } catch (const InputError& e) {
     out.validation = ValidationResult{};
     out.validation->errors.push_back(e.diagnostic());

@@ -14,6 +14,7 @@
 #include "common/diagnostics.h"
 #include "pipeline/generate.h"
 #include "variants/cache_store.h"
+#include "search/workload.h"
 #include "variants/manifest.h"
 
 namespace sg {
@@ -52,6 +53,9 @@ struct BuildOptions {
   unsigned jobs = 0;     // 0 = every hardware thread
   // Called (under a lock) as each variant finishes.
   std::function<void(size_t done, size_t total, const std::string& variant, bool cached)> progress;
+  // The workload each variant is priced for, by variant name (measured by the caller,
+  // measure/workload.h; absent: unknown). Part of the cache key when known.
+  std::map<std::string, Workload> workloads;
 };
 
 struct BuiltVariant {

@@ -115,7 +115,7 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
   y.expectMap(root, "a manifest");
   y.checkKeys(root, {"output", "rules", "templates", "target_env", "optimize", "heuristic", "emit", "rigs", "passes",
                      "axes", "exclude", "name", "device_profile", "max_error", "hlsl_shader_model", "msl_version",
-                     "msl_platform", "validate", "cache_url"});
+                     "msl_platform", "validate", "cache_url", "mesh"});
   m.outputDir = resolvePath(file, root["output"] ? y.scalar(root["output"], "'output'") : "shaders");
   if (!root["rules"]) y.fail(root, "the manifest needs 'rules' (a rules file or a list of them)");
   for (const auto& r : scalarOrList(y, root["rules"], "'rules'")) m.rules.push_back(resolvePath(file, r));
@@ -126,6 +126,11 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
       y.fail(root["target_env"], fmt::format("unknown target_env '{}' (vulkan1.0, vulkan1.1, vulkan1.2, vulkan1.3)", env));
   }
   if (root["device_profile"]) m.deviceProfile = resolvePath(file, y.scalar(root["device_profile"], "'device_profile'"));
+  if (root["mesh"]) {  // the procedural mesh YAML rigs' programs draw (their workload)
+    m.mesh = y.scalar(root["mesh"], "'mesh'");
+    if (m.mesh != "head" && m.mesh != "limb" && m.mesh != "dawn")
+      y.fail(root["mesh"], fmt::format("unknown mesh '{}' (head, limb, dawn)", m.mesh));
+  }
   if (root["max_error"]) {  // { vertex.normal: 0.1deg, vertex.position: 1e-4 }, as --max-error
     y.expectMap(root["max_error"], "'max_error'");
     for (const auto& kv : root["max_error"]) {

@@ -81,6 +81,9 @@ struct Manifest {
   // `max_error:` error budgets per encoded semantic, in its encodings' unit (GenerateOptions::maxError).
   std::map<std::string, double> maxError;
   std::string deviceProfile;  // `device_profile:` (docs/device-profiles.md); "" = instruction slots
+  // `mesh:` the procedural mesh (head, limb, dawn) whose workload YAML rigs are priced for
+  // under the device profile; glTF rigs are measured on their own mesh. "" = unknown.
+  std::string mesh;
   HlslOptions hlsl;           // `hlsl_shader_model:`, when emit has hlsl (docs/hlsl-msl.md)
   MslOptions msl;             // `msl_version:`, `msl_platform:`, when emit has msl
   ManifestValidation validate;  // `validate:`

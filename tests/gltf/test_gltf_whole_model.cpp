@@ -231,6 +231,43 @@ TEST(WholeModel, GenerateAndImportWriteEveryPrimitiveOrNothing) {
 
 // A manifest's whole-model rig is one rig per primitive; a rig axis value naming the model
 // stands for all of them, and exclusions name the parts.
+// bench MODEL.glb#*: every primitive timed on its own mesh (its vertex count, its workload),
+// one table each, each program validated on the device first.
+TEST(WholeModel, BenchTimesEveryPrimitiveOnItsOwnMesh) {
+  SKIP_WITHOUT_ROBOT();
+  CliRun b = cli(fmt::format("bench --rig \"{}#*\" -f \"{}\" -r \"{}\" --draws 1 --frames 1 --rounds 1 --raster off "
+                             "--no-alternatives --no-floor --no-validation-layers",
+                             robot(), sourcePath("examples/render/flat.frag"), sourcePath("rules/standard.yaml")));
+  ASSERT_EQ(b.status, 0) << b.out;
+  for (const GltfPart& part : gltfParts(robot())) {
+    SCOPED_TRACE(part.ref);
+    const size_t at = b.out.find(fmt::format("## {} ({})", part.name, part.ref));
+    ASSERT_NE(at, std::string::npos) << b.out;
+    GltfImportOptions io;
+    io.mesh = part.mesh;
+    io.primitive = part.primitive;
+    const size_t vertices = importGltf(robot(), io).data.vertexCount;
+    EXPECT_EQ(b.out.find(fmt::format("mesh: {} vertices", vertices), at), b.out.find("mesh: ", at));
+    EXPECT_EQ(b.out.find(fmt::format("workload: {} vertices per draw", vertices), at), b.out.find("workload: ", at));
+    EXPECT_NE(b.out.find("| generated | pass |", at), std::string::npos);
+  }
+  // With a profile, generate records the primitive's workload in the reflection; without one
+  // the workload prices nothing and --mesh is refused.
+  fs::path json = scratch("workload.json");
+  CliRun g = cli(fmt::format("generate -q --rig \"{}#12/1\" -f \"{}\" -r \"{}\" --device-profile \"{}\" --emit reflection -o \"{}\"",
+                             robot(), sourcePath("examples/render/flat.frag"), sourcePath("rules/standard.yaml"),
+                             sourcePath("devices/nvidia-h200.yaml"), json.string()));
+  ASSERT_EQ(g.status, 0) << g.out;
+  const nlohmann::json r = nlohmann::json::parse(std::ifstream(json));
+  ASSERT_TRUE(r.contains("workload")) << r.dump();
+  EXPECT_GE(r["workload"]["joints_per_warp"].get<double>(), 1.0);  // the hand is skinned
+  CliRun refused = cli(fmt::format("generate -q --rig \"{}\" -f \"{}\" -r \"{}\" --mesh dawn -o \"{}\"",
+                                   sourcePath("examples/dawn/face.rig.yaml"), sourcePath("examples/dawn/face.frag"),
+                                   sourcePath("examples/dawn/rules.yaml"), json.string()));
+  EXPECT_NE(refused.status, 0);
+  EXPECT_NE(refused.out.find("--mesh: does not apply without --device-profile"), std::string::npos) << refused.out;
+}
+
 TEST(WholeModel, ManifestExpandsAWholeModelIntoOneRigPerPrimitive) {
   SKIP_WITHOUT_ROBOT();
   std::string text = fmt::format(R"(rules: {}

@@ -35,6 +35,9 @@ TEST(Calibrate, EveryProbeAgreesWithItsExpectedOutputsOnLavapipeAndVariesOneTerm
     EXPECT_TRUE(s.validated) << s.label << ": " << s.failure;
     EXPECT_GT(s.measuredNs, 0) << s.label;
     EXPECT_EQ(s.amounts[kTermVertices], 1) << s.label;
+    // The workload of the probe mesh, whose skin (the Dawn face's) indexes the palette probes.
+    EXPECT_EQ(s.workload.verticesPerDraw, s.vertices) << s.label;
+    EXPECT_GE(s.workload.jointsPerWarp, 1.0) << s.label;
   }
   // Locations at fixed bytes and bytes at fixed locations, as built.
   const CalibrationSample* f16 = find(r, "locations 16 (float32x4 after the position)");
@@ -169,31 +172,8 @@ TEST(Calibrate, TwoMeshSizesSeparatePerDrawFromPerVertexCosts) {
 // both Dawn layouts' plans at Dawn scale and on the cached head, each validated before it was
 // timed): data the fit was not designed around. Rows "checked plan" are never fitted.
 std::vector<CalibrationSample> h200Samples() {
-  const std::map<std::string, double> vertices = {{"dawn", 180000}, {"head", 2009}};  // the log's meshes
   std::ifstream in(std::string(SG_SOURCE_DIR) + "/bench/data/h200-calibrate-alike.log");
-  std::vector<CalibrationSample> samples;
-  std::string line;
-  while (std::getline(in, line)) {
-    std::vector<std::string> cells;
-    std::stringstream row(line);
-    for (std::string cell; std::getline(row, cell, '|');) {
-      const size_t a = cell.find_first_not_of(' '), b = cell.find_last_not_of(' ');
-      cells.push_back(a == std::string::npos ? "" : cell.substr(a, b - a + 1));
-    }
-    // "| mesh | rig | program | 8 amounts | measured | predicted |": 14 cells with the empty first.
-    if (cells.size() != 14 || !vertices.count(cells[1])) continue;
-    CalibrationSample s;
-    s.mesh = cells[1];
-    s.vertices = vertices.at(s.mesh);
-    s.rig = cells[2].find(".rig.yaml") == std::string::npos ? "" : cells[2];  // a probe's is a dash
-    s.label = cells[3];
-    s.fitted = s.label.rfind("checked plan", 0) != 0;
-    for (int t = 0; t < kTermCount; ++t) s.amounts[size_t(t)] = std::stoll(cells[4 + size_t(t)]);
-    s.measuredNs = std::stod(cells[12]);
-    s.validated = true;
-    samples.push_back(s);
-  }
-  return samples;
+  return parseCalibrationSamples(in, {{"dawn", 180000}, {"head", 2009}});  // the log's meshes
 }
 
 // Of a rig's measured plans on a mesh, the one the profile predicts fastest, over the fastest.

@@ -35,6 +35,8 @@ TEST(Workload, JointsPerWarpCountsDistinctWeightedJointsPerGroupAndSlot) {
   // Pairs (group, slot) with a weighted influence: (0,0)=4, (1,0)=4, (0,1)=1: mean 9/3.
   Workload wl = measureWorkload(m, {}, false, -1, "hand");
   EXPECT_DOUBLE_EQ(wl.jointsPerWarp, 3.0);
+  // A rig reading only the first influence: slot 0 alone, 4 per group.
+  EXPECT_DOUBLE_EQ(measureWorkload(m, {}, false, -1, "hand", 1).jointsPerWarp, 4.0);
   EXPECT_DOUBLE_EQ(wl.verticesPerDraw, 64);
   EXPECT_EQ(wl.activeMorphTargets, -1);
   EXPECT_EQ(wl.invocationsPerVertex, 0);  // not triangles: unknown
@@ -156,6 +158,12 @@ TEST(Workload, RealModelsWithinTheirSkinsAndTargets) {
   EXPECT_GE(sphere.activeMorphTargets, 1);
   EXPECT_LE(sphere.activeMorphTargets, 2);
   EXPECT_THROW(rigWorkload(kModels + "Fox/Fox.glb#0/0", {}, "head"), InputError);  // its own mesh only
+  // A level-of-detail glTF rig with one influence reads slot 0 only, the slot whose joints
+  // vary most across a warp (later slots hold fewer, often zero-weight, influences): its mean
+  // is that slot's alone.
+  const double lod = rigWorkload(kModels + "Fox/Fox.glb#0/0", {{"influences", 1}}, "").jointsPerWarp;
+  EXPECT_GT(lod, rigWorkload(kModels + "Fox/Fox.glb#0/0", {}, "").jointsPerWarp);
+  EXPECT_LE(lod, 24.0);  // the Fox's skin has 24 joints
 }
 
 }  // namespace

@@ -470,3 +470,42 @@ TEST(Manifest, ErrorBudgetsAreChecked) {
   EXPECT_EQ(loadManifestText(head + "max_error: { vertex.position: 1e-4, vertex.normal: 0.1rad }\n", "m.yaml").maxError,
             (std::map<std::string, double>{{"vertex.normal", glm::degrees(0.1)}, {"vertex.position", 1e-4}}));
 }
+
+// The workload a variant is priced for (BuildOptions::workloads, measured by the CLI from the
+// manifest's `mesh:`): with a profile it is recorded in the reflection, as generate records it,
+// and a different workload is a different cache key; an unknown mesh is a located error.
+TEST(Build, TheWorkloadIsRecordedAndKeyed) {
+  auto dir = freshDir("workload");
+  const std::string data = std::string(SG_SOURCE_DIR) + "/tests/validate/data/";
+  writeText(dir / "m.yaml", "output: out\nrules: " + std::string(SG_SOURCE_DIR) + "/rules/standard.yaml\n" +
+                                "device_profile: " + SG_SOURCE_DIR + "/devices/nvidia-h200.yaml\nmesh: dawn\n" +
+                                "rigs:\n  limb: " + data + "limb8.rig.yaml\npasses:\n  world: " + data + "world.frag\n");
+  Manifest m = loadManifest((dir / "m.yaml").string());
+  EXPECT_EQ(m.mesh, "dawn");
+  std::vector<Variant> variants = expandVariants(m);
+  ASSERT_EQ(variants.size(), 1u);
+  BuildOptions bo;
+  bo.workloads[variants[0].name] = Workload{180000, 2.5, -1, 2.1, "procedural mesh 'dawn'"};
+  BuildReport r = buildVariants(m, variants, bo);
+  ASSERT_EQ(r.failed, 0u);
+  const std::string reflection = filesOf(r).at(r.variants[0].outputs.at("reflection"));
+  GenerateOptions o;
+  o.rigPath = data + "limb8.rig.yaml";
+  o.fragmentPath = data + "world.frag";
+  o.rulesPaths = m.rules;
+  o.deviceProfilePath = m.deviceProfile;
+  o.workload = bo.workloads.begin()->second;
+  o.outputName = r.variants[0].outputs.at("glsl");
+  EXPECT_EQ(reflection, reflectionOf(generate(o)));
+  EXPECT_NE(reflection.find("\"workload\": {\"vertices_per_draw\": 180000, \"joints_per_warp\": 2.5"), std::string::npos)
+      << reflection;
+  BuildReport unknown = buildVariants(m, variants, BuildOptions{});
+  EXPECT_NE(unknown.variants[0].key, r.variants[0].key);
+  bo.workloads.begin()->second.jointsPerWarp = 3;
+  EXPECT_NE(buildVariants(m, variants, bo).variants[0].key, r.variants[0].key);
+
+  writeText(dir / "bad.yaml", "rules: r.yaml\nrigs:\n  face: f.rig.yaml\npasses:\n  color: c.frag\nmesh: cube\n");
+  const auto d = errorOf([&] { loadManifest((dir / "bad.yaml").string()); });
+  EXPECT_NE(d.message.find("unknown mesh 'cube'"), std::string::npos) << d.message;
+  EXPECT_EQ(d.loc.line, 6);
+}

@@ -1,0 +1,126 @@
+// Leave-one-rig-out (measure/calibrate.h) on the samples of a real H200 calibration
+// (bench/data/h200-calibrate-alike.log): each rig's plans predicted by a fit that never saw
+// that rig, and the figures computed as stated.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+
+#include "measure/calibrate.h"
+#include "measure/corpus.h"
+
+namespace sg {
+namespace {
+
+std::vector<CalibrationSample> recorded() {
+  std::ifstream in(std::string(SG_SOURCE_DIR) + "/bench/data/h200-calibrate-alike.log");
+  return parseCalibrationSamples(in, {{"dawn", 180000}, {"head", 2009}});
+}
+
+const HeldOutRig* row(const LeaveOneRigOut& l, const std::string& rig, const std::string& mesh) {
+  for (const auto& h : l.rows)
+    if (h.rig == rig && h.mesh == mesh) return &h;
+  return nullptr;
+}
+
+TEST(HeldOut, EachRigIsPredictedByAFitThatNeverSawIt) {
+  const std::vector<CalibrationSample> samples = recorded();
+  ASSERT_EQ(samples.size(), 240u) << "the log's table changed";
+  const LeaveOneRigOut loo = leaveOneRigOut(samples, "H200", 180000, 4);
+  ASSERT_EQ(loo.rows.size(), 4u);  // two rigs on two meshes
+  for (const char* rig : {"face.rig.yaml", "face-packed.rig.yaml"})
+    for (const char* mesh : {"dawn", "head"}) ASSERT_NE(row(loo, rig, mesh), nullptr) << rig << " " << mesh;
+
+  // Slow every program of the float face down threefold: its own held-out predictions must
+  // not move (its samples are not in its fit), while the packed face's must (they are in its).
+  std::vector<CalibrationSample> slowed = samples;
+  for (auto& s : slowed)
+    if (s.rig == "face.rig.yaml") s.measuredNs *= 3;
+  const LeaveOneRigOut again = leaveOneRigOut(slowed, "H200", 180000, 4);
+  for (const char* mesh : {"dawn", "head"}) {
+    EXPECT_EQ(row(again, "face.rig.yaml", mesh)->predicted, row(loo, "face.rig.yaml", mesh)->predicted) << mesh;
+    EXPECT_NE(row(again, "face-packed.rig.yaml", mesh)->predicted, row(loo, "face-packed.rig.yaml", mesh)->predicted) << mesh;
+    // Its measured times did triple, so its error against the unchanged predictions changed.
+    EXPECT_NE(row(again, "face.rig.yaml", mesh)->rmsRelativeError, row(loo, "face.rig.yaml", mesh)->rmsRelativeError);
+  }
+}
+
+TEST(HeldOut, FiguresFollowTheirDefinitions) {
+  const LeaveOneRigOut loo = leaveOneRigOut(recorded(), "H200", 180000, 4);
+  std::vector<double> rho, rms;
+  double worst = 0;
+  for (const auto& h : loo.rows) {
+    SCOPED_TRACE(h.rig + " on " + h.mesh);
+    ASSERT_EQ(h.predicted.size(), h.plans);
+    ASSERT_GE(h.plans, 3u);
+    // chosen / fastest: the measured time of the least-predicted plan over the least measured.
+    const size_t chosen = size_t(std::min_element(h.predicted.begin(), h.predicted.end()) - h.predicted.begin());
+    EXPECT_DOUBLE_EQ(h.chosenOverFastest, h.measured[chosen] / *std::min_element(h.measured.begin(), h.measured.end()));
+    EXPECT_GE(h.chosenOverFastest, 1.0);
+    double sq = 0;
+    for (size_t i = 0; i < h.plans; ++i) sq += std::pow((h.predicted[i] - h.measured[i]) / h.measured[i], 2);
+    EXPECT_NEAR(h.rmsRelativeError, std::sqrt(sq / double(h.plans)), 1e-12);
+    EXPECT_GE(h.spearman, -1.0);
+    EXPECT_LE(h.spearman, 1.0);
+    rho.push_back(h.spearman);
+    rms.push_back(h.rmsRelativeError);
+    worst = std::max(worst, h.chosenOverFastest);
+  }
+  std::sort(rho.begin(), rho.end());
+  std::sort(rms.begin(), rms.end());
+  EXPECT_DOUBLE_EQ(loo.medianSpearman, 0.5 * (rho[1] + rho[2]));  // four rows
+  EXPECT_DOUBLE_EQ(loo.medianRms, 0.5 * (rms[1] + rms[2]));
+  EXPECT_DOUBLE_EQ(loo.maxRms, rms.back());
+  EXPECT_DOUBLE_EQ(loo.worstChosenOverFastest, worst);
+  // One rig alone cannot be held out: nothing would be left to fit its plans with.
+  std::vector<CalibrationSample> one;
+  for (const auto& s : recorded())
+    if (s.rig != "face-packed.rig.yaml") one.push_back(s);
+  EXPECT_TRUE(leaveOneRigOut(one, "H200", 180000, 4).rows.empty());
+}
+
+TEST(HeldOut, TheProfileRecordsTheSummary) {
+  CalibrationReport r;
+  r.samples = recorded();
+  r.profile = fitDeviceProfile(r.samples, "H200", 180000, 4);
+  r.heldOut = leaveOneRigOut(r.samples, "H200", 180000, 4);
+  const std::string yaml = deviceProfileYaml(r);
+  EXPECT_NE(yaml.find("# leave-one-rig-out over 4 (rig, mesh) pairs: median Spearman"), std::string::npos) << yaml;
+  EXPECT_NO_THROW(parseDeviceProfile(yaml, "held-out.yaml"));
+  const std::string text = formatCalibration(r);
+  EXPECT_NE(text.find("| held-out rig | mesh | plans | Spearman | chosen / fastest | RMS relative error |"), std::string::npos);
+  EXPECT_NE(text.find("| face-packed.rig.yaml | head |"), std::string::npos);
+}
+
+// calibrate --corpus: the random rigs' plans are timed on the device (lavapipe), each
+// validated first, and every rig is held out in turn.
+TEST(HeldOut, CalibrateTimesTheCorpusAndHoldsEachRigOut) {
+  CalibrationOptions o;
+  o.meshes = {"small"};
+  o.drawsPerFrame = 1;
+  o.frames = 1;
+  o.rounds = 1;
+  o.probes = false;
+  o.check = false;
+  o.corpus = 2;  // the fewest that can be held out in turn
+  o.validationLayers = false;
+  o.corpusSeed = 2;
+  o.plans.rulesPaths = {std::string(SG_SOURCE_DIR) + "/examples/dawn/rules.yaml"};
+  const CalibrationReport r = calibrateDevice(o);
+  EXPECT_TRUE(r.notes.empty()) << r.notes.front();
+  std::set<std::string> expected, timed, heldOut;
+  for (const auto& c : randomCorpus(2, 2)) expected.insert(c.name + ".rig.yaml");
+  for (const auto& s : r.samples) {
+    EXPECT_TRUE(s.validated) << s.rig << ": " << s.label << ": " << s.failure;
+    EXPECT_EQ(s.workload.verticesPerDraw, 41 * 49) << s.label;  // the procedural head they were timed on
+    timed.insert(s.rig);
+  }
+  for (const auto& h : r.heldOut.rows) heldOut.insert(h.rig);
+  EXPECT_EQ(timed, expected);
+  EXPECT_EQ(heldOut, expected);
+}
+
+}  // namespace
+}  // namespace sg
