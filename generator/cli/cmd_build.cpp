@@ -38,6 +38,7 @@ struct BuildCommand {
   bool quiet = false;
   bool progress = false;
   bool list = false;
+  GltfReadOptions gltf;
 
   int run() {
     if (noCache && !cacheDir.empty())
@@ -55,6 +56,7 @@ struct BuildCommand {
     }
     BuildOptions bo;
     bo.jobs = jobs;
+    bo.gltf = gltf;
     if (!noCache) bo.cacheDir = cacheDir.empty() ? (std::filesystem::path(m.outputDir) / ".shadergen-cache").string() : cacheDir;
     // Progress on a terminal, quiet in CI and in logs.
     bool showProgress = progress || (!quiet && isatty(STDERR_FILENO) && !std::getenv("CI"));
@@ -64,6 +66,7 @@ struct BuildCommand {
         if (done == total) std::cerr << "\n";
       };
     BuildReport r = buildVariants(m, variants, bo);
+    for (const auto& d : r.warnings) std::cerr << formatDiagnostic(d) << "\n";
     for (const auto& b : r.variants) {
       if (b.ok) continue;
       std::cerr << fmt::format("{}: error: variant '{}' failed:\n", m.file, b.variant->name);
@@ -103,6 +106,7 @@ void registerBuild(CLI::App& app, CliState& state) {
   sub->add_flag("-q,--quiet", cmd->quiet, "No progress and no summary");
   sub->add_flag("--progress", cmd->progress, "Show progress even when standard error is not a terminal");
   sub->add_flag("--list", cmd->list, "Print the variant names (one a line) and build nothing");
+  addGltfReadOptions(*sub, cmd->gltf);
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }
 

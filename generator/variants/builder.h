@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/diagnostics.h"
+#include "rig/gltf_import.h"
 #include "variants/manifest.h"
 
 namespace sg {
@@ -20,6 +21,7 @@ struct BuildOptions {
   unsigned jobs = 0;     // 0 = every hardware thread
   // Called (under a lock) as each variant finishes.
   std::function<void(size_t done, size_t total, const std::string& variant, bool cached)> progress;
+  GltfReadOptions gltf;  // how glTF rigs are read (--no-normalize-weights, --Werror)
 };
 
 struct BuiltVariant {
@@ -34,6 +36,7 @@ struct BuiltVariant {
   std::string hlsl, msl;               // when the manifest emits them
   std::string spirvHash;               // SHA-256 of the SPIR-V
   std::vector<std::string> inputs;     // every file it was made from (depfile)
+  std::string skinWeights;             // the rig's (Rig::skinWeights): recorded in the index
   std::map<std::string, std::string> outputs;  // kind -> path written
 };
 
@@ -47,6 +50,7 @@ struct BuildReport {
   std::vector<OutputFile> files;       // to write; deterministic order and bytes
   std::string indexPath;
   size_t cached = 0, generated = 0, failed = 0, sharedSpirv = 0;
+  std::vector<Diagnostic> warnings;    // the glTF rigs' import diagnostics, once per rig
 };
 
 // Builds every variant. Throws InputError when a shared input (rig, rules, fragment shader,
