@@ -224,7 +224,8 @@ AccessorData Reader::read(int index, const std::string& what) {
   for (float v : d.values)
     if (!std::isfinite(v))
       throw InputError(Diagnostic{Severity::Error, SourceLoc{file_, 0, 0},
-                                  fmt::format("{} holds a non-finite value", accName), "ACCESSOR_INVALID_FLOAT"});
+                                  fmt::format("{} holds a non-finite value (/accessors/{})", accName, index),
+                                  "ACCESSOR_INVALID_FLOAT"});
   return d;
 }
 

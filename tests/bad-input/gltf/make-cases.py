@@ -191,7 +191,7 @@ case("weights-unorm-sum-below", {"m.gltf": text(skinned(weights=((100, 100, 0, 0
      rig_import("@D/m.gltf"), 0, "the weights of 1 of 3 vertices do not sum to 1 (first: vertex 0; the farthest from 1: "
      "0.784314); renormalised")
 case("weights-nan", {"m.gltf": text(skinned(weights=((float("nan"), 0, 0, 0),) * 3))}, GEN, 1,
-     "WEIGHTS_0 (accessor 2) holds a non-finite value [ACCESSOR_INVALID_FLOAT]")
+     "WEIGHTS_0 (accessor 2) holds a non-finite value (/accessors/2) [ACCESSOR_INVALID_FLOAT]")
 case("joints-out-of-range", {"m.gltf": text(skinned(joints=((0, 7, 0, 0),) * 3))}, GEN, 1,
      "@D/m.gltf: error: mesh 'tri' primitive 0: JOINTS_0 (accessor 1, /meshes/0/primitives/0/attributes/JOINTS_0) of "
      "vertex 0 is joint 7, but the skin has 2 joints [ACCESSOR_JOINTS_INDEX_OOB]")
