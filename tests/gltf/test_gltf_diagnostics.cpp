@@ -16,6 +16,7 @@
 #include <set>
 
 #include "gltf_test_util.h"
+#include <shadergen/shadergen.h>
 #include "pipeline/generate.h"
 #include "rig/gltf_import.h"
 #include "validate/gltf_scene.h"
@@ -132,6 +133,26 @@ TEST(GltfDiagnostics, ReflectionRecordsTheWeights) {
   rigid.fragmentPath = dataPath("minimal.frag");
   rigid.rulesPaths = {sourcePath("rules/standard.yaml")};
   EXPECT_FALSE(nlohmann::json::parse(reflectionOf(generate(rigid))).contains("skin_weights"));
+}
+
+// The library (shadergen::core) returns the import's warnings with a successful result.
+TEST(GltfDiagnostics, LibraryReturnsTheImportWarnings) {
+  if (!fs::exists(robot())) GTEST_SKIP() << robot() << " is not installed";
+  shadergen::Options o;
+  o.rig = robot() + "#12/1";
+  o.fragment = dataPath("minimal.frag");
+  o.rules = {sourcePath("rules/standard.yaml")};
+  shadergen::Result r = shadergen::generate(o);
+  ASSERT_TRUE(r.ok);
+  ASSERT_FALSE(r.diagnostics.empty());
+  EXPECT_EQ(r.diagnostics.front().severity, "warning");
+  EXPECT_EQ(r.diagnostics.front().code, "ACCESSOR_WEIGHTS_NON_NORMALIZED");
+  EXPECT_NE(r.reflection.find(R"("skin_weights": "normalized")"), std::string::npos);
+  o.warningsAsErrors = true;
+  r = shadergen::generate(o);
+  EXPECT_FALSE(r.ok);
+  ASSERT_FALSE(r.diagnostics.empty());
+  EXPECT_EQ(r.diagnostics.front().severity, "error");
 }
 
 // The option reaches the validated scene: at "Wave" t = 0.9 the right hand skinned (on the CPU,
