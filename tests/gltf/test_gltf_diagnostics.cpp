@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <regex>
@@ -20,6 +21,8 @@
 #include "pipeline/generate.h"
 #include "rig/gltf_import.h"
 #include "validate/gltf_scene.h"
+#include "variants/builder.h"
+#include "variants/manifest.h"
 
 namespace sg {
 namespace {
@@ -133,6 +136,36 @@ TEST(GltfDiagnostics, ReflectionRecordsTheWeights) {
   rigid.fragmentPath = dataPath("minimal.frag");
   rigid.rulesPaths = {sourcePath("rules/standard.yaml")};
   EXPECT_FALSE(nlohmann::json::parse(reflectionOf(generate(rigid))).contains("skin_weights"));
+}
+
+// A build records the weights per variant in its index (and the import's warnings once).
+TEST(GltfDiagnostics, BuildIndexRecordsTheWeights) {
+  if (!fs::exists(robot())) GTEST_SKIP() << robot() << " is not installed";
+  const fs::path dir = fs::path(::testing::TempDir()) / "gltf_diagnostics_build";
+  fs::create_directories(dir);
+  const std::string manifest = (dir / "v.yaml").string();
+  std::ofstream(manifest) << fmt::format("rules: {}\nrigs:\n  hand: {}#12/1\n  foot: {}#0/0\npasses:\n  plain: {}\n"
+                                         "output: {}\n",
+                                         sourcePath("rules/standard.yaml"), robot(), robot(), dataPath("minimal.frag"),
+                                         (dir / "out").string());
+  for (bool normalize : {true, false}) {
+    const Manifest m = loadManifest(manifest);
+    const std::vector<Variant> variants = expandVariants(m);
+    BuildOptions bo;
+    bo.gltf.normalizeWeights = normalize;
+    const BuildReport r = buildVariants(m, variants, bo);
+    ASSERT_EQ(r.failed, 0u);
+    size_t weightWarnings = 0;
+    for (const auto& d : r.warnings) weightWarnings += d.code == "ACCESSOR_WEIGHTS_NON_NORMALIZED";
+    EXPECT_EQ(weightWarnings, 1u);
+    for (const auto& f : r.files)
+      if (f.path == r.indexPath) {
+        nlohmann::json index = nlohmann::json::parse(f.contents);
+        for (const auto& v : index.at("variants"))
+          EXPECT_EQ(v.value("skin_weights", ""), v.at("rig") == "hand" ? (normalize ? "normalized" : "stored") : "")
+              << v.dump();
+      }
+  }
 }
 
 // The library (shadergen::core) returns the import's warnings with a successful result.
