@@ -15,6 +15,7 @@ Diagnostic convert(const sg::Diagnostic& d) {
   o.column = d.loc.col;
   o.severity = d.severity == sg::Severity::Error ? "error" : d.severity == sg::Severity::Warning ? "warning" : "note";
   o.message = d.message;
+  o.code = d.code;
   return o;
 }
 
@@ -24,7 +25,8 @@ std::string Diagnostic::text() const {
   std::string where = file;
   if (line > 0) where += fmt::format(":{}", line);
   if (line > 0 && column > 0) where += fmt::format(":{}", column);
-  return fmt::format("{}{}{}: {}", where, where.empty() ? "" : ": ", severity, message);
+  return fmt::format("{}{}{}: {}{}", where, where.empty() ? "" : ": ", severity, message,
+                     code.empty() ? "" : " [" + code + "]");
 }
 
 Result generate(const Options& options) {
@@ -43,6 +45,8 @@ Result generate(const Options& options) {
     o.optimize = options.optimize;
     o.templateDir = options.templates;
     o.deviceProfilePath = options.deviceProfile;
+    o.gltf.normalizeWeights = options.normalizeSkinWeights;
+    o.gltf.warningsAsErrors = options.warningsAsErrors;
     if (!options.hlslShaderModel.empty()) {
       o.hlsl = sg::HlslOptions{};
       if (!sg::parseShaderModel(options.hlslShaderModel, o.hlsl->shaderModel))
@@ -73,6 +77,8 @@ Result generate(const Options& options) {
       }
       r.predictedNanoseconds = c.totalNanoseconds;
     }
+    for (const auto& d : g.in.notes)
+      if (!d.code.empty()) r.diagnostics.push_back(convert(d));  // the glTF import's findings
     r.ok = true;
   } catch (const sg::InputError& e) {
     r.diagnostics.push_back(convert(e.diagnostic()));

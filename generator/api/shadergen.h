@@ -31,6 +31,10 @@ struct Options {
   std::string hlslShaderModel;       // "5.0", "5.1", "6.0" .. "6.7"
   std::string mslVersion;            // "1.2", "2.0" .. "2.4", "3.0"
   std::string mslPlatform = "macos";  // with mslVersion: "macos" or "ios"
+  // A glTF rig (docs/gltf.md#import-diagnostics-and-weights): skin weights renormalised to sum
+  // to 1 (as three.js does; false: kept as stored), and the import's warnings as errors.
+  bool normalizeSkinWeights = true;
+  bool warningsAsErrors = false;
 };
 
 struct Diagnostic {
@@ -38,7 +42,8 @@ struct Diagnostic {
   int line = 0, column = 0;
   std::string severity;  // "error", "warning", "note"
   std::string message;
-  std::string text() const;  // "file:line:col: error: message"
+  std::string code;          // the glTF-Validator's code of a glTF import finding ("" = none)
+  std::string text() const;  // "file:line:col: error: message [code]"
 };
 
 struct Result {
@@ -54,7 +59,7 @@ struct Result {
   std::map<std::string, double> termNanoseconds;
   double predictedNanoseconds = 0;
   std::vector<std::string> rules;     // the plan's rules, in order
-  std::vector<Diagnostic> diagnostics;  // why it failed (when !ok)
+  std::vector<Diagnostic> diagnostics;  // why it failed (when !ok); the glTF import's warnings (when ok)
 };
 
 // Never throws for bad input: failures come back as diagnostics.

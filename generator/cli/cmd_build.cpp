@@ -42,6 +42,7 @@ struct BuildCommand {
   bool list = false;
   bool validate = false;
   std::string cacheUrl;
+  GltfReadOptions gltf;
 
   int run() {
     if (noCache && !cacheDir.empty())
@@ -100,6 +101,7 @@ struct BuildCommand {
         bo.workloads[v.name] = it->second;
       }
     }
+    bo.gltf = gltf;
     // Progress on a terminal, quiet in CI and in logs.
     bool showProgress = progress || (!quiet && isatty(STDERR_FILENO) && !std::getenv("CI"));
     if (showProgress)
@@ -108,6 +110,7 @@ struct BuildCommand {
         if (done == total) std::cerr << "\n";
       };
     BuildReport r = buildVariants(m, variants, bo);
+    for (const auto& d : r.warnings) std::cerr << formatDiagnostic(d) << "\n";
     for (const auto& b : r.variants) {
       if (b.ok) continue;
       std::cerr << fmt::format("{}: error: variant '{}' failed:\n", m.file, b.variant->name);
@@ -169,6 +172,7 @@ void registerBuild(CLI::App& app, CliState& state) {
                   "Shared cache server (HTTP GET/PUT, e.g. nginx WebDAV) over the local cache (default: "
                   "$SHADERGEN_CACHE_URL, then the manifest's 'cache_url'); credentials only from the environment "
                   "(SHADERGEN_CACHE_AUTH=user:password)");
+  addGltfReadOptions(*sub, cmd->gltf);
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }
 

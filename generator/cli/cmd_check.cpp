@@ -26,6 +26,7 @@ struct CheckCommand {
     if (!opts.rigPath.empty() && !noRun && !noCompile && !r.schemaError && r.errors == 0) {
       device.rigPath = opts.rigPath;
       device.rulesPaths = opts.rulesPaths;
+      device.gltf.warningsAsErrors = opts.werror;
       RuleCheckReport rc = checkRulesOnDevice(device);
       std::cerr << formatRuleCheckSummary(rc);
       for (const auto& d : rc.errors) r.findings.push_back(d);

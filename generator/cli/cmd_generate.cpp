@@ -66,6 +66,7 @@ void GenerateArgs::add(CLI::App& cmd) {
                  "(vertex.normal=0.1deg), a fraction of the bounds diagonal for a position (vertex.position=1e-4), of the "
                  "target's scale for a morph delta (morph.position=1e-4). Stored encodings that can err more are not offered to the search "
                  "(docs/rig-format.md, \"Encodings\")");
+  addGltfReadOptions(cmd, opts.gltf);
 }
 
 GenerateOptions GenerateArgs::resolve() const {

@@ -31,7 +31,9 @@ struct PackCommand {
       throw CLI::ValidationError("--model", "pack needs data: --model MODEL.glb#M/P (or a glTF rig), or --mesh head|limb|dawn");
     GenerateResult r = generate(o);
     // The model at its rest pose: vertex data does not depend on the pose.
-    ValidationScene scene = source.empty() ? proceduralScene(r.in.rig, mesh, 1, 1) : gltfScene(source, GltfSceneOptions{});
+    GltfSceneOptions so;
+    so.read = o.gltf;
+    ValidationScene scene = source.empty() ? proceduralScene(r.in.rig, mesh, 1, 1) : gltfScene(source, so);
     PackedVertices packed = packVertices(r, scene.mesh);
     std::vector<PendingFile> files = {{output + ".bin", std::string(packed.bytes.begin(), packed.bytes.end())},
                                       {output + ".json", packed.layoutJson}};

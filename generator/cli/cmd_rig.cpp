@@ -21,6 +21,7 @@ struct RigImportCommand {
   std::string output;
   bool quiet = false;
   bool packOcclusion = false;
+  GltfReadOptions read;
 
   // The rig as YAML, with the import's findings as header comments; read back before it is
   // returned, so nothing is written that loadRigText would refuse.
@@ -43,6 +44,7 @@ struct RigImportCommand {
       }
     }
     for (const auto& n : imp.notes) header.push_back("note: " + n);
+    for (const auto& d : imp.rig.importDiagnostics) header.push_back(formatDiagnostic(d));
     std::string yaml = rigToYaml(imp.rig, header);
     loadRigText(yaml, output.empty() ? "<stdout>" : output);
     return yaml;
@@ -58,10 +60,12 @@ struct RigImportCommand {
     o.mesh = mesh >= 0 ? mesh : ref.mesh;
     o.primitive = primitive >= 0 ? primitive : ref.primitive;
     o.packOcclusionInNormal = packOcclusion;
+    o.read = read;
     GltfImport imp = importGltf(ref.file, o);
     std::string yaml = rigYaml(imp, ref.file, output);
     if (!quiet)
       for (const auto& n : imp.notes) std::cerr << fmt::format("{}: warning: {}\n", ref.file, n);
+    for (const auto& d : imp.rig.importDiagnostics) std::cerr << formatDiagnostic(d) << "\n";
     if (output.empty() || output == "-") {
       std::cout << yaml;
     } else {
@@ -88,6 +92,7 @@ struct RigImportCommand {
       o.mesh = part.mesh;
       o.primitive = part.primitive;
       o.packOcclusionInNormal = packOcclusion;
+      o.read = read;
       GltfImport imp = importGltf(file, o);
       std::string path = (std::filesystem::path(output) / (part.name + ".yaml")).string();
       files.push_back({path, rigYaml(imp, file, path)});
@@ -99,6 +104,7 @@ struct RigImportCommand {
       e["morph_targets"] = imp.morphTargets;
       if (!quiet)
         for (const auto& n : imp.notes) std::cerr << fmt::format("{}: warning: {}\n", part.ref, n);
+      for (const auto& d : imp.rig.importDiagnostics) std::cerr << formatDiagnostic(d) << "\n";
     });
     failIfPartsFailed(model, parts.size(), failed);
     files.push_back({(std::filesystem::path(output) / "index.json").string(),
@@ -127,6 +133,7 @@ void registerRig(CLI::App& app, CliState& state) {
   imp->add_flag("--pack-occlusion", cmd->packOcclusion,
                 "Dawn's layout: baked _OCCLUSION in normal.w (float32x4) and its target deltas in the normal deltas' w");
   imp->add_flag("-q,--quiet", cmd->quiet, "Do not print warnings about attributes left out");
+  addGltfReadOptions(*imp, cmd->read);
   imp->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }
 

@@ -61,6 +61,7 @@ struct ValidateCommand {
       so.times = times;
       so.animation = animation;
       so.morphWeight = morphWeight;
+      so.read = vo.gen.gltf;
       GltfSceneInfo info;
       scene = gltfScene(vo.gen.rigPath, so, &info);
       std::string ts;
@@ -116,6 +117,7 @@ struct ValidateCommand {
       GltfImportOptions io;
       io.mesh = part.mesh;
       io.primitive = part.primitive;
+      io.read = vo.gen.gltf;
       GltfImport model = importGltf(parseGltfRef(part.ref).file, io);
       GltfSceneInfo info;
       ValidationScene scene = gltfScene(model, so, &info);

@@ -22,6 +22,15 @@ CLI::Validator finiteNumber(bool positive) {
       positive ? "NUMBER > 0" : "NUMBER >= 0");
 }
 
+void addGltfReadOptions(CLI::App& cmd, GltfReadOptions& o, bool werror) {
+  cmd.add_flag("--normalize-weights,!--no-normalize-weights", o.normalizeWeights,
+               "glTF skin weights that do not sum to 1 are renormalised, as three.js and Filament's viewers do "
+               "(default); --no-normalize-weights keeps them as stored (docs/gltf.md#import-diagnostics-and-weights)");
+  if (werror)
+    cmd.add_flag("--Werror", o.warningsAsErrors,
+                 "Treat the glTF import's warnings (weights, joints, rotations, frames) as errors (also -Werror)");
+}
+
 void registerCommands(CLI::App& app, CliState& state) {
   registerGenerate(app, state);
   registerValidate(app, state);

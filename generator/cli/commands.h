@@ -41,6 +41,10 @@ struct CrossArgs {
   void resolve(bool hlsl, bool msl, GenerateOptions& o) const;
 };
 
+// --no-normalize-weights and (werror) --Werror (-Werror), for every command that imports a
+// glTF rig (docs/gltf.md#import-diagnostics-and-weights).
+void addGltfReadOptions(CLI::App& cmd, GltfReadOptions& o, bool werror = true);
+
 // Every file `in` was loaded from (plus `extra`), named for refuseClobbering (output_files.h).
 std::vector<InputFile> inputFiles(const LoadedInputs& in, const std::vector<std::string>& extra = {});
 

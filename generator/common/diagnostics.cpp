@@ -29,7 +29,9 @@ std::string formatDiagnostic(const Diagnostic& d) {
   std::string where = d.loc.file.empty() ? "shadergen" : printable(d.loc.file, false);
   if (d.loc.line > 0) where += fmt::format(":{}", d.loc.line);
   if (d.loc.line > 0 && d.loc.col > 0) where += fmt::format(":{}", d.loc.col);
-  return fmt::format("{}: {}: {}", where, sev, printable(d.message, true));
+  std::string out = fmt::format("{}: {}: {}", where, sev, printable(d.message, true));
+  if (!d.code.empty()) out += " [" + printable(d.code, false) + "]";
+  return out;
 }
 
 std::string renderDiagnostic(const Diagnostic& d) {

@@ -19,6 +19,9 @@ struct Diagnostic {
   Severity severity = Severity::Error;
   SourceLoc loc;
   std::string message;
+  // The finding's name where an outside tool has one (the Khronos glTF-Validator's
+  // "ACCESSOR_WEIGHTS_NON_NORMALIZED"), printed after the message as "[CODE]"; "" = none.
+  std::string code;
 };
 
 // Thrown by loaders and stages for input errors (exit status 1).
@@ -34,7 +37,7 @@ class InputError : public std::runtime_error {
   Diagnostic diag_;
 };
 
-// "file:line:col: error: message" (no caret line).
+// "file:line:col: error: message [CODE]" (no caret line).
 std::string formatDiagnostic(const Diagnostic& d);
 // formatDiagnostic plus the quoted source line and a caret, read from d.loc.file.
 std::string renderDiagnostic(const Diagnostic& d);

@@ -142,7 +142,11 @@ std::string buffersHeader(const EmittedGlsl& glsl, const std::string& symbol) {
 std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvModule& spirv,
                            const DeviceProfile* profile, const PlanCostPrediction* predicted, const CrossShader* hlsl,
                            const CrossShader* msl, const Workload* workload) {
-  std::string j = "{\n  \"rig\": " + jsonQuote(rig.name) + ",\n  \"inputs\": [";
+  std::string j = "{\n  \"rig\": " + jsonQuote(rig.name) + ",\n";
+  // A skinned glTF rig: the weights the program was validated with, which the host must feed
+  // (docs/gltf.md#import-diagnostics-and-weights).
+  if (!rig.skinWeights.empty()) j += "  \"skin_weights\": " + jsonQuote(rig.skinWeights) + ",\n";
+  j += "  \"inputs\": [";
   for (size_t i = 0; i < glsl.inputs.size(); ++i) {
     const auto& in = glsl.inputs[i];
     const RigAttribute& a = rig.attributes[in.attribute];

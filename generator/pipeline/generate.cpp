@@ -6,6 +6,7 @@
 #include <set>
 #include <stdexcept>
 #include <tuple>
+#include <utility>
 
 #include "analysis/cost.h"
 #include "analysis/explain.h"
@@ -21,7 +22,7 @@ const char* shadergenVersion() { return SHADERGEN_VERSION; }
 
 // ---- stages -----------------------------------------------------------------------------
 
-Rig loadRigStage(const std::string& path) { return loadRig(path); }
+Rig loadRigStage(const std::string& path, const GltfReadOptions& gltf) { return loadRig(path, gltf); }
 
 RuleSet loadRulesStage(const std::vector<std::string>& paths) { return loadRules(paths); }
 
@@ -324,7 +325,7 @@ LoadedInputs cheapestStoredForms(const Rig& rig, const RuleSet& rules, const Fra
 
 LoadedInputs prepareInputs(Rig rig, const RuleSet& rules, const FragmentInterface& fragment, const GenerateOptions& opts,
                            const std::optional<DeviceProfile>& profile, const std::vector<DeviceProfile>& portable) {
-  std::vector<Diagnostic> notes;
+  std::vector<Diagnostic> notes = std::exchange(rig.importDiagnostics, {});
   if (!opts.maxError.empty()) rig = withinErrorBudgets(rig, opts.maxError, notes);
   LoadedInputs in;
   try {
@@ -338,7 +339,7 @@ LoadedInputs prepareInputs(Rig rig, const RuleSet& rules, const FragmentInterfac
 }
 
 LoadedInputs loadInputs(const GenerateOptions& opts) {
-  Rig rig = loadRigStage(opts.rigPath);
+  Rig rig = loadRigStage(opts.rigPath, opts.gltf);
   if (!opts.rigParams.empty()) rig = rigWithParameters(rig, opts.rigParams, SourceLoc{});
   const RuleSet rules = loadRulesStage(opts.rulesPaths);
   const FragmentInterface fragment = loadFragmentStage(opts.fragmentPath, opts.targetEnv);

@@ -32,6 +32,8 @@ struct GenerateOptions {
   std::vector<VaryingOverride> overrides;
   std::vector<std::string> conventions;  // naming conventions (--conventions): empty = all, unambiguous names
   std::map<std::string, int64_t> rigParams;  // deformer parameters set on the rig (--set)
+  // How a glTF rig's data is read (--no-normalize-weights, -Werror; rig/gltf_import.h).
+  GltfReadOptions gltf;
   // Error budgets per encoded source semantic, in its encodings' unit: degrees for a direction, a
   // fraction of the bounds diagonal for a position (--max-error; rig/vertex_encoding.h).
   std::map<std::string, double> maxError;
@@ -89,7 +91,9 @@ LoadedInputs loadInputs(const GenerateOptions& opts);
 // the error budgets (opts.maxError) take over-budget encodings out of the rig; a value the
 // rig stores both as itself and encoded is read in the form whose plan is cheapest; then
 // instantiation (opts.overrides, opts.conventions) and, with a profile, pricing. The
-// result's notes say what the budgets removed and which stored form is read. `portable`: the
+// result's notes are the rig's import diagnostics (taken out of the rig), then what the
+// budgets removed and which stored form is read.
+// `portable`: the
 // other devices of a portable choice (each plan is then priced by its worst regret).
 LoadedInputs prepareInputs(Rig rig, const RuleSet& rules, const FragmentInterface& fragment, const GenerateOptions& opts,
                            const std::optional<DeviceProfile>& profile, const std::vector<DeviceProfile>& portable = {});

@@ -18,6 +18,7 @@
 #include "emit/spirv.h"
 #include "emit/templates.h"
 #include "interface/fragment_interface.h"
+#include "rig/gltf_import.h"
 #include "rig/rig.h"
 #include "rules/rules.h"
 #include "search/astar.h"
@@ -29,7 +30,8 @@ namespace sg {
 
 // ---- load -------------------------------------------------------------------------------
 // Each throws InputError (file:line:col) for bad input.
-Rig loadRigStage(const std::string& path);  // YAML, or a glTF model "model.glb#mesh/primitive"
+// YAML, or a glTF model "model.glb#mesh/primitive" read as `gltf` says.
+Rig loadRigStage(const std::string& path, const GltfReadOptions& gltf = {});
 RuleSet loadRulesStage(const std::vector<std::string>& paths);
 FragmentInterface loadFragmentStage(const std::string& path, TargetEnv env);
 TemplateSet loadTemplatesStage(const std::string& dir);  // "" = defaultTemplateDir()

@@ -70,6 +70,7 @@ ModelPart modelPart(const RenderOptions& opts, const GltfPart& part) {
   GltfImportOptions io;
   io.mesh = part.mesh;
   io.primitive = part.primitive;
+  io.read = opts.gen.gltf;
   GltfImport model = importGltf(parseGltfRef(part.ref).file, io);
   const GltfModelData& d = model.data;
   for (int n : gltfSceneNodes(d)) {
@@ -148,6 +149,7 @@ RenderScene renderScene(const Rig& rig, const RenderOptions& opts) {
     GltfImportOptions io;
     io.mesh = ref.mesh;
     io.primitive = ref.primitive;
+    io.read = opts.gen.gltf;
     GltfImport model = importGltf(ref.file, io);
     GltfSceneOptions so;
     so.times = {opts.time};

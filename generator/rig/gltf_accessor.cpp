@@ -222,7 +222,10 @@ AccessorData Reader::read(int index, const std::string& what) {
           readComponent(val + k * elem + c * static_cast<size_t>(csize), a.componentType, a.normalized);
   }
   for (float v : d.values)
-    if (!std::isfinite(v)) fail(file_, fmt::format("{} holds a non-finite value", accName));
+    if (!std::isfinite(v))
+      throw InputError(Diagnostic{Severity::Error, SourceLoc{file_, 0, 0},
+                                  fmt::format("{} holds a non-finite value (/accessors/{})", accName, index),
+                                  "ACCESSOR_INVALID_FLOAT"});
   return d;
 }
 

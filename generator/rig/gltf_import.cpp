@@ -17,6 +17,7 @@
 #include "rig/gltf_load.h"
 #include "rig/gltf_meshopt.h"
 #include "rig/gltf_scene.h"
+#include "rig/skin_weights.h"
 
 namespace sg {
 namespace {
@@ -140,6 +141,170 @@ void noteDegenerateFrames(GltfImport& imp) {
                                     badTangents, total));
 }
 
+// ---- import diagnostics (docs/gltf.md#import-diagnostics-and-weights) ----------------------
+// What changes a vertex program's result, with the Khronos glTF-Validator's code and threshold
+// where it has one, so a finding of the validator on a model is a finding of the import too.
+
+// Where an attribute is, in the validator's terms: "WEIGHTS_0 (accessor 12,
+// /meshes/3/primitives/1/attributes/WEIGHTS_0)".
+std::string attributeText(const tinygltf::Primitive& prim, int mesh, int primitive, const std::string& name) {
+  return fmt::format("{} (accessor {}, /meshes/{}/primitives/{}/attributes/{})", name, prim.attributes.at(name), mesh,
+                     primitive, name);
+}
+
+void warn(Rig& rig, const std::string& file, const char* code, std::string message, Severity s = Severity::Warning) {
+  rig.importDiagnostics.push_back(Diagnostic{s, SourceLoc{file, 0, 0}, std::move(message), code});
+}
+
+// The validator's unit-length tolerance for a normal or tangent (ACCESSOR_VECTOR3_NON_UNIT).
+constexpr double kUnitVectorTolerance = 0.00674;
+
+// NORMAL and TANGENT of unit length, TANGENT.w exactly +1 or -1 (ACCESSOR_VECTOR3_NON_UNIT,
+// ACCESSOR_INVALID_SIGN). The program reads them as stored.
+void checkFrames(GltfImport& imp, const tinygltf::Primitive& prim, const std::string& where) {
+  const auto& st = imp.data.streams;
+  auto text = [&](const std::string& name) { return attributeText(prim, imp.data.mesh, imp.data.primitive, name); };
+  for (const auto& [semantic, name] : {std::pair<const char*, const char*>{"vertex.normal", "NORMAL"},
+                                       std::pair<const char*, const char*>{"vertex.tangent", "TANGENT"}}) {
+    auto it = st.find(semantic);
+    if (it == st.end()) continue;
+    size_t bad = 0, first = 0;
+    double worst = 1;
+    for (size_t v = 0; v < it->second.size(); ++v) {
+      const auto& x = it->second[v];
+      const double len = std::sqrt(double(x[0]) * x[0] + double(x[1]) * x[1] + double(x[2]) * x[2]);
+      if (std::abs(len - 1) <= kUnitVectorTolerance) continue;
+      if (bad++ == 0) first = v;
+      if (std::abs(len - 1) > std::abs(worst - 1)) worst = len;
+    }
+    if (bad)
+      warn(imp.rig, imp.data.file, "ACCESSOR_VECTOR3_NON_UNIT",
+           fmt::format("{}, {}: {} of {} vertices are not of unit length (first: vertex {}; the farthest from 1: "
+                       "length {:.6g}); the program reads them as stored, so a {} of length 0 has no direction",
+                       where, text(name), bad, it->second.size(), first, worst, name));
+  }
+  auto w = st.find("vertex.handedness");
+  if (w == st.end()) return;
+  size_t bad = 0, first = 0;
+  float value = 0;
+  for (size_t v = 0; v < w->second.size(); ++v)
+    if (w->second[v][0] != 1.0f && w->second[v][0] != -1.0f)
+      if (bad++ == 0) first = v, value = w->second[v][0];
+  if (bad)
+    warn(imp.rig, imp.data.file, "ACCESSOR_INVALID_SIGN",
+         fmt::format("{}, {}: TANGENT.w of {} of {} vertices is not +1 or -1 (first: vertex {}, {}); it is the "
+                     "bitangent's sign, and the program scales the bitangent by it",
+                     where, text("TANGENT"), bad, w->second.size(), first, value));
+}
+
+// The skin's JOINTS_n/WEIGHTS_n of every vertex (`sets` sets, streams read): negative weights,
+// one joint weighted twice, weights that do not sum to one (renormalised when `normalize`),
+// with the validator's test (rig/skin_weights.h). `steps`: 2^bits - 1 when every weight set is
+// unorm of that many bits (the renormalised codes then sum to exactly that), else 0.
+void checkSkinWeights(GltfImport& imp, const tinygltf::Primitive& prim, const std::string& where, int sets,
+                      double steps, bool normalize) {
+  GltfModelData& d = imp.data;
+  std::vector<std::vector<std::array<float, 4>>*> joints, weights;
+  std::string jointNames, weightNames;
+  for (int s = 0; s < sets; ++s) {
+    joints.push_back(&d.streams.at(fmt::format("skin.joints[{}]", s)));
+    weights.push_back(&d.streams.at(fmt::format("skin.weights[{}]", s)));
+    const std::string sep = s ? ", " : "";
+    jointNames += sep + attributeText(prim, d.mesh, d.primitive, fmt::format("JOINTS_{}", s));
+    weightNames += sep + attributeText(prim, d.mesh, d.primitive, fmt::format("WEIGHTS_{}", s));
+  }
+  const size_t n = static_cast<size_t>(sets) * 4;
+  std::vector<float> w(n);
+  std::vector<double> renormalised(n);
+  size_t negative = 0, firstNegative = 0, twice = 0, firstTwice = 0, off = 0, firstOff = 0;
+  double worstSum = 1;
+  float twiceJoint = 0;
+  for (size_t v = 0; v < d.vertexCount; ++v) {
+    for (size_t k = 0; k < n; ++k) w[k] = (*weights[k / 4])[v][k % 4];
+    bool neg = false, dup = false;
+    for (size_t k = 0; k < n; ++k) {
+      neg = neg || w[k] < 0;
+      if (w[k] == 0) continue;
+      for (size_t e = 0; e < k; ++e)
+        if (w[e] != 0 && (*joints[e / 4])[v][e % 4] == (*joints[k / 4])[v][k % 4]) {
+          if (!dup && twice == 0) twiceJoint = (*joints[k / 4])[v][k % 4];
+          dup = true;
+        }
+    }
+    if (neg && negative++ == 0) firstNegative = v;
+    if (dup && twice++ == 0) firstTwice = v;
+    if (skinWeightsNormalized(w.data(), n)) continue;
+    double sum = 0;
+    for (float x : w) sum += x;
+    if (off++ == 0) firstOff = v;
+    if (std::abs(sum - 1) > std::abs(worstSum - 1)) worstSum = sum;
+    if (!normalize) continue;
+    for (size_t k = 0; k < n; ++k) renormalised[k] = w[k];
+    normalizeSkinWeights(renormalised.data(), n, steps);
+    for (size_t k = 0; k < n; ++k) (*weights[k / 4])[v][k % 4] = static_cast<float>(renormalised[k]);
+  }
+  if (negative)
+    warn(imp.rig, d.file, "ACCESSOR_WEIGHTS_NEGATIVE",
+         fmt::format("{}, {}: {} of {} vertices have a negative weight (first: vertex {}); the program blends "
+                     "with it as stored",
+                     where, weightNames, negative, d.vertexCount, firstNegative));
+  if (twice)
+    warn(imp.rig, d.file, "ACCESSOR_JOINTS_INDEX_DUPLICATE",
+         fmt::format("{}, {}: {} of {} vertices weight one joint twice (first: vertex {}, joint {}); a linear "
+                     "blend adds the two weights",
+                     where, jointNames, twice, d.vertexCount, firstTwice, twiceJoint));
+  if (off)
+    warn(imp.rig, d.file, "ACCESSOR_WEIGHTS_NON_NORMALIZED",
+         fmt::format("{}, {}: the weights of {} of {} vertices do not sum to 1 (first: vertex {}; the farthest "
+                     "from 1: {:.6g}); {}",
+                     where, weightNames, off, d.vertexCount, firstOff, worstSum,
+                     normalize ? "renormalised to sum to 1, as three.js and Filament's viewers do "
+                                 "(--no-normalize-weights keeps them)"
+                               : "kept as stored (--no-normalize-weights): the skin there is scaled by the sum, "
+                                 "where three.js and Filament's viewers renormalise"));
+}
+
+// The mesh's skinned nodes ignore their own and their parents' transforms (glTF 2.0, 3.7.3):
+// posed as the spec says, which engines that apply them do not (NODE_SKINNED_MESH_NON_ROOT,
+// NODE_SKINNED_MESH_LOCAL_TRANSFORMS). Notes: the data is valid.
+void noteSkinnedNodeTransforms(GltfImport& imp, const tinygltf::Model& model, const std::string& meshDesc) {
+  std::vector<char> child(model.nodes.size(), 0);
+  for (const auto& n : model.nodes)
+    for (int c : n.children) child[static_cast<size_t>(c)] = 1;
+  for (size_t i = 0; i < model.nodes.size(); ++i) {
+    const GltfNode& n = imp.data.nodes[i];
+    if (n.mesh != imp.data.mesh || n.skin < 0) continue;
+    if (child[i])
+      warn(imp.rig, imp.data.file, "NODE_SKINNED_MESH_NON_ROOT",
+           fmt::format("node {} (/nodes/{}) instantiates {} with a skin and has a parent: the parent's transform "
+                       "does not move a skinned mesh (glTF 2.0), and it is posed without it",
+                       i, i, meshDesc),
+           Severity::Note);
+    const tinygltf::Node& t = model.nodes[i];
+    if (!t.matrix.empty() || !t.translation.empty() || !t.rotation.empty() || !t.scale.empty())
+      warn(imp.rig, imp.data.file, "NODE_SKINNED_MESH_LOCAL_TRANSFORMS",
+           fmt::format("node {} (/nodes/{}) instantiates {} with a skin and has a transform: it does not move a "
+                       "skinned mesh (glTF 2.0), and it is posed without it",
+                       i, i, meshDesc),
+           Severity::Note);
+  }
+}
+
+// -Werror: every warning of the import as one error.
+void throwWarnings(const Rig& rig) {
+  std::vector<Diagnostic> errors;
+  for (Diagnostic d : rig.importDiagnostics)
+    if (d.severity == Severity::Warning) {
+      d.severity = Severity::Error;
+      d.message += " (-Werror)";
+      errors.push_back(std::move(d));
+    }
+  if (errors.empty()) return;
+  InputError e(errors.front());
+  e.related.assign(errors.begin() + 1, errors.end());
+  throw e;
+}
+
 // The storage KHR_mesh_quantization's table allows an attribute (float always). Integers are
 // read as the GPU reads them (gltf_accessor.cpp) and re-expanded to float for the shader.
 enum class Storage {
@@ -212,7 +377,7 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   const std::string where = fmt::format("{} primitive {}", meshDesc, opts.primitive);
 
   // --- nodes, scene, skins, animations (plain data) ---
-  gltf::readScene(model, file, opts.mesh, meshDesc, reader, data, imp.notes);
+  gltf::readScene(model, file, opts.mesh, meshDesc, reader, data, imp.notes, imp.rig.importDiagnostics);
 
 
   // --- the primitive's attributes ---
@@ -415,6 +580,15 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   int skinIndex = data.meshNode >= 0 ? data.nodes[static_cast<size_t>(data.meshNode)].skin : -1;
   if (skinIndex >= static_cast<int>(data.skins.size()))
     fail(file, fmt::format("the node of {} uses skin {}, which does not exist", meshDesc, skinIndex));
+  // Every other node instantiating the mesh with a skin: the joints must fit each skin.
+  std::vector<std::pair<int, int>> instanceSkins;  // (node, skin)
+  for (size_t n = 0; n < data.nodes.size(); ++n) {
+    const GltfNode& node = data.nodes[n];
+    if (node.mesh != data.mesh || node.skin < 0 || static_cast<int>(n) == data.meshNode) continue;
+    if (static_cast<size_t>(node.skin) >= data.skins.size())
+      fail(file, fmt::format("node {} instantiates {} with skin {}, which does not exist", n, meshDesc, node.skin));
+    instanceSkins.emplace_back(static_cast<int>(n), node.skin);
+  }
   if (sets > 0 && skinIndex < 0) {
     imp.notes.push_back(fmt::format("{} has JOINTS_0/WEIGHTS_0 but no node gives it a skin: imported unskinned", where));
     sets = 0;
@@ -435,6 +609,7 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
     imp.influences = 4 * sets;
     rig.params["bones"] = joints;
     rig.params["influences"] = imp.influences;
+    std::set<int> unormBits;  // of the weight sets (0: float)
     for (int s = 0; s < sets; ++s) {
       std::string jn = fmt::format("JOINTS_{}", s), wn = fmt::format("WEIGHTS_{}", s);
       const auto* ja = accessorOf(jn);
@@ -468,12 +643,30 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
         for (int c = 0; c < 4; ++c) {
           float j = jd.values[v * 4 + static_cast<size_t>(c)];
           if (j >= static_cast<float>(joints))
-            fail(file, fmt::format("{}: {} of vertex {} is joint {}, but the skin has {} joints", where, jn, v,
-                                   static_cast<long>(j), joints));
+            throw InputError(Diagnostic{Severity::Error, SourceLoc{file, 0, 0},
+                                        fmt::format("{}: {} of vertex {} is joint {}, but the skin has {} joints", where,
+                                                    attributeText(prim, data.mesh, data.primitive, jn), v,
+                                                    static_cast<long>(j), joints),
+                                        "ACCESSOR_JOINTS_INDEX_OOB"});
+          for (const auto& [node, skin] : instanceSkins) {
+            const size_t size = data.skins[static_cast<size_t>(skin)].joints.size();
+            if (j >= static_cast<float>(size))
+              throw InputError(Diagnostic{
+                  Severity::Error, SourceLoc{file, 0, 0},
+                  fmt::format("{}: {} of vertex {} is joint {}, but skin {} (of node {}) has {} joints", where,
+                              attributeText(prim, data.mesh, data.primitive, jn), v, static_cast<long>(j), skin, node,
+                              size),
+                  "ACCESSOR_JOINTS_INDEX_OOB"});
+          }
         }
       data.streams[fmt::format("skin.joints[{}]", s)] = reader.stream(jd, 0, 4, where + " attribute " + jn);
       data.streams[fmt::format("skin.weights[{}]", s)] = reader.stream(readAttr(wn), 0, 4, where + " attribute " + wn);
+      unormBits.insert(wf == VertexFormat::Unorm8x4 ? 8 : wf == VertexFormat::Unorm16x4 ? 16 : 0);
     }
+    const int bits = unormBits.size() == 1 ? *unormBits.begin() : 0;
+    checkSkinWeights(imp, prim, where, sets, bits ? std::ldexp(1.0, bits) - 1 : 0, opts.read.normalizeWeights);
+    rig.skinWeights = opts.read.normalizeWeights ? "normalized" : "stored";
+    noteSkinnedNodeTransforms(imp, model, meshDesc);
   }
 
   // Every other attribute is reported as left out.
@@ -598,8 +791,10 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   rig.uniforms.push_back(makeUniform("projection", "camera.projection", Type::Mat4, "", 0, file));
   if (sets == 0) rig.uniforms.push_back(makeUniform("model", "model.matrix", Type::Mat4, "", 0, file));
   noteDegenerateFrames(imp);
+  checkFrames(imp, prim, where);
   if (modelScalesUniformly(imp.data)) rig.params["uniform_scale"] = 1;
   checkRig(rig);
+  if (opts.read.warningsAsErrors) throwWarnings(rig);
   return imp;
 }
 
@@ -741,10 +936,11 @@ GltfImport importGltfText(const std::string& json, const std::string& fileName, 
   return loadAndImport(fileName, opts, &json, baseDir);
 }
 
-Rig loadRig(const std::string& path) {
+Rig loadRig(const std::string& path, const GltfReadOptions& read) {
   if (!isGltfPath(path)) return loadRigFile(path);
   GltfRef ref = parseGltfRef(path);
   GltfImportOptions o;
+  o.read = read;
   o.mesh = ref.mesh;
   o.primitive = ref.primitive;
   return importGltf(ref.file, o).rig;

@@ -77,6 +77,16 @@ std::string gltfPartName(int mesh, int primitive, const std::string& meshName);
 // mesh primitives and for more than kMaxGltfParts.
 std::vector<GltfPart> gltfParts(const std::string& file);
 
+// The user's choices for reading a model's data, the same on every command that imports a glTF
+// rig (docs/gltf.md#import-diagnostics-and-weights).
+struct GltfReadOptions {
+  // Skin weights that do not sum to one are renormalised (rig/skin_weights.h), as three.js and
+  // Filament's viewers do; false (--no-normalize-weights) keeps them as stored.
+  bool normalizeWeights = true;
+  // The import's warnings are errors (-Werror): the import throws them all.
+  bool warningsAsErrors = false;
+};
+
 struct GltfImportOptions {
   int mesh = 0;
   int primitive = 0;
@@ -84,6 +94,7 @@ struct GltfImportOptions {
   size_t maxDecodedBytes = kMaxGltfDecodedBytes;  // likewise
   // Dawn's layout: _OCCLUSION in normal.w (float32x4), target deltas in the normal deltas' w.
   bool packOcclusionInNormal = false;
+  GltfReadOptions read;
 };
 
 // One attribute of the primitive as the file stores it, and what the rig made of it.
@@ -198,8 +209,8 @@ size_t loadGltfModel(const std::string& file, tinygltf::Model& model);
 GltfImport importGltfModel(const tinygltf::Model& model, size_t inputBytes, const std::string& file,
                            const GltfImportOptions& opts = {});
 
-// Any rig path: "rig.yaml" (loadRigFile) or "model.glb[#m/p]" (importGltf).
-Rig loadRig(const std::string& path);
+// Any rig path: "rig.yaml" (loadRigFile) or "model.glb[#m/p]" (importGltf with `read`).
+Rig loadRig(const std::string& path, const GltfReadOptions& read = {});
 
 // The rig as YAML that loadRigText reads back to the same rig. `header` lines become
 // comments at the top.

@@ -4,13 +4,23 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "common/diagnostics.h"
 
 namespace sg::gltf {
+namespace {
+// The glTF-Validator's tolerance for a unit quaternion: |length - 1| at most this
+// (ROTATION_NON_UNIT, ACCESSOR_ANIMATION_SAMPLER_OUTPUT_NON_NORMALIZED_QUATERNION).
+constexpr double kUnitQuaternionTolerance = 0.00769;
+double quaternionLength(const float* q) {
+  return std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2] + double(q[3]) * q[3]);
+}
+}  // namespace
 
 void readScene(const tinygltf::Model& model, const std::string& file, int mesh, const std::string& meshDesc,
-               Reader& reader, GltfModelData& data, std::vector<std::string>& notes) {
+               Reader& reader, GltfModelData& data, std::vector<std::string>& notes,
+               std::vector<Diagnostic>& diagnostics) {
   for (const auto& n : model.nodes) {
     GltfNode g;
     g.name = n.name;
@@ -22,7 +32,22 @@ void readScene(const tinygltf::Model& model, const std::string& file, int mesh, 
       std::copy(n.matrix.begin(), n.matrix.end(), g.matrix.begin());
     }
     if (n.translation.size() == 3) std::copy(n.translation.begin(), n.translation.end(), g.translation.begin());
-    if (n.rotation.size() == 4) std::copy(n.rotation.begin(), n.rotation.end(), g.rotation.begin());
+    if (n.rotation.size() == 4) {
+      std::copy(n.rotation.begin(), n.rotation.end(), g.rotation.begin());
+      const double len = std::sqrt(n.rotation[0] * n.rotation[0] + n.rotation[1] * n.rotation[1] +
+                                   n.rotation[2] * n.rotation[2] + n.rotation[3] * n.rotation[3]);
+      if (!(len > 0))
+        fail(file, fmt::format("node {} ('{}', /nodes/{}/rotation): the rotation quaternion has length 0: it is no "
+                               "rotation",
+                               data.nodes.size(), n.name, data.nodes.size()));
+      if (!(std::abs(len - 1) <= kUnitQuaternionTolerance))
+        diagnostics.push_back(Diagnostic{
+            Severity::Warning, SourceLoc{file, 0, 0},
+            fmt::format("node {} ('{}', /nodes/{}/rotation): the rotation quaternion has length {:.6g}, not 1; it is "
+                        "normalised before use",
+                        data.nodes.size(), n.name, data.nodes.size(), len),
+            "ROTATION_NON_UNIT"});
+    }
     if (n.scale.size() == 3) std::copy(n.scale.begin(), n.scale.end(), g.scale.begin());
     g.weights = n.weights;
     for (int c : g.children)
@@ -151,6 +176,30 @@ void readScene(const tinygltf::Model& model, const std::string& file, int mesh, 
         if (out.components != ch.components || out.count != ch.times.size() * perKey)
           fail(file, fmt::format("{}: expected {} {} output elements, found {} {}", what, ch.times.size() * perKey,
                                  ch.components == 4 ? "VEC4" : "VEC3", out.count, typeName(out.type)));
+      }
+      if (ch.path == GltfPath::Rotation) {
+        // Cubic splines: only the values are quaternions (not the tangents around them).
+        size_t bad = 0, first = 0;
+        double worst = 1;
+        for (size_t k = perKey / 3; k < out.count; k += perKey) {
+          const double len = quaternionLength(&out.values[k * 4]);
+          if (!(len > 0))
+            fail(file, fmt::format("{} (node {} rotation, sampler {}, output accessor {}, /animations/{}/channels/{}/sampler): "
+                                   "keyframe {} is a quaternion of length 0: it is no rotation",
+                                   what, c.target_node, c.sampler, smp.output, ai, ci, k / perKey));
+          if (std::abs(len - 1) <= kUnitQuaternionTolerance) continue;
+          if (bad++ == 0) first = k;
+          if (!(std::abs(len - 1) <= std::abs(worst - 1))) worst = len;
+        }
+        if (bad)
+          diagnostics.push_back(Diagnostic{
+              Severity::Warning, SourceLoc{file, 0, 0},
+              fmt::format("{} (node {} rotation, sampler {}, output accessor {}, /animations/{}/channels/{}/sampler): "
+                          "{} of {} keyframe quaternions are not of unit length (first: keyframe {}; the farthest from "
+                          "1: length {:.6g}); posing normalises them (three.js does not)",
+                          what, c.target_node, c.sampler, smp.output, ai, ci, bad, ch.times.size(), first / perKey,
+                          worst),
+              "ACCESSOR_ANIMATION_SAMPLER_OUTPUT_NON_NORMALIZED_QUATERNION"});
       }
       ch.values = std::move(out.values);
       g.start = first ? ch.times.front() : std::min(g.start, ch.times.front());

@@ -5,13 +5,16 @@
 #include <string>
 #include <vector>
 
+#include "common/diagnostics.h"
 #include "rig/gltf_accessor.h"
 #include "rig/gltf_import.h"
 
 namespace sg::gltf {
 
-// Fills data.nodes, sceneRoots, meshNode, skins and animations; notes what it leaves out.
+// Fills data.nodes, sceneRoots, meshNode, skins and animations; notes what it leaves out, and
+// warns (`diagnostics`) of rotations that are not unit quaternions, in nodes and in samplers.
 void readScene(const tinygltf::Model& model, const std::string& file, int mesh, const std::string& meshDesc,
-               Reader& reader, GltfModelData& data, std::vector<std::string>& notes);
+               Reader& reader, GltfModelData& data, std::vector<std::string>& notes,
+               std::vector<Diagnostic>& diagnostics);
 
 }  // namespace sg::gltf

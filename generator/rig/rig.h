@@ -76,6 +76,12 @@ struct Rig {
   std::vector<std::string> morphedAttributes;  // "position", "normal", "tangent"
   std::vector<RigAttribute> attributes;
   std::vector<RigUniform> uniforms;
+  // A glTF import (docs/gltf.md#import-diagnostics-and-weights): what it found suspect in the
+  // model's data (warnings, each with the glTF-Validator's code), which loading passes on with
+  // its notes; and the skin weights its data holds: "normalized" (renormalised to sum to one,
+  // the default), "stored" (--no-normalize-weights), "" (not a skinned glTF primitive).
+  std::vector<Diagnostic> importDiagnostics;
+  std::string skinWeights;
 
   int64_t param(const std::string& key, int64_t fallback = 0) const;
   int morphTargets() const { return static_cast<int>(param("morph_targets")); }

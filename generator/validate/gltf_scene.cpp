@@ -277,6 +277,7 @@ ValidationScene gltfScene(const std::string& modelRef, const GltfSceneOptions& o
   GltfImportOptions o;
   o.mesh = ref.mesh;
   o.primitive = ref.primitive;
+  o.read = opts.read;
   return gltfScene(importGltf(ref.file, o), opts, info);
 }
 

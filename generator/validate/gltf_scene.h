@@ -22,6 +22,7 @@ struct GltfSceneOptions {
   // expression held through the motion): models whose animations leave the weights at 0,
   // such as RobotExpressive's, otherwise never exercise their targets.
   std::optional<double> morphWeight;
+  GltfReadOptions read;  // how the model's data is read (the overload that imports it)
 };
 
 // What was posed, for reports.

@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "rig/packed_fields.h"
+#include "rig/skin_weights.h"
 #include "rig/vertex_encoding.h"
 #include "rules/instantiate.h"
 #include "validate/poses.h"
@@ -97,22 +98,14 @@ void renormaliseWeights(const Rig& rig, rt::Mesh& m) {
   std::vector<std::vector<glm::vec4>*> streams;
   std::vector<const std::vector<glm::vec4>*> read;
   for (const auto& s : sets) streams.push_back(&m.streams.at(s)), read.push_back(streams.back());
-  std::vector<double> w(sets.size() * 4), q(w.size());
-  std::vector<size_t> order(w.size());
+  std::vector<double> w(sets.size() * 4);
   for (size_t v = 0; v < m.vertexCount; ++v) {
-    const double sum = partitionSum(read, v);
-    if (std::isnan(sum)) continue;  // not a partition of one: rounded as it is
+    if (std::isnan(partitionSum(read, v))) continue;  // not a partition of one: rounded as it is
     for (size_t s = 0; s < sets.size(); ++s)
-      for (int c = 0; c < 4; ++c) w[s * 4 + static_cast<size_t>(c)] = std::max(0.0, double((*streams[s])[v][c]));
-    double total = 0;
-    for (size_t k = 0; k < w.size(); ++k) total += q[k] = std::floor(w[k] / sum * steps);
-    for (size_t k = 0; k < order.size(); ++k) order[k] = k;
-    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-      return w[a] / sum * steps - q[a] > w[b] / sum * steps - q[b];
-    });
-    for (size_t k = 0; total < steps; ++k, ++total) q[order[k]] += 1;
+      for (int c = 0; c < 4; ++c) w[s * 4 + static_cast<size_t>(c)] = (*streams[s])[v][c];
+    normalizeSkinWeights(w.data(), w.size(), steps);  // rig/skin_weights.h: the import's renormalisation
     for (size_t s = 0; s < sets.size(); ++s)
-      for (int c = 0; c < 4; ++c) (*streams[s])[v][c] = static_cast<float>(q[s * 4 + static_cast<size_t>(c)] / steps);
+      for (int c = 0; c < 4; ++c) (*streams[s])[v][c] = static_cast<float>(w[s * 4 + static_cast<size_t>(c)]);
   }
 }
 

@@ -407,7 +407,7 @@ class Checker {
 
 RuleCheckReport checkRulesOnDevice(const RuleCheckOptions& opts) {
   RuleCheckReport report;
-  const Rig rig = loadRigStage(opts.rigPath);
+  const Rig rig = loadRigStage(opts.rigPath, opts.gltf);
   const RuleSet rules = loadRulesStage(opts.rulesPaths);
   ValidateOptions vo;
   vo.device = opts.device;

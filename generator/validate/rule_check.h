@@ -23,6 +23,7 @@ struct RuleCheckOptions {
   uint32_t seed = 1;
   Tolerance tolerance;
   std::vector<std::string> only;  // check only the rules of these names (empty: every rule)
+  GltfReadOptions gltf;           // a glTF rig's import (check --Werror makes its warnings errors)
 };
 
 struct RuleCheckResult {

@@ -36,14 +36,18 @@ struct SharedInputs {
   std::optional<DeviceProfile> profile;                // the manifest's device_profile
 };
 
-SharedInputs loadShared(const Manifest& m, const std::vector<Variant>& variants) {
+SharedInputs loadShared(const Manifest& m, const std::vector<Variant>& variants, const GltfReadOptions& gltf,
+                        std::vector<Diagnostic>& warnings) {
   SharedInputs s;
   s.rules = loadRulesStage(m.rules);
   s.templates = loadTemplatesStage(m.templates);
   for (const auto& v : variants) {
     if (!s.rigs.count(v.rig->path)) {
       try {
-        s.rigs.emplace(v.rig->path, loadRigStage(v.rig->path));
+        Rig& rig = s.rigs.emplace(v.rig->path, loadRigStage(v.rig->path, gltf)).first->second;
+        // Printed once per rig, not once per variant (prepareInputs would pass them on).
+        warnings.insert(warnings.end(), rig.importDiagnostics.begin(), rig.importDiagnostics.end());
+        rig.importDiagnostics.clear();
       } catch (const InputError& e) {
         InputError out(e.diagnostic());
         out.related = e.related;
@@ -108,6 +112,8 @@ std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v,
                                           workload->activeMorphTargets, workload->invocationsPerVertex));
     h.field(workload->source);
   }
+  if (const std::string& w = s.rigs.at(v.rig->path).skinWeights; !w.empty())  // the reflection records it
+    h.field("skin_weights").field(w);
   h.field("inputs");
   for (const auto& f : inputs) h.field(f).field(s.digests.at(f));
   return h.hex();
@@ -240,6 +246,7 @@ void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts
               const std::string& validatorIdentity, BuiltVariant& out) {
   const Variant& v = *out.variant;
   out.inputs = inputsOf(s, v);
+  out.skinWeights = s.rigs.at(v.rig->path).skinWeights;
   auto w = opts.workloads.find(v.name);
   const Workload* workload = w == opts.workloads.end() ? nullptr : &w->second;
   out.key = cacheKey(m, s, v, out.inputs, workload);
@@ -351,6 +358,8 @@ std::string indexJson(const Manifest& m, const BuildReport& r) {
     out += fmt::format("      \"name\": {},\n", jsonString(v.name));
     out += fmt::format("      \"rig\": {},\n", jsonString(v.rig->name));
     out += fmt::format("      \"rig_file\": {},\n", jsonString(v.rig->path));
+    if (!b.skinWeights.empty())  // the weights the host must feed (docs/gltf.md#import-diagnostics-and-weights)
+      out += fmt::format("      \"skin_weights\": {},\n", jsonString(b.skinWeights));
     out += fmt::format("      \"pass\": {},\n", jsonString(v.pass->name));
     out += fmt::format("      \"fragment_file\": {},\n", jsonString(v.pass->fragment));
     std::string params;
@@ -381,10 +390,10 @@ std::string indexJson(const Manifest& m, const BuildReport& r) {
 }  // namespace
 
 BuildReport buildVariants(const Manifest& m, const std::vector<Variant>& variants, const BuildOptions& opts) {
-  SharedInputs shared = loadShared(m, variants);
+  BuildReport report;
+  SharedInputs shared = loadShared(m, variants, opts.gltf, report.warnings);
   CacheStore store({opts.cacheDir, opts.cacheUrl, opts.cacheAuth, 1500, 20000, opts.warn});
   const std::string identity = opts.validator ? opts.validator->identity() : "";
-  BuildReport report;
   report.variants.resize(variants.size());
   for (size_t i = 0; i < variants.size(); ++i) report.variants[i].variant = &variants[i];
 

@@ -15,6 +15,7 @@
 #include "pipeline/generate.h"
 #include "variants/cache_store.h"
 #include "search/workload.h"
+#include "rig/gltf_import.h"
 #include "variants/manifest.h"
 
 namespace sg {
@@ -56,6 +57,7 @@ struct BuildOptions {
   // The workload each variant is priced for, by variant name (measured by the caller,
   // measure/workload.h; absent: unknown). Part of the cache key when known.
   std::map<std::string, Workload> workloads;
+  GltfReadOptions gltf;  // how glTF rigs are read (--no-normalize-weights, --Werror)
 };
 
 struct BuiltVariant {
@@ -70,6 +72,7 @@ struct BuiltVariant {
   std::string hlsl, msl;               // when the manifest emits them
   std::string spirvHash;               // SHA-256 of the SPIR-V
   std::vector<std::string> inputs;     // every file it was made from (depfile)
+  std::string skinWeights;             // the rig's (Rig::skinWeights): recorded in the index
   std::map<std::string, std::string> outputs;  // kind -> path written
   std::optional<ValidationResult> validation;  // when validated (passing, or why it failed)
   bool validationCached = false;                // the result came from the cache
@@ -87,6 +90,7 @@ struct BuildReport {
   size_t cached = 0, generated = 0, failed = 0, sharedSpirv = 0;
   size_t validated = 0, validationsCached = 0;  // validations run, and taken from the cache
   CacheStoreStats cache;
+  std::vector<Diagnostic> warnings;    // the glTF rigs' import diagnostics, once per rig
 };
 
 // Builds every variant. Throws InputError when a shared input (rig, rules, fragment shader,

@@ -122,6 +122,125 @@ case("joints-set-number-overflows", {"m.gltf": text(model([POS], extra={
 case("position-nan", {"m.gltf": text(model([POS], blob=struct.pack("<9f", 0, 0, 0, float("nan"), 0, 0, 0, 1, 0)))},
      rig_import("@D/m.gltf"), 1, "holds a non-finite value")
 
+# --- skin weights, joints, quaternions, frames, instancing (docs/gltf.md#import-diagnostics-and-weights)
+# A skinned triangle on node 0 (skin 0: joints nodes 1 and 2), an animation rotating node 2.
+# Valid but suspect data warns (exit 0; -Werror makes it exit 1 and write nothing); data no
+# program can use is an error.
+def skinned(weights=((1, 0, 0, 0),) * 3, joints=((0, 1, 0, 0),) * 3, weight_type=5126, rotation=None,
+            keys=((0, 0, 0, 1), (0, 0.7071068, 0, 0.7071068)), normals=None, tangents=None, nodes=None, skins=None):
+    parts, views, accessors = [], [], []
+
+    def add(data, **acc):
+        off = sum(len(x) for x in parts)
+        parts.append(data + b"\0" * (-len(data) % 4))
+        views.append({"buffer": 0, "byteOffset": off, "byteLength": len(data)})
+        accessors.append(dict(acc, bufferView=len(views) - 1))
+        return len(accessors) - 1
+
+    attrs = {"POSITION": add(TRI, componentType=5126, count=3, type="VEC3")}
+    attrs["JOINTS_0"] = add(struct.pack("<12B", *[j for v in joints for j in v]), componentType=5121,
+                            count=len(joints), type="VEC4")
+    flat = [w for v in weights for w in v]
+    if weight_type == 5126:
+        attrs["WEIGHTS_0"] = add(struct.pack(f"<{len(flat)}f", *flat), componentType=5126, count=len(weights), type="VEC4")
+    else:
+        attrs["WEIGHTS_0"] = add(struct.pack(f"<{len(flat)}B", *flat), componentType=5121, normalized=True,
+                                 count=len(weights), type="VEC4")
+    if normals:
+        attrs["NORMAL"] = add(struct.pack("<9f", *[c for v in normals for c in v]), componentType=5126, count=3, type="VEC3")
+    if tangents:
+        attrs["TANGENT"] = add(struct.pack("<12f", *[c for v in tangents for c in v]), componentType=5126, count=3,
+                               type="VEC4")
+    times = add(struct.pack("<2f", 0, 1), componentType=5126, count=2, type="SCALAR", min=[0], max=[1])
+    rots = add(struct.pack("<8f", *[c for q in keys for c in q]), componentType=5126, count=2, type="VEC4")
+    blob = b"".join(parts)
+    joint_node = {"rotation": list(rotation)} if rotation else {}
+    return {
+        "asset": {"version": "2.0"},
+        "buffers": [{"byteLength": len(blob), "uri": data_uri(blob)}],
+        "bufferViews": views, "accessors": accessors,
+        "meshes": [{"name": "tri", "primitives": [{"attributes": attrs}]}],
+        "nodes": nodes or [{"mesh": 0, "skin": 0}, {"children": [2]}, joint_node],
+        "skins": skins or [{"joints": [1, 2]}],
+        "scenes": [{"nodes": [0, 1]}],
+        "animations": [{"samplers": [{"input": times, "output": rots}],
+                        "channels": [{"sampler": 0, "target": {"node": 2, "path": "rotation"}}]}],
+    }
+
+
+GEN = "generate --rig @D/m.gltf -f tests/gltf/data/minimal.frag -r rules/standard.yaml -o @O/tri"
+W = "@D/m.gltf: warning: mesh 'tri' primitive 0, "
+case("weights-sum-above-one", {"m.gltf": text(skinned(weights=((0.9, 0.6, 0, 0), (1, 0, 0, 0), (0.5, 0.5, 0, 0))))},
+     rig_import("@D/m.gltf"), 0,
+     W + "WEIGHTS_0 (accessor 2, /meshes/0/primitives/0/attributes/WEIGHTS_0): the weights of 1 of 3 vertices do not "
+     "sum to 1 (first: vertex 0; the farthest from 1: 1.5); renormalised to sum to 1",
+     "(--no-normalize-weights keeps them) [ACCESSOR_WEIGHTS_NON_NORMALIZED]")
+case("weights-sum-werror", {"m.gltf": text(skinned(weights=((0.9, 0.6, 0, 0),) * 3))}, GEN + " -Werror", 1,
+     "@D/m.gltf: error: mesh 'tri' primitive 0, WEIGHTS_0 (accessor 2",
+     "the weights of 3 of 3 vertices do not sum to 1", "(-Werror) [ACCESSOR_WEIGHTS_NON_NORMALIZED]")
+case("weights-sum-kept", {"m.gltf": text(skinned(weights=((0.2, 0.3, 0, 0),) * 3))},
+     rig_import("@D/m.gltf") + " --no-normalize-weights", 0,
+     "the farthest from 1: 0.5); kept as stored (--no-normalize-weights): the skin there is scaled by the sum")
+case("weights-all-zero", {"m.gltf": text(skinned(weights=((0, 0, 0, 0), (1, 0, 0, 0), (1, 0, 0, 0))))}, GEN, 0,
+     "the weights of 1 of 3 vertices do not sum to 1 (first: vertex 0; the farthest from 1: 0)")
+case("weights-negative", {"m.gltf": text(skinned(weights=((1.5, -0.5, 0, 0),) * 3))}, rig_import("@D/m.gltf"), 0,
+     W + "WEIGHTS_0 (accessor 2, /meshes/0/primitives/0/attributes/WEIGHTS_0): 3 of 3 vertices have a negative weight "
+     "(first: vertex 0); the program blends with it as stored [ACCESSOR_WEIGHTS_NEGATIVE]")
+case("weights-unorm-sum-below", {"m.gltf": text(skinned(weights=((100, 100, 0, 0), (255, 0, 0, 0), (128, 127, 0, 0)),
+                                                        weight_type=5121))},
+     rig_import("@D/m.gltf"), 0, "the weights of 1 of 3 vertices do not sum to 1 (first: vertex 0; the farthest from 1: "
+     "0.784314); renormalised")
+case("weights-nan", {"m.gltf": text(skinned(weights=((float("nan"), 0, 0, 0),) * 3))}, GEN, 1,
+     "WEIGHTS_0 (accessor 2) holds a non-finite value (/accessors/2) [ACCESSOR_INVALID_FLOAT]")
+case("joints-out-of-range", {"m.gltf": text(skinned(joints=((0, 7, 0, 0),) * 3))}, GEN, 1,
+     "@D/m.gltf: error: mesh 'tri' primitive 0: JOINTS_0 (accessor 1, /meshes/0/primitives/0/attributes/JOINTS_0) of "
+     "vertex 0 is joint 7, but the skin has 2 joints [ACCESSOR_JOINTS_INDEX_OOB]")
+case("joints-out-of-range-zero-weight", {"m.gltf": text(skinned(joints=((0, 1, 200, 0),) * 3))},
+     rig_import("@D/m.gltf"), 1, "is joint 200, but the skin has 2 joints [ACCESSOR_JOINTS_INDEX_OOB]")
+case("joints-weighted-twice", {"m.gltf": text(skinned(joints=((1, 1, 0, 0),) * 3, weights=((0.5, 0.5, 0, 0),) * 3))},
+     rig_import("@D/m.gltf"), 0,
+     "JOINTS_0 (accessor 1, /meshes/0/primitives/0/attributes/JOINTS_0): 3 of 3 vertices weight one joint twice "
+     "(first: vertex 0, joint 1); a linear blend adds the two weights [ACCESSOR_JOINTS_INDEX_DUPLICATE]")
+case("quaternion-node-short", {"m.gltf": text(skinned(rotation=(0, 0, 0, 0.9)))}, rig_import("@D/m.gltf"), 0,
+     "@D/m.gltf: warning: node 2 ('', /nodes/2/rotation): the rotation quaternion has length 0.9, not 1; it is "
+     "normalised before use [ROTATION_NON_UNIT]")
+case("quaternion-node-zero", {"m.gltf": text(skinned(rotation=(0, 0, 0, 0)))}, rig_import("@D/m.gltf"), 1,
+     "@D/m.gltf: error: node 2 ('', /nodes/2/rotation): the rotation quaternion has length 0: it is no rotation")
+case("quaternion-sampler-long", {"m.gltf": text(skinned(keys=((0, 0, 0, 1), (0, 0.8, 0, 0.8))))}, GEN, 0,
+     "@D/m.gltf: warning: animation '0' channel 0 (node 2 rotation, sampler 0, output accessor 4, /animations/0/channels/0/sampler): "
+     "1 of 2 "
+     "keyframe quaternions are not of unit length (first: keyframe 1; the farthest from 1: length 1.13137)",
+     "[ACCESSOR_ANIMATION_SAMPLER_OUTPUT_NON_NORMALIZED_QUATERNION]")
+case("quaternion-sampler-zero", {"m.gltf": text(skinned(keys=((0, 0, 0, 1), (0, 0, 0, 0))))}, GEN, 1,
+     "@D/m.gltf: error: animation '0' channel 0 (node 2 rotation, sampler 0, output accessor 4, /animations/0/channels/0/sampler): "
+     "keyframe 1 "
+     "is a quaternion of length 0: it is no rotation")
+case("normal-zero-tangent-sign", {"m.gltf": text(skinned(normals=((0, 0, 1), (0, 0, 0), (0, 0, 1)),
+                                                         tangents=((1, 0, 0, 1), (1, 0, 0, 0), (1, 0, 0, -1))))},
+     rig_import("@D/m.gltf"), 0,
+     "NORMAL (accessor 3, /meshes/0/primitives/0/attributes/NORMAL): 1 of 3 vertices are not of unit length (first: "
+     "vertex 1; the farthest from 1: length 0)", "[ACCESSOR_VECTOR3_NON_UNIT]",
+     "TANGENT (accessor 4, /meshes/0/primitives/0/attributes/TANGENT): TANGENT.w of 1 of 3 vertices is not +1 or -1 "
+     "(first: vertex 1, 0)", "[ACCESSOR_INVALID_SIGN]")
+case("normal-zero-werror", {"m.gltf": text(skinned(normals=((0, 0, 1), (0, 0, 0), (0, 0, 1))))},
+     rig_import("@D/m.gltf") + " --Werror", 1, "(-Werror) [ACCESSOR_VECTOR3_NON_UNIT]")
+# Instancing: one mesh on two nodes with different skins; the second skin is too small for the
+# joints the primitive uses, so that instance cannot be posed.
+two_skins = skinned(joints=((0, 2, 0, 0),) * 3, nodes=[{"mesh": 0, "skin": 0}, {"children": [2, 3]}, {}, {},
+                                                       {"mesh": 0, "skin": 1}],
+                    skins=[{"joints": [1, 2, 3]}, {"joints": [1, 2]}])
+two_skins["scenes"] = [{"nodes": [0, 1, 4]}]
+case("instance-skin-too-small", {"m.gltf": text(two_skins)}, GEN, 1,
+     "@D/m.gltf: error: mesh 'tri' primitive 0: JOINTS_0 (accessor 1, /meshes/0/primitives/0/attributes/JOINTS_0) of "
+     "vertex 0 is joint 2, but skin 1 (of node 4) has 2 joints [ACCESSOR_JOINTS_INDEX_OOB]")
+missing_skin = skinned(nodes=[{"mesh": 0, "skin": 0}, {"children": [2]}, {}, {"mesh": 0, "skin": 9}])
+missing_skin["scenes"] = [{"nodes": [0, 1, 3]}]
+case("instance-skin-missing", {"m.gltf": text(missing_skin)}, GEN, 1,
+     "@D/m.gltf: error: node 3 instantiates mesh 'tri' with skin 9, which does not exist")
+mixed = skinned(nodes=[{"mesh": 0, "skin": 0}, {"children": [2]}, {}, {"mesh": 0, "translation": [2, 0, 0]}])
+mixed["scenes"] = [{"nodes": [0, 1, 3]}]
+case("instance-skinned-and-rigid", {"m.gltf": text(mixed)}, GEN, 0)
+
 # --- JSON ----------------------------------------------------------------------------------
 deep = b'{"asset":{"version":"2.0"},\n"extras":' + b"[" * 5000 + b"]" * 5000 + b"}"
 case("json-deep-nesting", {"m.gltf": deep}, rig_import("@D/m.gltf"), 1,
