@@ -46,7 +46,8 @@ std::string DeviceVariantValidator::identity() const {
       s.strict, s.floatCheck, s.validationLayers);
 }
 
-std::shared_ptr<const ValidationScene> DeviceVariantValidator::sceneOf(const std::string& rigPath) {
+std::shared_ptr<const ValidationScene> DeviceVariantValidator::sceneOf(const std::string& rigPath,
+                                                                      const GltfReadOptions& read) {
   {
     std::lock_guard<std::mutex> g(lock_);
     if (auto it = scenes_.find(rigPath); it != scenes_.end()) return it->second;
@@ -57,6 +58,7 @@ std::shared_ptr<const ValidationScene> DeviceVariantValidator::sceneOf(const std
     so.times = settings_.times;
     so.animation = settings_.animation;
     so.morphWeight = settings_.morphWeight;
+    so.read = read;  // the weights the variant was generated with (one choice per build)
     scene = std::make_shared<ValidationScene>(gltfScene(rigPath, so));
   } else {  // a procedural mesh in random poses, as `validate` makes for a YAML rig
     scene = std::make_shared<ValidationScene>(
@@ -67,7 +69,7 @@ std::shared_ptr<const ValidationScene> DeviceVariantValidator::sceneOf(const std
 }
 
 ValidationResult DeviceVariantValidator::validate(const Variant&, const GenerateOptions& gen) {
-  std::shared_ptr<const ValidationScene> scene = sceneOf(gen.rigPath);
+  std::shared_ptr<const ValidationScene> scene = sceneOf(gen.rigPath, gen.gltf);
   std::unique_ptr<Validator> validator;
   {
     std::lock_guard<std::mutex> g(lock_);

@@ -24,7 +24,7 @@ class DeviceVariantValidator : public VariantValidator {
 
  private:
   ValidateOptions options(const GenerateOptions& gen) const;
-  std::shared_ptr<const ValidationScene> sceneOf(const std::string& rigPath);
+  std::shared_ptr<const ValidationScene> sceneOf(const std::string& rigPath, const GltfReadOptions& read);
   ManifestValidation settings_;
   std::string device_, driver_;
   std::mutex lock_;

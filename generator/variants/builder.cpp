@@ -285,8 +285,9 @@ void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts
     }
   }
   try {
-    GenerateOptions o = generateOptionsOf(m, v);  // priced as it was generated
+    GenerateOptions o = generateOptionsOf(m, v);  // priced and read as it was generated
     if (workload) o.workload = *workload;
+    o.gltf = opts.gltf;
     out.validation = opts.validator->validate(v, o);
   } catch (const InputError& e) {
     out.validation = ValidationResult{};
