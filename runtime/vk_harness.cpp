@@ -35,6 +35,7 @@ struct DeviceInfo {
   VkPhysicalDevice pd = VK_NULL_HANDLE;
   VkPhysicalDeviceProperties props{};
   VkDriverId driverID{};
+  std::string driver;  // "<driver name> <driver info>", or the driver version number
   bool xfb = false;
   VkPhysicalDeviceTransformFeedbackPropertiesEXT xfbProps{};
 };
@@ -50,7 +51,8 @@ DeviceInfo describe(VkPhysicalDevice pd) {
   VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
   VkPhysicalDeviceDriverProperties drv{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
   info.xfbProps = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_TRANSFORM_FEEDBACK_PROPERTIES_EXT};
-  if (api >= VK_API_VERSION_1_2 || hasDeviceExtension(pd, VK_KHR_DRIVER_PROPERTIES_EXTENSION_NAME)) {
+  const bool driverProps = api >= VK_API_VERSION_1_2 || hasDeviceExtension(pd, VK_KHR_DRIVER_PROPERTIES_EXTENSION_NAME);
+  if (driverProps) {
     drv.pNext = p2.pNext;
     p2.pNext = &drv;
   }
@@ -61,6 +63,8 @@ DeviceInfo describe(VkPhysicalDevice pd) {
   vkGetPhysicalDeviceProperties2(pd, &p2);
   info.xfbProps.pNext = nullptr;
   info.driverID = drv.driverID;
+  info.driver = driverProps ? fmt::format("{} {}", drv.driverName, drv.driverInfo)
+                    : fmt::format("driver version {:#x}", info.props.driverVersion);
 
   VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
   VkPhysicalDeviceTransformFeedbackFeaturesEXT xfbFeat{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_TRANSFORM_FEEDBACK_FEATURES_EXT};
@@ -283,6 +287,7 @@ Harness::~Harness() {
 
 const std::vector<std::string>& Harness::validationMessages() const { return impl_->messages; }
 std::string Harness::deviceName() const { return impl_->dev.props.deviceName; }
+std::string Harness::driver() const { return impl_->dev.driver; }
 bool Harness::validationEnabled() const { return impl_->validation; }
 const VkPhysicalDeviceLimits& Harness::limits() const { return impl_->dev.props.limits; }
 Harness::Handles Harness::handles() const { return {impl_->dev.pd, impl_->device, impl_->queueFamily, impl_->queue}; }

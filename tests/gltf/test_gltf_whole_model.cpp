@@ -5,8 +5,11 @@
 #include <nlohmann/json.hpp>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -364,6 +367,152 @@ TEST(WholeModel, RenderDrawsEveryNodeThatInstantiatesAMesh) {
   EXPECT_EQ(loW, lo0);
   EXPECT_EQ(hiW, hi1);
   fs::remove_all(d);
+}
+
+// RecursiveSkeletons: one mesh drawn by 84 nodes, each with its own skin (skeletons nested in
+// skeletons). Every instance is posed with its own skin and checked at every time; the report
+// lists them; each is posed differently (84 distinct places in the saved outputs).
+std::string skeletons() { return modelPath("RecursiveSkeletons/RecursiveSkeletons.glb"); }
+
+TEST(WholeModel, EveryInstanceOfRecursiveSkeletonsIsValidatedAndListed) {
+  fs::path out = scratch("skeletons");
+  CliRun r = cli(fmt::format("validate --rig \"{}#*\" -f \"{}\" -r \"{}\" --time 0.7 --time 1.4 --no-validation-layers "
+                             "--report \"{}\" --save-outputs \"{}\"",
+                             skeletons(), dataPath("minimal.frag"), sourcePath("rules/standard.yaml"),
+                             (out / "report.json").string(), (out / "saved").string()));
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("instances: 84 checked, each at every time"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("PASS  m0p0-skinned_mesh  (" + skeletons() + "#0/0): 40 vertices, skinned (10 joints), 84 instance(s)"),
+            std::string::npos)
+      << r.out;
+  std::ifstream in(out / "report.json");
+  nlohmann::json rep = nlohmann::json::parse(in);
+  ASSERT_EQ(rep["primitives"].size(), 1u);
+  const auto& prim = rep["primitives"][0];
+  ASSERT_EQ(prim["instances"].size(), 84u);
+  std::set<int> nodes, skins;
+  for (const auto& i : prim["instances"]) {
+    nodes.insert(i["node"].get<int>());
+    skins.insert(i["skin"].get<int>());
+  }
+  EXPECT_EQ(nodes.size(), 84u);
+  EXPECT_EQ(skins.size(), 84u) << "each node has its own skin";
+  const auto& poses = prim["runs"][0]["poses"];
+  ASSERT_EQ(poses.size(), 168u);  // 84 instances x 2 times, instance-major
+  for (size_t k = 0; k < poses.size(); ++k) {
+    EXPECT_EQ(poses[k]["instance"], k / 2);
+    EXPECT_EQ(poses[k]["time"], k % 2 ? 1.4 : 0.7);
+    EXPECT_TRUE(poses[k]["pass"].get<bool>());
+  }
+  EXPECT_FALSE(rep["driver"].get<std::string>().empty());
+  // Every instance posed in its own place: 84 distinct centroids at t = 0.7.
+  std::ifstream sin(out / "saved" / "outputs.json");
+  nlohmann::json saved = nlohmann::json::parse(sin);
+  std::set<std::tuple<long, long, long>> centroids;
+  for (const auto& a : saved["primitives"][0]["arrays"]) {
+    if (a["output"] != "gl_Position" || a["time_index"] != 0) continue;
+    std::ifstream f(out / "saved" / a["file"].get<std::string>(), std::ios::binary);
+    std::vector<float> v(40 * 4);
+    f.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(v.size() * 4));
+    double c[3] = {0, 0, 0};
+    for (size_t i = 0; i < 40; ++i)
+      for (int k = 0; k < 3; ++k) c[k] += v[i * 4 + static_cast<size_t>(k)] / v[i * 4 + 3] / 40;
+    centroids.insert({std::lround(c[0] * 1e4), std::lround(c[1] * 1e4), std::lround(c[2] * 1e4)});
+  }
+  EXPECT_EQ(centroids.size(), 84u);
+  fs::remove_all(out);
+}
+
+// --report and --save-outputs write the same bytes on every run, under names that depend only
+// on the model, the primitive, the instance, the time index and the output.
+TEST(WholeModel, ReportAndSavedOutputsAreByteIdenticalAcrossRuns) {
+  auto run = [&](const fs::path& out) {
+    return cli(fmt::format("validate --rig \"{}#*\" -f \"{}\" -r \"{}\" --time 0.25 --no-validation-layers "
+                           "--report \"{}\" --save-outputs \"{}\"",
+                           modelPath("AnimatedMorphSphere/AnimatedMorphSphere.gltf"), dataPath("lit.frag"),
+                           sourcePath("rules/standard.yaml"), (out / "report.json").string(), (out / "saved").string()));
+  };
+  fs::path a = scratch("determinism_a"), b = scratch("determinism_b");
+  CliRun ra = run(a), rb = run(b);
+  ASSERT_EQ(ra.status, 0) << ra.out;
+  ASSERT_EQ(rb.status, 0) << rb.out;
+  auto slurp = [](const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+  };
+  std::vector<std::string> names;
+  for (const auto& e : fs::recursive_directory_iterator(a))
+    if (e.is_regular_file()) names.push_back(fs::relative(e.path(), a).string());
+  std::sort(names.begin(), names.end());
+  // report.json, outputs.json, one .glb and the 4 outputs of lit.frag's plan (gl_Position, world
+  // position, eye direction, normal) of the one instance at the one time.
+  EXPECT_EQ(names, (std::vector<std::string>{"report.json", "saved/m0p0-Sphere.i0.t0.gl_Position.bin",
+                                             "saved/m0p0-Sphere.i0.t0.world_eye_dir.bin",
+                                             "saved/m0p0-Sphere.i0.t0.world_normal.bin",
+                                             "saved/m0p0-Sphere.i0.t0.world_position.bin", "saved/m0p0-Sphere.t0.glb",
+                                             "saved/outputs.json"}));
+  for (const auto& n : names) EXPECT_EQ(slurp(a / n), slurp(b / n)) << n << " differs between two runs";
+  // The report names the file's device and the tolerance; the saved .glb is a GLB 2.0.
+  std::string glb = slurp(a / "saved/m0p0-Sphere.t0.glb");
+  ASSERT_GE(glb.size(), 20u);
+  EXPECT_EQ(glb.substr(0, 4), "glTF");
+  uint32_t total = 0;
+  std::memcpy(&total, glb.data() + 8, 4);
+  EXPECT_EQ(total, glb.size());
+  // Writing over an input is refused before anything is written.
+  CliRun clobber = cli(fmt::format("validate --rig \"{}#*\" -f \"{}\" -r \"{}\" --time 0.25 --report \"{}\"",
+                                   modelPath("AnimatedMorphSphere/AnimatedMorphSphere.gltf"), dataPath("lit.frag"),
+                                   sourcePath("rules/standard.yaml"), dataPath("lit.frag")));
+  EXPECT_NE(clobber.status, 0);
+  EXPECT_NE(clobber.out.find("refusing to overwrite an input"), std::string::npos) << clobber.out;
+  fs::remove_all(a);
+  fs::remove_all(b);
+}
+
+// The 84 figures drawn: the whole picture covers exactly the union of the 84 instances' own
+// draws under the same camera, and every instance adds to it.
+TEST(WholeModel, RenderDrawsAll84RecursiveSkeletons) {
+  fs::path png = scratch("skeletons.png");
+  const std::string frag = dataPath("solid.frag");
+  CliRun r = cli(fmt::format("render --rig \"{}#*\" -f \"{}\" -r \"{}\" --time 0.7 --size 128x128 -o \"{}\"",
+                             skeletons(), frag, sourcePath("rules/standard.yaml"), png.string()));
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(r.out.find("not drawn"), std::string::npos) << r.out;
+  rt::Image whole = readPng(png.string());
+  RenderOptions ro;
+  ro.gen.rigPath = skeletons() + "#*";
+  ro.gen.fragmentPath = frag;
+  ro.gen.rulesPaths = {sourcePath("rules/standard.yaml")};
+  ro.time = 0.7;
+  ro.width = ro.height = 128;
+  std::vector<ModelPart> parts{modelPart(ro, gltfParts(skeletons()).front())};
+  ASSERT_EQ(parts[0].instances.size(), 83u);
+  frameModel(parts, ro.camera, 1.0f);
+  RenderSession session("", false);
+  FragmentProgram fp = compileFragmentFile(frag, ro.gen.targetEnv);
+  std::vector<rt::Image> draws;
+  session.renderModel(parts, fp, texturesFor(fp, ro.lighting), ro, &draws);
+  ASSERT_EQ(draws.size(), 84u);
+  size_t unionCovered = 0, mismatched = 0, largest = 0;
+  for (const auto& im : draws) {
+    size_t c = 0;
+    for (float d : im.depth) c += d < 1.0f;
+    EXPECT_GT(c, 0u) << "an instance is not in the picture";
+    largest = std::max(largest, c);
+  }
+  for (size_t px = 0; px < whole.rgba.size() / 4; ++px) {
+    bool inUnion = false;
+    for (const auto& im : draws) inUnion = inUnion || im.depth[px] < 1.0f;
+    const uint8_t* w = &whole.rgba[px * 4];
+    bool covered = w[0] == 255 && w[1] == 128 && w[2] == 64;  // solid.frag's colour, not the background
+    unionCovered += inUnion;
+    mismatched += covered != inUnion;
+  }
+  EXPECT_EQ(mismatched, 0u);
+  EXPECT_GT(unionCovered, 4 * largest) << "84 figures cover far more than one";
+  fs::remove(png);
 }
 
 }  // namespace
