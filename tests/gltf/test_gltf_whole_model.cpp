@@ -17,6 +17,8 @@
 
 #include "gltf_test_util.h"
 #include "render/render.h"
+#include "runtime/reference.h"
+#include "validate/gltf_scene.h"
 #include "rig/gltf_import.h"
 #include "variants/manifest.h"
 
@@ -516,6 +518,69 @@ TEST(WholeModel, RenderDrawsAll84RecursiveSkeletons) {
   EXPECT_EQ(mismatched, 0u);
   EXPECT_GT(unionCovered, 2 * largest) << "84 figures cover far more than the largest one";
   fs::remove(png);
+}
+
+// gltfInstances on a skinned triangle drawn by two nodes (the bad-input corpus's model:
+// skin 0 = joints [2, 3], vertex 2 bound to joint 1 = node 3, translated +1 on x): each
+// instance posed by its own skin; a second skin larger than the palette poses with its first
+// joints; a node repeating an earlier node's skin, or drawing the skinned mesh without one,
+// is left out with a note.
+TEST(WholeModel, InstancesArePosedByTheirOwnSkin) {
+  std::ifstream in(sourcePath("tests/bad-input/gltf/instance-skin-too-small/m.gltf"));
+  nlohmann::json base = nlohmann::json::parse(in);
+  fs::path d = scratch("skins");
+  fs::create_directories(d);
+  auto instancesOf = [&](const nlohmann::json& node1, const nlohmann::json& skin1, std::vector<std::string>* notes,
+                         std::vector<glm::vec4>* secondWorld) {
+    nlohmann::json m = base;
+    m["nodes"][1] = node1;
+    m["skins"][1]["joints"] = skin1;
+    std::ofstream((d / "m.gltf").string()) << m.dump();
+    GltfImport imp = importGltf((d / "m.gltf").string());
+    GltfSceneOptions so;
+    so.times = {0};
+    so.allInstances = true;
+    GltfSceneInfo info;
+    ValidationScene scene = gltfScene(imp, so, &info);
+    if (notes) *notes = info.notes;
+    if (secondWorld && scene.poses.size() > 1)
+      *secondWorld = rt::referenceValues("world.position", scene.mesh, scene.poses[1], scene.shape);
+    if (scene.poses.size() == 2) {
+      std::vector<glm::vec4> first = rt::referenceValues("world.position", scene.mesh, scene.poses[0], scene.shape);
+      EXPECT_FLOAT_EQ(first[2].x, 1.0f) << "instance 0: vertex 2 follows node 3 (+1 on x)";
+    }
+    return info.instances;
+  };
+  std::vector<std::string> notes;
+  std::vector<glm::vec4> world;
+  // Skin 1 = joints [4, 2, 3]: three joints for a two-joint palette; vertex 2's joint 1 is node 2 (at the origin).
+  std::vector<GltfInstance> two = instancesOf({{"mesh", 0}, {"skin", 1}}, {4, 2, 3}, &notes, &world);
+  ASSERT_EQ(two.size(), 2u);
+  EXPECT_EQ(two[0].node, 0);
+  EXPECT_EQ(two[0].skin, 0);
+  EXPECT_EQ(two[1].node, 1);
+  EXPECT_EQ(two[1].skin, 1);
+  ASSERT_EQ(world.size(), 3u);
+  EXPECT_FLOAT_EQ(world[2].x, 0.0f) << "instance 1: vertex 2 follows node 2 (its skin's joint 1)";
+  EXPECT_TRUE(notes.empty());
+  // The same skin as node 0: posed identically, left out.
+  EXPECT_EQ(instancesOf({{"mesh", 0}, {"skin", 0}}, {4}, &notes, nullptr).size(), 1u);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("node 1 poses mesh 0 exactly as an earlier node with skin 0"), std::string::npos) << notes[0];
+  // No skin on a node drawing a skinned mesh: left out.
+  EXPECT_EQ(instancesOf({{"mesh", 0}}, {4}, &notes, nullptr).size(), 1u);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("draws the skinned mesh 0 without a skin"), std::string::npos) << notes[0];
+  // A skin too small for the joints the vertices use: the primitive fails, naming the node.
+  try {
+    instancesOf({{"mesh", 0}, {"skin", 1}}, {4}, nullptr, nullptr);
+    ADD_FAILURE() << "a one-joint skin cannot pose vertices bound to joint 1";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("node 1 poses mesh 0 with skin 1 of 1 joints, but its vertices use joint 1"),
+              std::string::npos)
+        << e.what();
+  }
+  fs::remove_all(d);
 }
 
 }  // namespace
