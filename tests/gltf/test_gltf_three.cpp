@@ -49,8 +49,9 @@ std::string script() { return sourcePath("tests/js/three_pose.mjs"); }
 // Node.js and the pinned three.js (tests/js, `npm ci` in cmake/dev.sh); the tests skip without them.
 std::string missingNode() {
   if (sh("node --version").status != 0) return "node is not installed (Debian package nodejs; cmake/dev.sh)";
-  if (!fs::exists(sourcePath("tests/js/node_modules/three/package.json")))
-    return "three.js is not installed in tests/js/node_modules (npm ci in tests/js; cmake/dev.sh)";
+  for (const char* package : {"three", "gltf-validator"})
+    if (!fs::exists(sourcePath(fmt::format("tests/js/node_modules/{}/package.json", package))))
+      return fmt::format("{} is not installed in tests/js/node_modules (npm ci in tests/js; cmake/dev.sh)", package);
   return "";
 }
 #define SKIP_WITHOUT_NODE()                                          \
@@ -275,7 +276,8 @@ TEST(ThreeJs, EverySharedModelAgreesWithThreeJs) {
             << mc.model << "#" << part << " now agrees with three.js: remove it from kKnownDifferences";
     std::cout << fmt::format("{}: worst position error {:.2e} of the model's size, worst normal {:.2e}\n", mc.model,
                              worst, worstNormal);
-    // The saved glTF opens in three.js's loader, its positions the .bin arrays float for float.
+    // The saved glTF passes the Khronos glTF-Validator and opens in three.js's loader, its
+    // positions the .bin arrays float for float.
     ShellRun back = sh(fmt::format("node \"{}\" --check-saved \"{}\"", script(), dir.string()));
     EXPECT_EQ(back.status, 0) << back.out;
     EXPECT_NE(back.out.find("\"meshes\":"), std::string::npos) << back.out;

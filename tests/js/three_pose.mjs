@@ -4,8 +4,9 @@
 // posed world positions (and normals) as JSON.
 //
 //   node three_pose.mjs MODEL.glb|.gltf --animation NAME|INDEX --time T [--time T2 ...]
-//   node three_pose.mjs --check-saved DIR   (loads validate --save-outputs' .glb files back
-//                                            and checks their positions equal the .bin arrays)
+//   node three_pose.mjs --check-saved DIR   (loads validate --save-outputs' .glb files back,
+//                                            checks them with the Khronos glTF-Validator and
+//                                            their positions against the .bin arrays)
 //
 // In Node there is no DOM: the loader cannot decode images. Images, textures and samplers
 // are removed and every material emptied before parsing (positions and normals do not read
@@ -213,14 +214,19 @@ async function pose(file, animation, times) {
   return result;
 }
 
-// validate --save-outputs' glTF files loaded back: every instance node's POSITION equals the
-// .bin of the output it was written from, float for float.
+// validate --save-outputs' glTF files loaded back: each passes the Khronos glTF-Validator
+// with no error or warning, and every instance node's POSITION equals the .bin of the output
+// it was written from, float for float.
 async function checkSaved(dir) {
+  const validator = (await import('gltf-validator')).default;
   const index = JSON.parse(readFileSync(join(dir, 'outputs.json'), 'utf8'));
   let files = 0, meshes = 0;
   for (const prim of index.primitives) {
     for (const g of prim.gltf) {
       const bytes = readFileSync(join(dir, g.file));
+      const report = await validator.validateBytes(new Uint8Array(bytes));
+      if (report.issues.numErrors + report.issues.numWarnings > 0)
+        fail(`${g.file}: the glTF-Validator reports ${JSON.stringify(report.issues.messages)}`);
       const gltf = await load(bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.length));
       const found = meshesOf(gltf);
       if (found.length !== prim.instances.length)
