@@ -583,5 +583,30 @@ TEST(WholeModel, InstancesArePosedByTheirOwnSkin) {
   fs::remove_all(d);
 }
 
+// A morphed mesh under two nodes with their own default weights: two instances, each posed
+// with its node's weights (and with the animation's, when it targets that node).
+TEST(WholeModel, InstancesCarryTheirNodesMorphWeights) {
+  fs::path d = scratch("morph_instances");
+  fs::create_directories(d);
+  std::ofstream(d / "m.gltf")
+      << R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}],)"
+         R"("bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
+         R"("meshes":[{"name":"tri","primitives":[{"attributes":{"POSITION":0},"targets":[{"POSITION":0}]}],"weights":[0.5]}],)"
+         R"("nodes":[{"mesh":0,"weights":[0.25]},{"mesh":0,"translation":[2,0,0]},{"mesh":0,"weights":[1.0]}],"scenes":[{"nodes":[0,1,2]}]})";
+  GltfImport imp = importGltf((d / "m.gltf").string());
+  GltfSceneOptions so;
+  so.times = {0};
+  so.allInstances = true;
+  GltfSceneInfo info;
+  ValidationScene scene = gltfScene(imp, so, &info);
+  ASSERT_EQ(info.instances.size(), 3u);
+  ASSERT_EQ(scene.poses.size(), 3u);
+  EXPECT_FLOAT_EQ(scene.poses[0].morphWeights.at(0), 0.25f);  // node 0's own weights
+  EXPECT_FLOAT_EQ(scene.poses[1].morphWeights.at(0), 0.5f);   // node 1: the mesh's
+  EXPECT_FLOAT_EQ(scene.poses[2].morphWeights.at(0), 1.0f);
+  EXPECT_FLOAT_EQ(scene.poses[1].model[3][0], 2.0f);  // node 1's translation
+  fs::remove_all(d);
+}
+
 }  // namespace
 }  // namespace sg
