@@ -151,9 +151,29 @@ TEST(WholeModel, PlantedRuleFailureNamesTheMorphedPrimitives) {
       ${out} += 2.0 * ${morph.weights}[${i}] * ${morph.position[i]};
       @end
 )";
-  CliRun r = cli(fmt::format("validate --rig \"{}#*\" -f \"{}\" -r \"{}\" --animation Wave --time 0.5 --morph-weight 0.8",
-                          robot(), dataPath("lit.frag"), (d / "broken.yaml").string()));
+  CliRun r = cli(fmt::format("validate --rig \"{}#*\" -f \"{}\" -r \"{}\" --animation Wave --time 0.5 --morph-weight 0.8 "
+                             "--report \"{}\"",
+                             robot(), dataPath("lit.frag"), (d / "broken.yaml").string(), (d / "report.json").string()));
   EXPECT_EQ(r.status, 1) << r.out;
+  // The report of a failing model is written too, and says where it fails.
+  std::ifstream rin(d / "report.json");
+  nlohmann::json rep = nlohmann::json::parse(rin);
+  EXPECT_FALSE(rep["pass"].get<bool>());
+  EXPECT_EQ(rep["tolerance"]["abs"], 1e-6);
+  ASSERT_EQ(rep["primitives"].size(), 19u);
+  for (const auto& p : rep["primitives"]) {
+    const bool broken = p["name"] == "m2p2-Head";
+    EXPECT_EQ(p["pass"].get<bool>(), !broken) << p["name"];
+    const auto& run = p["runs"][0];
+    EXPECT_FALSE(run["rules"].empty());
+    EXPECT_EQ(run["poses"].size(), 1u);  // one instance, one time
+    if (!broken) continue;
+    EXPECT_FALSE(run["poses"][0]["pass"].get<bool>());
+    bool positionFails = false;
+    for (const auto& o : run["poses"][0]["outputs"])
+      if (o["name"] == "gl_Position") positionFails = !o["pass"].get<bool>() && o["max_rel_error"].get<double>() > 1e-5;
+    EXPECT_TRUE(positionFails) << run["poses"][0].dump();
+  }
   EXPECT_NE(r.out.find("18 of 19 primitive(s) pass"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("RobotExpressive.glb#*: error: 1 of 19 primitive(s) failed (m2p2-Head); the model does not validate"),
             std::string::npos)
