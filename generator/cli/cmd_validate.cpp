@@ -55,8 +55,8 @@ struct ValidateCommand {
     return part;
   }
 
-  // "instances: 84 (node 3 'a', node 7 'b', ...), each at every time: all pass" and a line
-  // per failing instance and time.
+  // "instances: 84 checked, each at every time (node 10, node 21, ...)", a note per instance
+  // left out, and a line per failing instance and time.
   static std::string formatInstances(const ValidatedPart& p) {
     std::string names;
     for (const auto& i : p.instances) names += (names.empty() ? "" : ", ") + i.name;
