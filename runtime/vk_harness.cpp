@@ -35,7 +35,7 @@ struct DeviceInfo {
   VkPhysicalDevice pd = VK_NULL_HANDLE;
   VkPhysicalDeviceProperties props{};
   VkDriverId driverID{};
-  std::string driver;  // "llvmpipe Mesa 22.3.6 (LLVM 15.0.6)": driver name and version
+  std::string driver;  // "<driver name> <driver info>", or the driver version number
   bool xfb = false;
   VkPhysicalDeviceTransformFeedbackPropertiesEXT xfbProps{};
 };
@@ -51,7 +51,8 @@ DeviceInfo describe(VkPhysicalDevice pd) {
   VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
   VkPhysicalDeviceDriverProperties drv{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
   info.xfbProps = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_TRANSFORM_FEEDBACK_PROPERTIES_EXT};
-  if (api >= VK_API_VERSION_1_2 || hasDeviceExtension(pd, VK_KHR_DRIVER_PROPERTIES_EXTENSION_NAME)) {
+  const bool driverProps = api >= VK_API_VERSION_1_2 || hasDeviceExtension(pd, VK_KHR_DRIVER_PROPERTIES_EXTENSION_NAME);
+  if (driverProps) {
     drv.pNext = p2.pNext;
     p2.pNext = &drv;
   }
@@ -62,8 +63,8 @@ DeviceInfo describe(VkPhysicalDevice pd) {
   vkGetPhysicalDeviceProperties2(pd, &p2);
   info.xfbProps.pNext = nullptr;
   info.driverID = drv.driverID;
-  info.driver = drv.driverName[0] ? fmt::format("{} {}", drv.driverName, drv.driverInfo)
-                                  : fmt::format("driver version {:#x}", info.props.driverVersion);
+  info.driver = driverProps ? fmt::format("{} {}", drv.driverName, drv.driverInfo)
+                    : fmt::format("driver version {:#x}", info.props.driverVersion);
 
   VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
   VkPhysicalDeviceTransformFeedbackFeaturesEXT xfbFeat{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_TRANSFORM_FEEDBACK_FEATURES_EXT};

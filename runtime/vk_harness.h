@@ -55,7 +55,8 @@ class Harness {
   // Every debug-utils message (warning and error severities, all types) since construction.
   const std::vector<std::string>& validationMessages() const;
   std::string deviceName() const;
-  std::string driver() const;  // the driver's name and version (VkPhysicalDeviceDriverProperties)
+  // "<driver name> <driver info>" (VkPhysicalDeviceDriverProperties), or the driver version number.
+  std::string driver() const;
   bool validationEnabled() const;  // whether the layer was found and enabled
   // The physical device's limits (maxVertexInputAttributes, maxUniformBufferRange, ...).
   const VkPhysicalDeviceLimits& limits() const;

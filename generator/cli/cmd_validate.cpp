@@ -1,6 +1,7 @@
 // `shadergen validate`: generate, run on lavapipe, compare with the GLM reference.
 #include <fmt/format.h>
 
+#include <filesystem>
 #include <iostream>
 
 #include "cli/commands.h"
@@ -9,6 +10,7 @@
 #include "cli/output_files.h"
 #include "cli/whole_model.h"
 #include "validate/validate.h"
+#include "validate/validation_files.h"
 
 namespace sg {
 namespace {
@@ -32,6 +34,65 @@ struct ValidateCommand {
   std::string via = "spirv";
   bool optimize = false;
   CrossArgs cross;
+  std::string reportPath;  // --report FILE.json
+  std::string saveOutputs;  // --save-outputs DIR
+
+  // A glTF primitive at every instance and time: its section of the text report, and what
+  // --report and --save-outputs write.
+  ValidatedPart validatePrimitive(Validator& v, const GltfImport& model, const GenerateOptions& gen,
+                                  const GltfSceneOptions& so, const std::string& name, GltfSceneInfo& info) {
+    ValidationScene scene = gltfScene(model, so, &info);
+    ValidatedPart part;
+    part.name = name;
+    part.rig = gen.rigPath;
+    part.report = v.run(scene, gen);
+    part.instances = info.instances;
+    part.instanceNotes = info.notes;
+    part.times = info.times;
+    part.vertices = scene.mesh.vertexCount;
+    part.mode = model.data.mode;
+    part.indices = model.data.indices;
+    return part;
+  }
+
+  // "instances: 84 checked, each at every time (node 10, node 21, ...)", a note per instance
+  // left out, and a line per failing instance and time.
+  static std::string formatInstances(const ValidatedPart& p) {
+    std::string names;
+    for (const auto& i : p.instances) names += (names.empty() ? "" : ", ") + i.name;
+    std::string s = fmt::format("instances: {} checked, each at every time ({})\n", p.instances.size(), names);
+    for (const auto& n : p.instanceNotes) s += "note: " + n + "\n";
+    const RunReport& run = p.report.runs.front();
+    const size_t nt = std::max<size_t>(1, p.times.size());
+    for (size_t k = 0; k < run.poseOutputs.size(); ++k)
+      for (const auto& o : run.poseOutputs[k])
+        if (!o.pass)
+          s += fmt::format("  FAIL instance {} ({}) at t = {:g}: {} max rel {:.3e} at vertex {}\n", k / nt,
+                           p.instances[k / nt].name, p.times[k % nt], o.name, o.maxRelError, o.worstVertex);
+    return s;
+  }
+
+  // --report and --save-outputs, all files or none.
+  void writeFiles(const ValidateOptions& vo, const std::vector<ValidatedPart>& parts) {
+    if (reportPath.empty() && saveOutputs.empty()) return;
+    ValidationContext ctx;
+    ctx.model = vo.gen.rigPath;
+    ctx.animation = animation;
+    ctx.tolerance = vo.tolerance;
+    ctx.strict = vo.strict;
+    std::vector<PendingFile> files;
+    if (!reportPath.empty()) files.push_back({reportPath, validationReportJson(ctx, parts)});
+    if (!saveOutputs.empty())
+      for (auto& [name, bytes] : savedOutputFiles(ctx, parts))
+        files.push_back({(std::filesystem::path(saveOutputs) / name).string(), std::move(bytes)});
+    std::vector<std::string> paths;
+    for (const auto& f : files) paths.push_back(f.path);
+    std::vector<InputFile> inputs{{parseGltfRef(vo.gen.rigPath, true).file, "the rig"},
+                                  {vo.gen.fragmentPath, "the fragment shader"}};
+    for (const auto& r : vo.gen.rulesPaths) inputs.push_back({r, "a rules file"});
+    refuseClobbering(paths, inputs);
+    writeFilesAtomically(files);
+  }
 
   int run() {
     ValidateOptions vo;
@@ -46,6 +107,7 @@ struct ValidateCommand {
     vo.tolerance = tol;
     vo.checkFloatData = !noFloatCheck;
     vo.strict = strict;
+    vo.keepOutputs = !saveOutputs.empty();
     ValidationScene scene;
     std::string what;
     bool gltf = isGltfPath(vo.gen.rigPath);
@@ -53,7 +115,7 @@ struct ValidateCommand {
       for (const char* o : {"--mesh", "--seed", "--poses"})
         refuseOption(*cmd, o, "to a glTF rig: the model's own mesh is posed by its animation (use --time, --animation)");
     if (!gltf)
-      for (const char* o : {"--time", "--animation", "--morph-weight"})
+      for (const char* o : {"--time", "--animation", "--morph-weight", "--report", "--save-outputs"})
         refuseOption(*cmd, o, "to a YAML rig: it is validated on a procedural mesh in random poses (--mesh, --seed, --poses)");
     if (auto parts = wholeModelParts(vo.gen.rigPath)) return runModel(vo, *parts);
     if (gltf) {  // a real model: its own mesh, posed by its animation
@@ -62,15 +124,31 @@ struct ValidateCommand {
       so.animation = animation;
       so.morphWeight = morphWeight;
       so.read = vo.gen.gltf;
+      so.allInstances = true;
+      GltfRef ref = parseGltfRef(vo.gen.rigPath);
+      GltfImportOptions io;
+      io.mesh = ref.mesh;
+      io.primitive = ref.primitive;
+      io.read = vo.gen.gltf;
+      GltfImport model = importGltf(ref.file, io);
+      Validator v(vo);
       GltfSceneInfo info;
-      scene = gltfScene(vo.gen.rigPath, so, &info);
+      std::vector<ValidatedPart> parts{validatePrimitive(v, model, vo.gen, so,
+                                                         gltfPartName(ref.mesh, ref.primitive, model.data.meshName), info)};
+      if (!savePoses.empty()) {
+        refuseClobbering({savePoses}, {{ref.file, "the rig"}});
+        writeFilesAtomically({{savePoses, formatPoseFile(parts.front().report.poses)}});
+      }
       std::string ts;
       for (double t : info.times) ts += fmt::format("{}{:g}", ts.empty() ? "" : ", ", t);
-      what = fmt::format("model '{}' ({} vertices), {}, t = {}\n", scene.mesh.name, scene.mesh.vertexCount,
-                         info.animation.empty() ? std::string("no animation (rest pose)")
-                                                : fmt::format("animation '{}' [{:g}, {:g}] s", info.animation,
-                                                              info.start, info.end),
-                         ts);
+      std::cout << fmt::format("model '{}' ({} vertices), {}, t = {}\n", model.rig.name, model.data.vertexCount,
+                               info.animation.empty() ? std::string("no animation (rest pose)")
+                                                      : fmt::format("animation '{}' [{:g}, {:g}] s", info.animation,
+                                                                    info.start, info.end),
+                               ts);
+      std::cout << formatReport(parts.front().report) << formatInstances(parts.front());
+      writeFiles(vo, parts);
+      return parts.front().report.pass ? 0 : 1;
     } else {
       bool count = !poses.empty() && poses.find_first_not_of("0123456789") == std::string::npos && poses.size() < 4;
       int n = count ? std::stoi(poses) : 1;
@@ -106,21 +184,28 @@ struct ValidateCommand {
     so.times = times;
     so.animation = animation;
     so.morphWeight = morphWeight;
+    so.allInstances = true;
     checkWholeModelAnimation(parts, animation);
     Validator v(vo);
+    std::vector<ValidatedPart> done(parts.size());
     std::vector<std::string> lines(parts.size());
     std::string header;
     size_t passed = 0;
     std::vector<std::string> failed = forEachPart(parts, [&](const GltfPart& part) {
       size_t i = static_cast<size_t>(&part - parts.data());
       lines[i] = fmt::format("  FAIL  {}  ({}): not run, see the error above", part.name, part.ref);
+      done[i].name = part.name;
+      done[i].rig = part.ref;
+      done[i].error = "not run: see the diagnostics";
       GltfImportOptions io;
       io.mesh = part.mesh;
       io.primitive = part.primitive;
       io.read = vo.gen.gltf;
       GltfImport model = importGltf(parseGltfRef(part.ref).file, io);
+      GenerateOptions gen = vo.gen;
+      gen.rigPath = part.ref;
       GltfSceneInfo info;
-      ValidationScene scene = gltfScene(model, so, &info);
+      done[i] = validatePrimitive(v, model, gen, so, part.name, info);
       if (header.empty()) {
         std::string ts;
         for (double t : info.times) ts += fmt::format("{}{:g}", ts.empty() ? "" : ", ", t);
@@ -131,26 +216,26 @@ struct ValidateCommand {
                              ts);
         std::cout << header;
       }
-      GenerateOptions gen = vo.gen;
-      gen.rigPath = part.ref;
-      ValidateReport report = v.run(scene, gen);
+      const ValidateReport& report = done[i].report;
+      const size_t vertices = done[i].vertices;
       std::string kind = model.joints > 0 ? fmt::format("skinned ({} joints)", model.joints) : "rigid";
       if (model.morphTargets > 0) kind += fmt::format(", {} morph target(s)", model.morphTargets);
-      std::cout << fmt::format("== {} ({}): {} vertices, {}\n", part.name, part.ref, scene.mesh.vertexCount, kind);
+      std::cout << fmt::format("== {} ({}): {} vertices, {}\n", part.name, part.ref, vertices, kind);
       bool weighted = false;
-      for (const auto& pose : scene.poses)
+      for (const auto& pose : report.poses)
         for (float w : pose.morphWeights) weighted = weighted || w != 0.0f;
       if (model.morphTargets > 0 && !weighted)
         std::cout << "note: every morph weight is 0 at these times, so the targets are not exercised (--morph-weight W "
                      "sets them)\n";
-      std::cout << formatReport(report);
-      lines[i] = fmt::format("  {}  {}  ({}): {} vertices, {}, plan cost {}", report.pass ? "PASS" : "FAIL", part.name,
-                             part.ref, scene.mesh.vertexCount, kind, report.runs.front().planCost);
+      std::cout << formatReport(report) << formatInstances(done[i]);
+      lines[i] = fmt::format("  {}  {}  ({}): {} vertices, {}, {} instance(s), plan cost {}", report.pass ? "PASS" : "FAIL",
+                             part.name, part.ref, vertices, kind, done[i].instances.size(), report.runs.front().planCost);
       if (!report.pass) throw InputError(SourceLoc{part.ref, 0, 0}, "outputs differ from their definitions (report above)");
       ++passed;
     });
     std::cout << fmt::format("{} of {} primitive(s) pass:\n", passed, parts.size());
     for (const auto& l : lines) std::cout << l << "\n";
+    writeFiles(vo, done);  // the report and outputs of a failing model too: that is when they are needed
     failIfPartsFailed(vo.gen.rigPath, parts.size(), failed, "the model does not validate");
     return 0;
   }
@@ -173,6 +258,12 @@ void registerValidate(CLI::App& app, CliState& state) {
         return "";
       });
   sub->add_option("--save-poses", cmd->savePoses, "Write the poses run (with drawn uniforms) to FILE, for --poses FILE");
+  sub->add_option("--report", cmd->reportPath,
+                  "glTF rig: write a JSON report to FILE (per primitive, instance, time and output: pass, worst error "
+                  "and where, tolerances, the plan, device and driver; docs/validation.md)");
+  sub->add_option("--save-outputs", cmd->saveOutputs,
+                  "glTF rig: write what the device computed to DIR (the posed world positions and normals as .glb, "
+                  "every captured output as little-endian float32 .bin, described by DIR/outputs.json)");
   sub->add_flag("--strict", cmd->strict, "Fail outputs whose semantic has no definition (unchecked)");
   CLI::Validator finiteNonNegative = finiteNumber(false);  // no nan, inf or negative times and tolerances
   sub->add_option("--time", cmd->times, "glTF rig (MODEL.glb#m/p or MODEL.glb#*): animation time in seconds (repeatable)")

@@ -66,28 +66,22 @@ ModelPart modelPart(const RenderOptions& opts, const GltfPart& part) {
   p.name = part.name;
   p.gen = generate(o.gen);
   p.scene = renderScene(p.gen.in.rig, o);
-  // Other instances: every node of the scene that draws this mesh.
+  // Other instances: every node of the scene that draws this mesh, with its own transform,
+  // skin and morph weights (gltfInstances), under the one program.
   GltfImportOptions io;
   io.mesh = part.mesh;
   io.primitive = part.primitive;
   io.read = opts.gen.gltf;
   GltfImport model = importGltf(parseGltfRef(part.ref).file, io);
-  const GltfModelData& d = model.data;
-  for (int n : gltfSceneNodes(d)) {
-    const GltfNode& node = d.nodes[static_cast<size_t>(n)];
-    if (node.mesh != d.mesh || n == d.meshNode) continue;
-    if (node.skin >= 0 || d.skin >= 0) {  // a skin places the mesh, not the node
-      p.notes.push_back(fmt::format("node {} also instantiates mesh {} with a skin; it is not drawn again", n, d.mesh));
-      continue;
-    }
-    GltfImport instance = model;
-    instance.data.meshNode = n;
-    GltfSceneOptions so;
-    so.times = {opts.time};
-    so.animation = opts.animation;
-    so.morphWeight = opts.gltfMorphWeight;
-    p.instances.push_back(gltfScene(instance, so).poses.front());
-  }
+  GltfSceneOptions so;
+  so.times = {opts.time};
+  so.animation = opts.animation;
+  so.morphWeight = opts.gltfMorphWeight;
+  so.allInstances = true;
+  GltfSceneInfo info;
+  ValidationScene all = gltfScene(model, so, &info);
+  p.instances.assign(all.poses.begin() + 1, all.poses.end());
+  p.notes = info.notes;
   return p;
 }
 

@@ -74,8 +74,9 @@ struct ModelPart {
   std::string name;  // gltfPartName
   GenerateResult gen;
   RenderScene scene;
-  // The other nodes of the scene that draw this (unskinned) mesh, each pose with its node's
-  // world transform as model.matrix: a mesh instanced by several nodes is drawn at each.
+  // The primitive's other instances (gltfInstances: nodes drawing the mesh with their own
+  // transform, skin or morph weights), one pose each: a mesh instanced by several nodes is
+  // drawn at each.
   std::vector<rt::Pose> instances;
   std::vector<std::string> notes;  // instances not drawn, and why
 };

@@ -131,6 +131,11 @@ std::vector<double> sampleGltfChannel(const GltfChannel& ch, double t) {
 
 std::vector<glm::dmat4> gltfNodeGlobals(const GltfModelData& data, int anim, double t,
                                         std::vector<double>* morphWeights) {
+  return gltfNodeGlobals(data, anim, t, morphWeights, data.meshNode);
+}
+
+std::vector<glm::dmat4> gltfNodeGlobals(const GltfModelData& data, int anim, double t,
+                                        std::vector<double>* morphWeights, int meshNode) {
   const size_t N = data.nodes.size();
   std::vector<std::array<double, 3>> tr(N), sc(N);
   std::vector<std::array<double, 4>> rot(N);
@@ -141,8 +146,8 @@ std::vector<glm::dmat4> gltfNodeGlobals(const GltfModelData& data, int anim, dou
     sc[i] = data.nodes[i].scale;
   }
   std::vector<double> weights = data.meshWeights;
-  if (data.meshNode >= 0 && !data.nodes[static_cast<size_t>(data.meshNode)].weights.empty()) {
-    const auto& nw = data.nodes[static_cast<size_t>(data.meshNode)].weights;
+  if (meshNode >= 0 && !data.nodes[static_cast<size_t>(meshNode)].weights.empty()) {
+    const auto& nw = data.nodes[static_cast<size_t>(meshNode)].weights;
     for (size_t i = 0; i < weights.size() && i < nw.size(); ++i) weights[i] = nw[i];
   }
   if (anim >= 0) {
@@ -154,7 +159,7 @@ std::vector<glm::dmat4> gltfNodeGlobals(const GltfModelData& data, int anim, dou
         case GltfPath::Rotation: std::copy(v.begin(), v.end(), rot[node].begin()); animated[node] = true; break;
         case GltfPath::Scale: std::copy(v.begin(), v.end(), sc[node].begin()); animated[node] = true; break;
         case GltfPath::Weights:
-          if (ch.node == data.meshNode)
+          if (ch.node == meshNode)
             for (size_t i = 0; i < weights.size() && i < v.size(); ++i) weights[i] = v[i];
           break;
       }
@@ -198,20 +203,27 @@ std::vector<glm::dmat4> gltfNodeGlobals(const GltfModelData& data, int anim, dou
   return global;
 }
 
-rt::Pose gltfPose(const GltfImport& model, const rt::Mesh& mesh, const rt::RigShape& shape, int anim, double t) {
+rt::Pose gltfPose(const GltfImport& model, const rt::Mesh& mesh, const rt::RigShape& shape, int anim, double t,
+                  const GltfInstance* instance) {
   const GltfModelData& d = model.data;
+  const int node = instance ? instance->node : d.meshNode;
+  const int skinIndex = instance ? instance->skin : d.skin;
   std::vector<double> weights;
-  std::vector<glm::dmat4> G = gltfNodeGlobals(d, anim, t, &weights);
+  std::vector<glm::dmat4> G = gltfNodeGlobals(d, anim, t, &weights, node);
   rt::Pose pose;
-  if (d.skin >= 0) {
-    const GltfSkin& skin = d.skins[static_cast<size_t>(d.skin)];
+  if (skinIndex >= 0) {
+    const GltfSkin& skin = d.skins[static_cast<size_t>(skinIndex)];
     // glTF skinning: jointMatrix_j = inverse(global(meshNode)) · global(joint_j) · IBM_j puts
     // vertices in the mesh node's space, and the spec then ignores the skinned node's transform;
-    // the palette maps bind pose to world directly: global(joint_j) · IBM_j.
-    for (size_t j = 0; j < skin.joints.size(); ++j)
-      pose.bones.push_back(glm::mat4(G[static_cast<size_t>(skin.joints[j])] * glm::dmat4(fromArrayF(skin.inverseBind[j]))));
+    // the palette maps bind pose to world directly: global(joint_j) · IBM_j. Another
+    // instance's skin may have more joints than the program's palette (the vertices use only
+    // the first ones) or fewer (gltfInstances checked the vertices stay below them): identity.
+    for (size_t j = 0; j < static_cast<size_t>(shape.bones); ++j)
+      pose.bones.push_back(j < skin.joints.size()
+                               ? glm::mat4(G[static_cast<size_t>(skin.joints[j])] * glm::dmat4(fromArrayF(skin.inverseBind[j])))
+                               : glm::mat4(1.0f));
   } else {
-    pose.model = d.meshNode >= 0 ? glm::mat4(G[static_cast<size_t>(d.meshNode)]) : glm::mat4(1.0f);
+    pose.model = node >= 0 ? glm::mat4(G[static_cast<size_t>(node)]) : glm::mat4(1.0f);
   }
   for (int i = 0; i < shape.morphTargets; ++i)
     pose.morphWeights.push_back(static_cast<float>(static_cast<size_t>(i) < weights.size() ? weights[static_cast<size_t>(i)] : 0.0));
@@ -242,6 +254,55 @@ rt::Pose gltfPose(const GltfImport& model, const rt::Mesh& mesh, const rt::RigSh
   return pose;
 }
 
+std::vector<GltfInstance> gltfInstances(const GltfImport& model, std::vector<std::string>* notes) {
+  const GltfModelData& d = model.data;
+  auto describe = [&](int n) {
+    const std::string& name = d.nodes[static_cast<size_t>(n)].name;
+    return name.empty() ? fmt::format("node {}", n) : fmt::format("node {} '{}'", n, name);
+  };
+  std::vector<GltfInstance> out;
+  out.push_back(GltfInstance{d.meshNode, d.skin, d.meshNode >= 0 ? describe(d.meshNode) : "no node (origin)"});
+  // Nodes whose morph weights an animation sets: their instances differ even under one skin.
+  std::vector<char> animatedWeights(d.nodes.size(), 0);
+  for (const auto& a : d.animations)
+    for (const auto& ch : a.channels)
+      if (ch.path == GltfPath::Weights) animatedWeights[static_cast<size_t>(ch.node)] = 1;
+  // The highest joint index the vertices use (skins with fewer joints cannot pose them).
+  int usedJoints = 0;
+  for (const auto& [sem, values] : d.streams)
+    if (sem.rfind("skin.joints[", 0) == 0)
+      for (const auto& v : values)
+        for (float j : v) usedJoints = std::max(usedJoints, static_cast<int>(j) + 1);
+  for (int n : gltfSceneNodes(d)) {
+    const GltfNode& node = d.nodes[static_cast<size_t>(n)];
+    if (node.mesh != d.mesh || n == d.meshNode) continue;
+    GltfInstance inst{n, -1, describe(n)};
+    if (d.skin >= 0) {
+      if (node.skin < 0 || static_cast<size_t>(node.skin) >= d.skins.size()) {
+        if (notes) notes->push_back(fmt::format("{} draws the skinned mesh {} without a skin: not posed", inst.name, d.mesh));
+        continue;
+      }
+      inst.skin = node.skin;
+      const bool same = std::any_of(out.begin(), out.end(), [&](const GltfInstance& o) {
+        return o.skin == inst.skin && o.node >= 0 && !animatedWeights[static_cast<size_t>(o.node)] &&
+               !animatedWeights[static_cast<size_t>(n)] && d.nodes[static_cast<size_t>(o.node)].weights == node.weights;
+      });
+      if (same) {
+        if (notes) notes->push_back(fmt::format("{} poses mesh {} exactly as an earlier node with skin {}: not repeated",
+                                                inst.name, d.mesh, inst.skin));
+        continue;
+      }
+      const size_t joints = d.skins[static_cast<size_t>(inst.skin)].joints.size();
+      if (static_cast<size_t>(usedJoints) > joints)
+        throw InputError(SourceLoc{d.file, 0, 0},
+                         fmt::format("{} poses mesh {} with skin {} of {} joints, but its vertices use joint {}",
+                                     inst.name, d.mesh, inst.skin, joints, usedJoints - 1));
+    }
+    out.push_back(std::move(inst));
+  }
+  return out;
+}
+
 ValidationScene gltfScene(const GltfImport& model, const GltfSceneOptions& opts, GltfSceneInfo* info) {
   const GltfModelData& d = model.data;
   int anim = findGltfAnimation(d, opts.animation);
@@ -263,11 +324,14 @@ ValidationScene gltfScene(const GltfImport& model, const GltfSceneOptions& opts,
   }
   inf.times = opts.times;
   if (inf.times.empty()) inf.times = {inf.start, inf.start + 0.4 * (inf.end - inf.start)};
-  for (double t : inf.times) {
-    s.poses.push_back(gltfPose(model, s.mesh, s.shape, anim, t));
-    if (opts.morphWeight)
-      std::fill(s.poses.back().morphWeights.begin(), s.poses.back().morphWeights.end(), static_cast<float>(*opts.morphWeight));
-  }
+  inf.instances = gltfInstances(model, &inf.notes);
+  if (!opts.allInstances) inf.instances.resize(1);
+  for (const GltfInstance& instance : inf.instances)
+    for (double t : inf.times) {
+      s.poses.push_back(gltfPose(model, s.mesh, s.shape, anim, t, &instance));
+      if (opts.morphWeight)
+        std::fill(s.poses.back().morphWeights.begin(), s.poses.back().morphWeights.end(), static_cast<float>(*opts.morphWeight));
+    }
   if (info) *info = inf;
   return s;
 }

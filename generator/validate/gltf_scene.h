@@ -23,16 +23,35 @@ struct GltfSceneOptions {
   // such as RobotExpressive's, otherwise never exercise their targets.
   std::optional<double> morphWeight;
   GltfReadOptions read;  // how the model's data is read (the overload that imports it)
+  // Pose every instance of the primitive (gltfInstances), each at every time: poses are
+  // instance-major (pose i * times + k). false: the import's node alone.
+  bool allInstances = false;
 };
+
+// One node of the scene drawing the primitive's mesh, posed with its own transform, skin and
+// morph weights (docs/gltf.md, "Instances").
+struct GltfInstance {
+  int node = -1;  // -1: no node instantiates the mesh (posed at the origin)
+  int skin = -1;  // the skin posing it (-1: rigid, at the node)
+  std::string name;  // "node 12 'Armature.003'" (for reports)
+};
+// The primitive's distinct instances: the import's node first, then every other node of the
+// scene drawing the mesh (depth first, pre-order). A skinned primitive's node is placed by its
+// skin: a node with the same skin and the same morph weights (node defaults, no animated
+// `weights`) as an earlier one poses it identically and is left out, as is a node without a
+// skin (noted in `notes`). Throws InputError for a skin whose joints the vertices overrun.
+std::vector<GltfInstance> gltfInstances(const GltfImport& model, std::vector<std::string>* notes = nullptr);
 
 // What was posed, for reports.
 struct GltfSceneInfo {
   std::string animation;  // "" = no animation (node transforms and default weights)
   double start = 0, end = 0;
   std::vector<double> times;
+  std::vector<GltfInstance> instances;  // posed (one unless allInstances)
+  std::vector<std::string> notes;       // instances left out, and why
 };
 
-// One pose per time. Skinned: skin.bones[j] = global(joint_j) · inverseBind_j (world space;
+// One pose per time (and instance). Skinned: skin.bones[j] = global(joint_j) · inverseBind_j (world space;
 // the skinned mesh node's own transform is ignored, as the glTF spec requires). Unskinned:
 // model.matrix = global(mesh node). Throws InputError for an unknown animation.
 ValidationScene gltfScene(const GltfImport& model, const GltfSceneOptions& opts, GltfSceneInfo* info = nullptr);
@@ -46,10 +65,15 @@ int findGltfAnimation(const GltfModelData& data, const std::string& which);
 // Samples a channel at time t (clamped to its keyframes): `components` values.
 std::vector<double> sampleGltfChannel(const GltfChannel& ch, double t);
 // Global transforms of every node with animation `anim` (-1: none) applied at time t; also
-// the morph weights of the primitive's mesh node (node/mesh defaults, then the animation).
+// the morph weights of the mesh node `meshNode` (default: the import's; node/mesh defaults,
+// then the animation).
 std::vector<glm::dmat4> gltfNodeGlobals(const GltfModelData& data, int anim, double t,
                                         std::vector<double>* morphWeights = nullptr);
-// The uniforms for time t (camera framing the posed model).
-rt::Pose gltfPose(const GltfImport& model, const rt::Mesh& mesh, const rt::RigShape& shape, int anim, double t);
+std::vector<glm::dmat4> gltfNodeGlobals(const GltfModelData& data, int anim, double t,
+                                        std::vector<double>* morphWeights, int meshNode);
+// The uniforms for time t (camera framing the posed model), of `instance` (default: the
+// import's node and skin).
+rt::Pose gltfPose(const GltfImport& model, const rt::Mesh& mesh, const rt::RigShape& shape, int anim, double t,
+                  const GltfInstance* instance = nullptr);
 
 }  // namespace sg

@@ -42,6 +42,58 @@ std::string nonFiniteReport(Interpreter& reference, const EmittedOutput& o, size
   return s;
 }
 
+
+// Folds one pose's comparison of an output into the union over the poses: the worst error
+// (by relative error, as the vertex loop picks it) and where, every check's pass.
+void mergeOutputReport(OutputReport& all, const OutputReport& pose) {
+  if (pose.maxRelError > all.maxRelError || (pose.maxAbsError > all.maxAbsError && all.maxRelError == 0)) {
+    all.worstVertex = pose.worstVertex;
+    all.worstComponent = pose.worstComponent;
+    all.worstGpu = pose.worstGpu;
+    all.worstReference = pose.worstReference;
+  }
+  all.maxAbsError = std::max(all.maxAbsError, pose.maxAbsError);
+  all.maxRelError = std::max(all.maxRelError, pose.maxRelError);
+  all.storedPass = all.storedPass && pose.storedPass;
+  if (all.nonFinite.empty()) all.nonFinite = pose.nonFinite;
+  OutputReport::FloatCheck& f = all.floatCheck;
+  const OutputReport::FloatCheck& p = pose.floatCheck;
+  if (p.ratio < f.ratio) {
+    f.ratio = p.ratio;
+    f.tolerance = p.tolerance;
+    f.deviation = p.deviation;
+    f.worstVertex = p.worstVertex;
+    f.worstComponent = p.worstComponent;
+  }
+  f.maxDeviation = std::max(f.maxDeviation, p.maxDeviation);
+  f.pass = f.pass && p.pass;
+  f.notCompared += p.notCompared;
+}
+
+// Every output of a capture as floats, `components` per vertex (integers converted).
+std::vector<std::vector<float>> capturedOutputs(const GenerateResult& r, const std::vector<uint8_t>& captured,
+                                                size_t vertices) {
+  std::vector<std::vector<float>> out;
+  for (const EmittedOutput& o : r.glsl.outputs) {
+    const size_t comps = static_cast<size_t>(componentCount(o.type) * std::max(1, o.arraySize));
+    const ScalarKind kind = scalarKind(o.type);
+    std::vector<float> values(vertices * comps);
+    for (size_t v = 0; v < vertices; ++v)
+      for (size_t c = 0; c < comps; ++c) {
+        const uint8_t* at = captured.data() + v * r.glsl.captureStride + o.captureOffset + 4 * c;
+        uint32_t u;
+        std::memcpy(&u, at, 4);
+        float f;
+        std::memcpy(&f, at, 4);
+        values[v * comps + c] = kind == ScalarKind::Float ? f
+                                : kind == ScalarKind::Int ? static_cast<float>(static_cast<int32_t>(u))
+                                                          : static_cast<float>(u);
+      }
+    out.push_back(std::move(values));
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string withoutIntegerMatrices(const std::string& hlsl) {
@@ -233,7 +285,8 @@ RunReport Validator::runOne(const GenerateResult& r, const ValidationScene& scen
 }
 
 RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh, const ValidationScene& scene,
-                                  const std::vector<rt::Pose>& poses, const std::string& label, ReferenceCache* cache) {
+                                  const std::vector<rt::Pose>& poses, const std::string& label, ReferenceCache* cache,
+                                  bool keepOutputs) {
   RunReport rep;
   rep.label = label;
   rep.planCost = r.plan.cost;
@@ -250,6 +303,8 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
     OutputReport out;
     out.name = o.name;
     out.semantics = o.semantics;
+    out.type = std::string(glslName(o.type));
+    out.components = componentCount(o.type) * std::max(1, o.arraySize);
     rep.outputs.push_back(out);
   }
   // Messages since the last run, so those of the harness setup (instance, device) count too.
@@ -327,6 +382,18 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
       for (size_t k = 0; k < missing.size(); ++k) pr.values[missing[k]] = std::move(values[k]);
     }
     rep.referenceMs += msSince(t0);
+    // This pose's comparison, merged into rep.outputs (the worst over the poses) at its end.
+    std::vector<OutputReport> poseOut(rep.outputs.size());
+    for (size_t oi = 0; oi < rep.outputs.size(); ++oi) {
+      const OutputReport& all = rep.outputs[oi];
+      OutputReport& po = poseOut[oi];
+      po.name = all.name;
+      po.semantics = all.semantics;
+      po.type = all.type;
+      po.components = all.components;
+      po.unchecked = all.unchecked;
+      po.uncheckedReason = all.uncheckedReason;
+    }
     if (!bounds.empty()) {
       auto tf = Clock::now();
       std::vector<std::string> floatMissing;
@@ -364,12 +431,12 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
     for (size_t oi = 0; oi < r.glsl.outputs.size(); ++oi) {
       if (rep.outputs[oi].unchecked) continue;
       const EmittedOutput& o = r.glsl.outputs[oi];
-      Compared c{&o, &rep.outputs[oi], {}, static_cast<size_t>(componentCount(o.type) * std::max(1, o.arraySize))};
+      Compared c{&o, &poseOut[oi], {}, static_cast<size_t>(componentCount(o.type) * std::max(1, o.arraySize))};
       for (const auto& sem : o.semantics) {
         c.refs.emplace_back(pr.values.at(sem).data(), static_cast<size_t>(reference.components(sem)));
         if (!bounds.empty()) c.floatRefs.emplace_back(pr.floatValues.at(sem).data(), pr.floatTolerance.at(sem).data());
       }
-      rep.outputs[oi].floatCheck.ran = !bounds.empty();
+      rep.outputs[oi].floatCheck.ran = poseOut[oi].floatCheck.ran = !bounds.empty();
       widest = std::max(widest, c.comps);
       compared.push_back(std::move(c));
     }
@@ -452,6 +519,13 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
         }
       }
     }
+    for (size_t oi = 0; oi < rep.outputs.size(); ++oi) {
+      OutputReport& po = poseOut[oi];
+      po.pass = po.storedPass && po.floatCheck.pass && !(po.unchecked && opts_.strict);
+      mergeOutputReport(rep.outputs[oi], po);
+    }
+    rep.poseOutputs.push_back(std::move(poseOut));
+    if (keepOutputs) rep.captured.push_back(capturedOutputs(r, res.captured, mesh.vertexCount));
     if (cache) cache->trim(pi);
   }
   const auto& msgs = harness_->validationMessages();
@@ -468,6 +542,7 @@ ValidateReport Validator::run(const ValidationScene& scene) { return run(scene, 
 ValidateReport Validator::run(const ValidationScene& scene, const GenerateOptions& options) {
   ValidateReport report;
   report.device = harness_->deviceName();
+  report.driver = harness_->driver();
   report.limits = limits_;
   report.validationLayers = harness_->validationEnabled();
   GenerateOptions gen = options;
@@ -492,7 +567,7 @@ ValidateReport Validator::run(const ValidationScene& scene, const GenerateOption
   report.poses = scene.poses;
   drawDeclaredUniforms(report.poses, chosen.in.rig, chosen.in.rules);
   ReferenceCache cache;
-  report.runs.push_back(runQuantized(chosen, mesh, scene, report.poses, "chosen plan", &cache));
+  report.runs.push_back(runQuantized(chosen, mesh, scene, report.poses, "chosen plan", &cache, opts_.keepOutputs));
   report.runs.back().generateMs = genMs;
 
   if (opts_.crossCheck) {

@@ -30,6 +30,8 @@ struct Tolerance {
 struct OutputReport {
   std::string name;                    // "gl_Position", "WorldEyeDir", ...
   std::vector<std::string> semantics;  // what it carries
+  std::string type;                    // GLSL type of an element ("vec3")
+  int components = 0;                  // per vertex (all elements of an array)
   double maxAbsError = 0;
   double maxRelError = 0;  // |gpu - ref| / max(1, |ref|_max)
   size_t worstVertex = 0;
@@ -70,10 +72,17 @@ struct RunReport {
   size_t floatCheckStride = 1;  // the second check compared every this-th vertex
   double generateMs = 0;
   bool pass = true;
+  // Per pose (as the scene lists them), every output compared on that pose alone; `outputs`
+  // above is their union (worst over the poses).
+  std::vector<std::vector<OutputReport>> poseOutputs;
+  // What the device computed, when ValidateOptions::keepOutputs (the chosen plan only):
+  // [pose][output], `components` values per vertex (integers converted to float).
+  std::vector<std::vector<std::vector<float>>> captured;
 };
 
 struct ValidateReport {
   std::string device;
+  std::string driver;  // "<driver name> <driver info>"
   std::string via = "SPIR-V";  // what ran: "SPIR-V", or "HLSL 5.0 (compiled back by glslang)"
   std::string limits;  // the device limits the plans were searched under (applyDeviceLimits)
   bool validationLayers = false;
@@ -130,6 +139,8 @@ struct ValidateOptions {
   bool checkFloatData = true;
   // At most this many vertices (every k-th) in the second check; 0: all.
   size_t floatCheckVertices = 20000;
+  // Keep the chosen plan's captured outputs (RunReport::captured), for --save-outputs.
+  bool keepOutputs = false;
 };
 
 class Validator {
@@ -151,7 +162,8 @@ class Validator {
   struct ReferenceCache;  // reference values by pose, shared by the runs of one validation
   // runOne on a mesh already quantized to the rig's attribute formats.
   RunReport runQuantized(const GenerateResult& r, const rt::Mesh& mesh, const ValidationScene& scene,
-                         const std::vector<rt::Pose>& poses, const std::string& label, ReferenceCache* cache = nullptr);
+                         const std::vector<rt::Pose>& poses, const std::string& label, ReferenceCache* cache = nullptr,
+                         bool keepOutputs = false);
 
   ValidateOptions opts_;
   std::unique_ptr<rt::Harness> harness_;

@@ -5,8 +5,11 @@
 #include <nlohmann/json.hpp>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -14,6 +17,8 @@
 
 #include "gltf_test_util.h"
 #include "render/render.h"
+#include "runtime/reference.h"
+#include "validate/gltf_scene.h"
 #include "rig/gltf_import.h"
 #include "variants/manifest.h"
 
@@ -146,9 +151,29 @@ TEST(WholeModel, PlantedRuleFailureNamesTheMorphedPrimitives) {
       ${out} += 2.0 * ${morph.weights}[${i}] * ${morph.position[i]};
       @end
 )";
-  CliRun r = cli(fmt::format("validate --rig \"{}#*\" -f \"{}\" -r \"{}\" --animation Wave --time 0.5 --morph-weight 0.8",
-                          robot(), dataPath("lit.frag"), (d / "broken.yaml").string()));
+  CliRun r = cli(fmt::format("validate --rig \"{}#*\" -f \"{}\" -r \"{}\" --animation Wave --time 0.5 --morph-weight 0.8 "
+                             "--report \"{}\"",
+                             robot(), dataPath("lit.frag"), (d / "broken.yaml").string(), (d / "report.json").string()));
   EXPECT_EQ(r.status, 1) << r.out;
+  // The report of a failing model is written too, and says where it fails.
+  std::ifstream rin(d / "report.json");
+  nlohmann::json rep = nlohmann::json::parse(rin);
+  EXPECT_FALSE(rep["pass"].get<bool>());
+  EXPECT_EQ(rep["tolerance"]["abs"], 1e-6);
+  ASSERT_EQ(rep["primitives"].size(), 19u);
+  for (const auto& p : rep["primitives"]) {
+    const bool broken = p["name"] == "m2p2-Head";
+    EXPECT_EQ(p["pass"].get<bool>(), !broken) << p["name"];
+    const auto& run = p["runs"][0];
+    EXPECT_FALSE(run["rules"].empty());
+    EXPECT_EQ(run["poses"].size(), 1u);  // one instance, one time
+    if (!broken) continue;
+    EXPECT_FALSE(run["poses"][0]["pass"].get<bool>());
+    bool positionFails = false;
+    for (const auto& o : run["poses"][0]["outputs"])
+      if (o["name"] == "gl_Position") positionFails = !o["pass"].get<bool>() && o["max_rel_error"].get<double>() > 1e-5;
+    EXPECT_TRUE(positionFails) << run["poses"][0].dump();
+  }
   EXPECT_NE(r.out.find("18 of 19 primitive(s) pass"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("RobotExpressive.glb#*: error: 1 of 19 primitive(s) failed (m2p2-Head); the model does not validate"),
             std::string::npos)
@@ -400,6 +425,243 @@ TEST(WholeModel, RenderDrawsEveryNodeThatInstantiatesAMesh) {
   EXPECT_EQ(nW, n0 + n1);
   EXPECT_EQ(loW, lo0);
   EXPECT_EQ(hiW, hi1);
+  fs::remove_all(d);
+}
+
+// RecursiveSkeletons: one mesh drawn by 84 nodes, each with its own skin (skeletons nested in
+// skeletons). Every instance is posed with its own skin and checked at every time; the report
+// lists them; each is posed differently (84 distinct places in the saved outputs).
+std::string skeletons() { return modelPath("RecursiveSkeletons/RecursiveSkeletons.glb"); }
+
+TEST(WholeModel, EveryInstanceOfRecursiveSkeletonsIsValidatedAndListed) {
+  fs::path out = scratch("skeletons");
+  CliRun r = cli(fmt::format("validate --rig \"{}#*\" -f \"{}\" -r \"{}\" --time 0.7 --time 1.4 --no-validation-layers "
+                             "--report \"{}\" --save-outputs \"{}\"",
+                             skeletons(), dataPath("minimal.frag"), sourcePath("rules/standard.yaml"),
+                             (out / "report.json").string(), (out / "saved").string()));
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("instances: 84 checked, each at every time"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("PASS  m0p0-skinned_mesh  (" + skeletons() + "#0/0): 40 vertices, skinned (10 joints), 84 instance(s)"),
+            std::string::npos)
+      << r.out;
+  std::ifstream in(out / "report.json");
+  nlohmann::json rep = nlohmann::json::parse(in);
+  ASSERT_EQ(rep["primitives"].size(), 1u);
+  const auto& prim = rep["primitives"][0];
+  ASSERT_EQ(prim["instances"].size(), 84u);
+  std::set<int> nodes, skins;
+  for (const auto& i : prim["instances"]) {
+    nodes.insert(i["node"].get<int>());
+    skins.insert(i["skin"].get<int>());
+  }
+  EXPECT_EQ(nodes.size(), 84u);
+  EXPECT_EQ(skins.size(), 84u) << "each node has its own skin";
+  const auto& poses = prim["runs"][0]["poses"];
+  ASSERT_EQ(poses.size(), 168u);  // 84 instances x 2 times, instance-major
+  for (size_t k = 0; k < poses.size(); ++k) {
+    EXPECT_EQ(poses[k]["instance"], k / 2);
+    EXPECT_EQ(poses[k]["time"], k % 2 ? 1.4 : 0.7);
+    EXPECT_TRUE(poses[k]["pass"].get<bool>());
+  }
+  EXPECT_FALSE(rep["driver"].get<std::string>().empty());
+  // Every instance posed in its own place: 84 distinct centroids at t = 0.7.
+  std::ifstream sin(out / "saved" / "outputs.json");
+  nlohmann::json saved = nlohmann::json::parse(sin);
+  std::set<std::tuple<long, long, long>> centroids;
+  for (const auto& a : saved["primitives"][0]["arrays"]) {
+    if (a["output"] != "world_position" || a["time_index"] != 0) continue;
+    std::ifstream f(out / "saved" / a["file"].get<std::string>(), std::ios::binary);
+    std::vector<float> v(40 * 3);
+    f.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(v.size() * 4));
+    double c[3] = {0, 0, 0};
+    for (size_t i = 0; i < 40; ++i)
+      for (int k = 0; k < 3; ++k) c[k] += v[i * 3 + static_cast<size_t>(k)] / 40;
+    centroids.insert({std::lround(c[0] * 1e4), std::lround(c[1] * 1e4), std::lround(c[2] * 1e4)});
+  }
+  EXPECT_EQ(centroids.size(), 84u);
+  fs::remove_all(out);
+}
+
+// --report and --save-outputs write the same bytes on every run, under names that depend only
+// on the model, the primitive, the instance, the time index and the output.
+TEST(WholeModel, ReportAndSavedOutputsAreByteIdenticalAcrossRuns) {
+  auto run = [&](const fs::path& out) {
+    return cli(fmt::format("validate --rig \"{}#*\" -f \"{}\" -r \"{}\" --time 0.25 --no-validation-layers "
+                           "--report \"{}\" --save-outputs \"{}\"",
+                           modelPath("AnimatedMorphSphere/AnimatedMorphSphere.gltf"), dataPath("lit.frag"),
+                           sourcePath("rules/standard.yaml"), (out / "report.json").string(), (out / "saved").string()));
+  };
+  fs::path a = scratch("determinism_a"), b = scratch("determinism_b");
+  CliRun ra = run(a), rb = run(b);
+  ASSERT_EQ(ra.status, 0) << ra.out;
+  ASSERT_EQ(rb.status, 0) << rb.out;
+  auto slurp = [](const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+  };
+  std::vector<std::string> names;
+  for (const auto& e : fs::recursive_directory_iterator(a))
+    if (e.is_regular_file()) names.push_back(fs::relative(e.path(), a).string());
+  std::sort(names.begin(), names.end());
+  // report.json, outputs.json, one .glb and the 4 outputs of lit.frag's plan (gl_Position, world
+  // position, eye direction, normal) of the one instance at the one time.
+  EXPECT_EQ(names, (std::vector<std::string>{"report.json", "saved/m0p0-Sphere.i0.t0.gl_Position.bin",
+                                             "saved/m0p0-Sphere.i0.t0.world_eye_dir.bin",
+                                             "saved/m0p0-Sphere.i0.t0.world_normal.bin",
+                                             "saved/m0p0-Sphere.i0.t0.world_position.bin", "saved/m0p0-Sphere.t0.glb",
+                                             "saved/outputs.json"}));
+  for (const auto& n : names) EXPECT_EQ(slurp(a / n), slurp(b / n)) << n << " differs between two runs";
+  // The report names the file's device and the tolerance; the saved .glb is a GLB 2.0.
+  std::string glb = slurp(a / "saved/m0p0-Sphere.t0.glb");
+  ASSERT_GE(glb.size(), 20u);
+  EXPECT_EQ(glb.substr(0, 4), "glTF");
+  uint32_t total = 0;
+  std::memcpy(&total, glb.data() + 8, 4);
+  EXPECT_EQ(total, glb.size());
+  // Writing over an input is refused before anything is written.
+  CliRun clobber = cli(fmt::format("validate --rig \"{}#*\" -f \"{}\" -r \"{}\" --time 0.25 --report \"{}\"",
+                                   modelPath("AnimatedMorphSphere/AnimatedMorphSphere.gltf"), dataPath("lit.frag"),
+                                   sourcePath("rules/standard.yaml"), dataPath("lit.frag")));
+  EXPECT_NE(clobber.status, 0);
+  EXPECT_NE(clobber.out.find("refusing to overwrite an input"), std::string::npos) << clobber.out;
+  fs::remove_all(a);
+  fs::remove_all(b);
+}
+
+// The 84 figures drawn: the whole picture covers exactly the union of the 84 instances' own
+// draws under the same camera, and every instance is in it (256 pixels: at 128 the thinnest
+// figures fall between pixel centres).
+TEST(WholeModel, RenderDrawsAll84RecursiveSkeletons) {
+  fs::path png = scratch("skeletons.png");
+  const std::string frag = dataPath("solid.frag");
+  CliRun r = cli(fmt::format("render --rig \"{}#*\" -f \"{}\" -r \"{}\" --time 0.7 --size 256x256 -o \"{}\"",
+                             skeletons(), frag, sourcePath("rules/standard.yaml"), png.string()));
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(r.out.find("not drawn"), std::string::npos) << r.out;
+  rt::Image whole = readPng(png.string());
+  RenderOptions ro;
+  ro.gen.rigPath = skeletons() + "#*";
+  ro.gen.fragmentPath = frag;
+  ro.gen.rulesPaths = {sourcePath("rules/standard.yaml")};
+  ro.time = 0.7;
+  ro.width = ro.height = 256;
+  std::vector<ModelPart> parts{modelPart(ro, gltfParts(skeletons()).front())};
+  ASSERT_EQ(parts[0].instances.size(), 83u);
+  frameModel(parts, ro.camera, 1.0f);
+  RenderSession session("", false);
+  FragmentProgram fp = compileFragmentFile(frag, ro.gen.targetEnv);
+  std::vector<rt::Image> draws;
+  session.renderModel(parts, fp, texturesFor(fp, ro.lighting), ro, &draws);
+  ASSERT_EQ(draws.size(), 84u);
+  size_t unionCovered = 0, mismatched = 0, largest = 0;
+  std::vector<size_t> empty;
+  for (size_t i = 0; i < draws.size(); ++i) {
+    size_t c = 0;
+    for (float d : draws[i].depth) c += d < 1.0f;
+    if (c == 0) empty.push_back(i);
+    largest = std::max(largest, c);
+  }
+  EXPECT_TRUE(empty.empty()) << "instances not in the picture: " << fmt::format("{}", fmt::join(empty, ", "));
+  for (size_t px = 0; px < whole.rgba.size() / 4; ++px) {
+    bool inUnion = false;
+    for (const auto& im : draws) inUnion = inUnion || im.depth[px] < 1.0f;
+    const uint8_t* w = &whole.rgba[px * 4];
+    bool covered = w[0] == 255 && w[1] == 128 && w[2] == 64;  // solid.frag's colour, not the background
+    unionCovered += inUnion;
+    mismatched += covered != inUnion;
+  }
+  EXPECT_EQ(mismatched, 0u);
+  EXPECT_GT(unionCovered, 2 * largest) << "84 figures cover far more than the largest one";
+  fs::remove(png);
+}
+
+// gltfInstances on a skinned triangle drawn by two nodes (the bad-input corpus's model:
+// skin 0 = joints [2, 3], vertex 2 bound to joint 1 = node 3, translated +1 on x): each
+// instance posed by its own skin; a second skin larger than the palette poses with its first
+// joints; a node repeating an earlier node's skin, or drawing the skinned mesh without one,
+// is left out with a note.
+TEST(WholeModel, InstancesArePosedByTheirOwnSkin) {
+  std::ifstream in(sourcePath("tests/bad-input/gltf/instance-skin-too-small/m.gltf"));
+  nlohmann::json base = nlohmann::json::parse(in);
+  fs::path d = scratch("skins");
+  fs::create_directories(d);
+  auto instancesOf = [&](const nlohmann::json& node1, const nlohmann::json& skin1, std::vector<std::string>* notes,
+                         std::vector<glm::vec4>* secondWorld) {
+    nlohmann::json m = base;
+    m["nodes"][1] = node1;
+    m["skins"][1]["joints"] = skin1;
+    std::ofstream((d / "m.gltf").string()) << m.dump();
+    GltfImport imp = importGltf((d / "m.gltf").string());
+    GltfSceneOptions so;
+    so.times = {0};
+    so.allInstances = true;
+    GltfSceneInfo info;
+    ValidationScene scene = gltfScene(imp, so, &info);
+    if (notes) *notes = info.notes;
+    if (secondWorld && scene.poses.size() > 1)
+      *secondWorld = rt::referenceValues("world.position", scene.mesh, scene.poses[1], scene.shape);
+    if (scene.poses.size() == 2) {
+      std::vector<glm::vec4> first = rt::referenceValues("world.position", scene.mesh, scene.poses[0], scene.shape);
+      EXPECT_FLOAT_EQ(first[2].x, 1.0f) << "instance 0: vertex 2 follows node 3 (+1 on x)";
+    }
+    return info.instances;
+  };
+  std::vector<std::string> notes;
+  std::vector<glm::vec4> world;
+  // Skin 1 = joints [4, 2, 3]: three joints for a two-joint palette; vertex 2's joint 1 is node 2 (at the origin).
+  std::vector<GltfInstance> two = instancesOf({{"mesh", 0}, {"skin", 1}}, {4, 2, 3}, &notes, &world);
+  ASSERT_EQ(two.size(), 2u);
+  EXPECT_EQ(two[0].node, 0);
+  EXPECT_EQ(two[0].skin, 0);
+  EXPECT_EQ(two[1].node, 1);
+  EXPECT_EQ(two[1].skin, 1);
+  ASSERT_EQ(world.size(), 3u);
+  EXPECT_FLOAT_EQ(world[2].x, 0.0f) << "instance 1: vertex 2 follows node 2 (its skin's joint 1)";
+  EXPECT_TRUE(notes.empty());
+  // The same skin as node 0: posed identically, left out.
+  EXPECT_EQ(instancesOf({{"mesh", 0}, {"skin", 0}}, {4}, &notes, nullptr).size(), 1u);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("node 1 poses mesh 0 exactly as an earlier node with skin 0"), std::string::npos) << notes[0];
+  // No skin on a node drawing a skinned mesh: left out.
+  EXPECT_EQ(instancesOf({{"mesh", 0}}, {4}, &notes, nullptr).size(), 1u);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("draws the skinned mesh 0 without a skin"), std::string::npos) << notes[0];
+  // A skin too small for the joints the vertices use: the primitive fails, naming the node.
+  try {
+    instancesOf({{"mesh", 0}, {"skin", 1}}, {4}, nullptr, nullptr);
+    ADD_FAILURE() << "a one-joint skin cannot pose vertices bound to joint 1";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("node 1 poses mesh 0 with skin 1 of 1 joints, but its vertices use joint 1"),
+              std::string::npos)
+        << e.what();
+  }
+  fs::remove_all(d);
+}
+
+// A morphed mesh under two nodes with their own default weights: two instances, each posed
+// with its node's weights (and with the animation's, when it targets that node).
+TEST(WholeModel, InstancesCarryTheirNodesMorphWeights) {
+  fs::path d = scratch("morph_instances");
+  fs::create_directories(d);
+  std::ofstream(d / "m.gltf")
+      << R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}],)"
+         R"("bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
+         R"("meshes":[{"name":"tri","primitives":[{"attributes":{"POSITION":0},"targets":[{"POSITION":0}]}],"weights":[0.5]}],)"
+         R"("nodes":[{"mesh":0,"weights":[0.25]},{"mesh":0,"translation":[2,0,0]},{"mesh":0,"weights":[1.0]}],"scenes":[{"nodes":[0,1,2]}]})";
+  GltfImport imp = importGltf((d / "m.gltf").string());
+  GltfSceneOptions so;
+  so.times = {0};
+  so.allInstances = true;
+  GltfSceneInfo info;
+  ValidationScene scene = gltfScene(imp, so, &info);
+  ASSERT_EQ(info.instances.size(), 3u);
+  ASSERT_EQ(scene.poses.size(), 3u);
+  EXPECT_FLOAT_EQ(scene.poses[0].morphWeights.at(0), 0.25f);  // node 0's own weights
+  EXPECT_FLOAT_EQ(scene.poses[1].morphWeights.at(0), 0.5f);   // node 1: the mesh's
+  EXPECT_FLOAT_EQ(scene.poses[2].morphWeights.at(0), 1.0f);
+  EXPECT_FLOAT_EQ(scene.poses[1].model[3][0], 2.0f);  // node 1's translation
   fs::remove_all(d);
 }
 

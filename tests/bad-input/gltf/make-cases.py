@@ -362,6 +362,39 @@ case("whole-unknown-animation", {},
 case("whole-selection-malformed", {"m.gltf": text(model([POS]))}, "rig import @D/m.gltf#** -o @O/rigs", 1,
      "'#**' does not select a primitive", "or MODEL.gltf#* (every primitive)")
 
+# --- instances (one mesh under several nodes, each with its own skin) ------------------------
+SKIN_BLOB = TRI + bytes([0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0]) + struct.pack("<12f", 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0)
+SKIN_VIEWS = [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 12},
+              {"buffer": 0, "byteOffset": 48, "byteLength": 48}]
+SKIN_ACCESSORS = [POS, {"bufferView": 1, "componentType": 5121, "count": 3, "type": "VEC4"},
+                  {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC4"}]
+
+
+def skinned_instances(second_skin_joints):
+    """Node 0 draws the skinned triangle with skin 0 (2 joints: vertex 2 uses joint 1); node 1
+    draws it with skin 1."""
+    return model(SKIN_ACCESSORS, views=SKIN_VIEWS, blob=SKIN_BLOB, extra={
+        "meshes": [{"name": "tri", "primitives": [{"attributes": {"POSITION": 0, "JOINTS_0": 1, "WEIGHTS_0": 2}}]}],
+        "nodes": [{"mesh": 0, "skin": 0}, {"mesh": 0, "skin": 1}, {"name": "a"}, {"name": "b", "translation": [1, 0, 0]},
+                  {"name": "c"}],
+        "skins": [{"joints": [2, 3]}, {"joints": second_skin_joints}],
+        "scenes": [{"nodes": [0, 1, 2, 3, 4]}]})
+
+
+VALIDATE_TRI = "validate --rig @D/m.gltf -f tests/gltf/data/minimal.frag -r rules/standard.yaml --time 0"
+case("instance-skin-too-small-validate", {"m.gltf": text(skinned_instances([4]))}, VALIDATE_TRI, 1,
+     "@D/m.gltf: error: node 1 poses mesh 0 with skin 1 of 1 joints, but its vertices use joint 1")
+case("instance-render-skin-too-small", {"m.gltf": text(skinned_instances([4]))},
+     "render --rig @D/m.gltf#* -f tests/gltf/data/minimal.frag -r rules/standard.yaml --size 8x8 -o @O/m.png", 1,
+     "node 1 poses mesh 0 with skin 1 of 1 joints, but its vertices use joint 1")
+case("report-over-the-model", {"m.gltf": text(model([POS]))}, VALIDATE_TRI + " --report @D/m.gltf", 1,
+     "output '@D/m.gltf' is the rig", "refusing to overwrite an input")
+case("save-outputs-into-a-file", {"m.gltf": text(model([POS]))}, VALIDATE_TRI + " --save-outputs @D/m.gltf", 1,
+     "cannot write '@D/m.gltf/")
+case("report-on-a-yaml-rig", {},
+     "validate --rig examples/dawn/face.rig.yaml -f examples/dawn/face.frag -r examples/dawn/rules.yaml --report @O/r.json",
+     2, "--report", "to a YAML rig")
+
 
 def main():
     for name in sorted(os.listdir(HERE)):
