@@ -241,8 +241,9 @@ class Emitter {
       for (const auto& line : p_.actions[a].code) {
         const std::string& t = line.text;
         for (size_t i = 0; i < t.size();) {
-          if (t[i] == kFactRefBegin) {
-            i = t.find(kFactRefEnd, i) + 1;
+          if (t[i] == kFactRefBegin) {  // a fact reference, named here
+            const size_t e = t.find(kFactRefEnd, i);
+            i = e == std::string::npos ? t.size() : e + 1;
           } else if (std::isalpha(static_cast<unsigned char>(t[i])) || t[i] == '_') {
             size_t e = i;
             while (e < t.size() && (std::isalnum(static_cast<unsigned char>(t[e])) || t[e] == '_')) ++e;
