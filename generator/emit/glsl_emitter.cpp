@@ -3,14 +3,17 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <set>
 #include <stdexcept>
 
+#include "interface/fragment_interface.h"
+
 namespace sg {
 
-std::string tempName(const std::string& fact) {
-  std::string s = "t_";
+std::string semanticIdentifier(const std::string& fact) {
+  std::string s;
   for (char c : fact) {
     if (c == '.' || c == '[') s += '_';
     else if (c != ']') s += c;
@@ -30,6 +33,72 @@ std::string commentSafe(const std::string& text) {
 }
 
 namespace {
+
+// A local's name from what it holds ("world.normal" -> world_normal): no "__" (reserved
+// in GLSL) and no trailing '_' (the snippets' own temporaries end with one).
+std::string localBase(const std::string& semantic) {
+  std::string s;
+  for (char c : semanticIdentifier(semantic))
+    if (c != '_' || (!s.empty() && s.back() != '_')) s += c;
+  while (!s.empty() && s.back() == '_') s.pop_back();
+  // A name without '_' could be a GLSL keyword or built-in function (no keyword has one
+  // but atomic_uint), and gl_ is reserved.
+  if (s.find('_') == std::string::npos || s.rfind("gl_", 0) == 0 || s == "atomic_uint") s = "value_" + s;
+  return s;
+}
+
+// The local holding an attribute read in parts, named for the semantics it provides:
+// {vertex.normal: xyz, vertex.occlusion: w} -> vertex_normal_occlusion; per target t, _t.
+std::string attributeLocalBase(const RigAttribute& a, int target) {
+  std::string s, family;
+  for (const auto& p : a.provides) {
+    const size_t dot = p.semantic.rfind('.');
+    const std::string prefix = dot == std::string::npos ? "" : p.semantic.substr(0, dot);
+    if (s.empty()) {
+      s = p.semantic;
+      family = prefix;
+    } else {
+      s += "_" + (prefix == family && dot != std::string::npos ? p.semantic.substr(dot + 1) : p.semantic);
+    }
+  }
+  if (target >= 0) s += fmt::format("_{}", target);
+  return localBase(s);
+}
+
+// One rule's snippet lines re-indented as a person would write them: two spaces inside
+// main, two more per open brace, and a line that continues a statement keeps its offset
+// (at least two spaces) from the statement's first line as the rules file wrote it. The
+// lines of a shared snippet (`@use`) keep their own YAML indentation, which says nothing
+// about where the using rule puts them; braces and statement ends do.
+std::vector<std::string> reindent(const std::vector<std::string>& lines) {
+  std::vector<std::string> out;
+  int depth = 0, stmtIndent = 2, stmtOwn = 0;
+  bool continues = false;
+  for (const auto& line : lines) {
+    const size_t b = line.find_first_not_of(" \t");
+    if (b == std::string::npos) {
+      out.emplace_back();
+      continue;
+    }
+    std::string text = line.substr(b);
+    text.erase(text.find_last_not_of(" \t") + 1);
+    std::string code = text.substr(0, text.find("//"));  // without a trailing comment
+    while (!code.empty() && (code.back() == ' ' || code.back() == '\t')) code.pop_back();
+    const int own = static_cast<int>(b);
+    int indent = 0;
+    if (continues) {
+      indent = stmtIndent + std::max(2, own - stmtOwn);
+    } else {
+      indent = 2 + 2 * std::max(0, depth - (text[0] == '}' ? 1 : 0));
+      stmtIndent = indent;
+      stmtOwn = own;
+    }
+    for (char c : code) depth = std::max(0, depth + (c == '{') - (c == '}'));
+    if (!code.empty() && code[0] != '#') continues = code.back() != ';' && code.back() != '{' && code.back() != '}';
+    out.push_back(std::string(static_cast<size_t>(indent), ' ') + text);
+  }
+  return out;
+}
 
 std::string baseName(const std::string& path) { return commentSafe(std::filesystem::path(path).filename().string()); }
 
@@ -57,6 +126,7 @@ class Emitter {
     declareUniforms();
     declareBuffers();
     std::string outputs = declareOutputs();
+    nameLocals();
     std::string inputs;
     for (const auto& in : out_.inputs)
       inputs += t_.fill("input", {{"location", std::to_string(in.location)},
@@ -155,6 +225,60 @@ class Emitter {
     }
   }
 
+  // Every local gets a name of its own (docs/design.md "Generated names"): the semantic it
+  // holds, made unique against the interface (inputs, uniforms, buffers, outputs), the
+  // template's names, every identifier the plan's snippets write and earlier locals, by a
+  // suffix _2, _3, ... So no local hides an input or another local.
+  void nameLocals() {
+    std::set<std::string> taken{"main", std::string(kUniformBlockName)};
+    for (const auto& in : out_.inputs) taken.insert(in.name);
+    for (const auto& u : out_.uniforms) taken.insert(u.name);
+    for (const auto& b : out_.buffers) {
+      taken.insert({b.name, b.name + "_data", fmt::format("ShadergenBuffer{}", b.binding)});
+    }
+    for (const auto& o : out_.outputs) taken.insert(o.name);
+    for (int a : plan_.actions)
+      for (const auto& line : p_.actions[a].code) {
+        const std::string& t = line.text;
+        for (size_t i = 0; i < t.size();) {
+          if (t[i] == kFactRefBegin) {  // a fact reference, named here
+            const size_t e = t.find(kFactRefEnd, i);
+            i = e == std::string::npos ? t.size() : e + 1;
+          } else if (std::isalpha(static_cast<unsigned char>(t[i])) || t[i] == '_') {
+            size_t e = i;
+            while (e < t.size() && (std::isalnum(static_cast<unsigned char>(t[e])) || t[e] == '_')) ++e;
+            taken.insert(t.substr(i, e - i));
+            i = e;
+          } else {
+            ++i;
+          }
+        }
+      }
+    auto unique = [&](const std::string& base) {
+      std::string name = base;
+      for (int n = 2; taken.count(name); ++n) name = fmt::format("{}_{}", base, n);
+      taken.insert(name);
+      return name;
+    };
+    inputLocal_.assign(out_.inputs.size(), "");
+    for (size_t i = 0; i < out_.inputs.size(); ++i)
+      if (readInParts(out_.inputs[i]))
+        inputLocal_[i] = unique(attributeLocalBase(rig_.attributes[out_.inputs[i].attribute], out_.inputs[i].target));
+    local_.assign(p_.facts.size(), "");
+    for (int a : plan_.actions) local_[p_.actions[a].add] = unique(localBase(p_.facts[p_.actions[a].add].name));
+  }
+
+  // An attribute read in parts (a_normal.xyz and a_normal.w) is loaded once into a local:
+  // each part of an input variable would be a load of its own, and spirv-opt does not
+  // rebuild vec4(a.xyz, a.w) into a.
+  bool readInParts(const EmittedInput& in) const {
+    for (size_t f = 0; f < p_.facts.size(); ++f)
+      if (used_[f] && p_.facts[f].source == Fact::Source::Attribute && p_.facts[f].rigIndex == in.attribute &&
+          p_.facts[f].target == in.target && !p_.facts[f].swizzle.empty())
+        return true;
+    return false;
+  }
+
   void declareUniforms() {
     std::set<int> needed;
     for (size_t f = 0; f < p_.facts.size(); ++f)
@@ -168,7 +292,7 @@ class Emitter {
       if (!used_[f] || p_.facts[f].source != Fact::Source::Buffer) continue;
       const BufferSource& b = p_.buffers[p_.facts[f].rigIndex];
       EmittedBuffer e;
-      e.name = "b_" + tempName(p_.facts[f].name).substr(2);
+      e.name = "b_" + semanticIdentifier(p_.facts[f].name);
       e.semantic = p_.facts[f].name;
       e.binding = binding++;
       e.buffer = p_.facts[f].rigIndex;
@@ -256,15 +380,18 @@ class Emitter {
     const Fact& fact = p_.facts[f];
     switch (fact.source) {
       case Fact::Source::Computed:
-        return tempName(fact.name);
+        return local_[f];
       case Fact::Source::Uniform:
         return "u_" + rig_.uniforms[fact.rigIndex].name;
       case Fact::Source::Buffer:
-        return "b_" + tempName(fact.name).substr(2);
+        return "b_" + semanticIdentifier(fact.name);
       case Fact::Source::Attribute: {
-        for (const auto& in : out_.inputs)
-          if (in.attribute == fact.rigIndex && in.target == fact.target)
-            return fact.swizzle.empty() ? in.name : in.name + "." + fact.swizzle;
+        for (size_t i = 0; i < out_.inputs.size(); ++i) {
+          const EmittedInput& in = out_.inputs[i];
+          if (in.attribute != fact.rigIndex || in.target != fact.target) continue;
+          const std::string& name = inputLocal_[i].empty() ? in.name : inputLocal_[i];
+          return fact.swizzle.empty() ? name : name + "." + fact.swizzle;
+        }
         return "?";
       }
     }
@@ -316,17 +443,12 @@ class Emitter {
         start = nl + 1;
       }
     };
-    // An attribute read in parts (a_normal.xyz and a_normal.w) is loaded once into a local
-    // of the same name, which hides the input: each part of an input variable would be a
-    // load of its own, and spirv-opt does not rebuild vec4(a.xyz, a.w) into a.
-    for (const auto& in : out_.inputs) {
-      bool parts = false;
-      for (size_t f = 0; f < p_.facts.size(); ++f)
-        parts = parts || (used_[f] && p_.facts[f].source == Fact::Source::Attribute &&
-                          p_.facts[f].rigIndex == in.attribute && p_.facts[f].target == in.target &&
-                          !p_.facts[f].swizzle.empty());
-      if (parts) push(fmt::format("  {} {} = {};", glslName(in.type), in.name, in.name));
-    }
+    // The attributes read in parts (readInParts), each loaded once.
+    if (std::any_of(inputLocal_.begin(), inputLocal_.end(), [](const std::string& n) { return !n.empty(); }))
+      push("  // Attributes read in parts, each loaded once.");
+    for (size_t i = 0; i < out_.inputs.size(); ++i)
+      if (!inputLocal_[i].empty())
+        push(fmt::format("  {} {} = {};", glslName(out_.inputs[i].type), inputLocal_[i], out_.inputs[i].name));
     for (int a : plan_.actions) {
       const Action& act = p_.actions[a];
       const Fact& f = p_.facts[act.add];
@@ -334,13 +456,17 @@ class Emitter {
                             {"semantic", f.name},
                             {"cost", std::to_string(act.cost)},
                             {"type", std::string(glslName(f.type))},
-                            {"name", tempName(f.name)}}));
+                            {"name", local_[act.add]}}));
+      std::vector<std::string> code;
+      for (const auto& cl : act.code) code.push_back(resolve(cl.text));
+      code = reindent(code);
       int expectLine = -1, expectSrc = -1;
-      for (const auto& cl : act.code) {
+      for (size_t k = 0; k < act.code.size(); ++k) {
+        const CodeLine& cl = act.code[k];
         int src = sourceIndex(cl.loc.file);
         if (cl.loc.line != expectLine || src != expectSrc)
           push(t_.fill("line", {{"line", std::to_string(cl.loc.line)}, {"source", std::to_string(src)}}));
-        push("  " + resolve(cl.text));
+        push(code[k]);
         expectLine = cl.loc.line + 1;
         expectSrc = src;
       }
@@ -362,6 +488,8 @@ class Emitter {
   const TemplateSet& t_;
   EmitOptions opts_;
   std::vector<bool> used_;
+  std::vector<std::string> local_;       // per fact: the local a computed fact is held in
+  std::vector<std::string> inputLocal_;  // per input: the local it is loaded into ("" = read directly)
   EmittedGlsl out_;
 };
 

@@ -70,8 +70,9 @@ struct EmittedGlsl {
 EmittedGlsl emitGlsl(const Rig& rig, const Problem& p, const Plan& plan, const std::vector<Varying>& varyings,
                      const TemplateSet& templates, const std::string& fragmentName, const EmitOptions& opts);
 
-// GLSL identifier for a computed fact: "world.normal" → "t_world_normal", "a[2]" → "t_a_2".
-std::string tempName(const std::string& fact);
+// A semantic as an identifier: "world.normal" → "world_normal", "a[2]" → "a_2" (storage
+// buffers are b_<this>; locals are this, made unique, docs/design.md "Generated names").
+std::string semanticIdentifier(const std::string& fact);
 // Text safe inside a `//` comment: control bytes and '\\' become '?' (names from the rig,
 // the glTF mesh or a file name must not end the comment or splice the next line).
 std::string commentSafe(const std::string& text);

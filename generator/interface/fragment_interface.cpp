@@ -123,7 +123,6 @@ void addColumn(Diagnostic& d, const std::string& source) {
 }  // namespace
 
 const char* reservedNameUse(const std::string& name) {
-  if (name.rfind("t_", 0) == 0) return "starts with 't_', the prefix of the generator's temporaries";
   if (name.rfind("a_", 0) == 0) return "starts with 'a_', the prefix of the generated vertex attributes";
   if (name.rfind("u_", 0) == 0) return "starts with 'u_', the prefix of the generated uniforms";
   if (name == kUniformBlockName) return "is the name of the generated uniform block";

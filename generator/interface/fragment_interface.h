@@ -52,10 +52,10 @@ struct Varying {
   std::string via;  // how it was mapped: "--map", "rules 'varyings:'", "its name", "convention 'threejs'"
 };
 
-// The generated vertex shader names its own declarations t_<fact> (temporaries), a_<name>
-// (attributes), u_<name> (uniforms) and kUniformBlockName; its outputs take the fragment
-// inputs' names, so an input with such a name would collide. Returns why `name` is
-// reserved, or nullptr.
+// The generated vertex shader names its inputs a_<name> (attributes), its uniforms
+// u_<name> and its block kUniformBlockName; its outputs take the fragment inputs' names,
+// so an input with such a name would collide. (Its locals are named around the outputs:
+// emit/glsl_emitter.h.) Returns why `name` is reserved, or nullptr.
 inline constexpr const char* kUniformBlockName = "ShadergenUniforms";
 const char* reservedNameUse(const std::string& name);
 

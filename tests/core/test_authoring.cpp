@@ -249,8 +249,8 @@ TEST(Authoring, MatrixAndArrayVaryingsAreEmittedAndLinked) {
   EXPECT_TRUE(has(r.glsl.text, "layout(location = 0, xfb_buffer = 0, xfb_offset = 16, xfb_stride = 104) out mat3 v_TBN;"))
       << r.glsl.text;
   EXPECT_TRUE(has(r.glsl.text, "out vec3 rows[3];")) << r.glsl.text;
-  EXPECT_TRUE(has(r.glsl.text, "v_TBN = mat3(t_world_tangent, t_world_binormal, t_world_normal);")) << r.glsl.text;
-  EXPECT_TRUE(has(r.glsl.text, "rows[2] = t_frame_row_z;")) << r.glsl.text;
+  EXPECT_TRUE(has(r.glsl.text, "v_TBN = mat3(world_tangent, world_binormal, world_normal);")) << r.glsl.text;
+  EXPECT_TRUE(has(r.glsl.text, "rows[2] = frame_row_z;")) << r.glsl.text;
   ASSERT_EQ(r.glsl.outputs.size(), 4u);
   EXPECT_EQ(r.glsl.outputs[2].captureOffset, 16u + 36u);  // after gl_Position and 9 floats
   EXPECT_EQ(r.glsl.outputs[3].captureOffset, 16u + 36u + 36u);

@@ -2,6 +2,7 @@
 // SPIR-V that validates, an interface that links with the fragment shader), determinism,
 // dead-code-free plans, GLSL errors mapped back to rules-file lines, unsatisfiable
 // requests, and the transform-feedback capture build.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -23,6 +24,7 @@
 #include "emit/spirv.h"
 #include "interface/fragment_interface.h"
 #include "pipeline/generate.h"
+#include "pipeline/stages.h"
 
 namespace {
 
@@ -432,6 +434,190 @@ TEST(GenerateHostile, BanMustNameARule) {
   o.bannedRules = {"no_such_rule"};
   auto d = errorOf([&] { sg::generate(o); });
   EXPECT_NE(d.message.find("--ban no_such_rule: no rule of that name"), std::string::npos) << sg::formatDiagnostic(d);
+}
+
+// ---- The generated GLSL reads like a person wrote it (issue 34) --------------------------
+
+const char* const kGlslType = R"((?:float|double|int|uint|bool|[iubd]?vec[234]|mat[234](?:x[234])?))";
+
+struct StyleFinding {
+  int line = 0;
+  std::string what;
+};
+
+// What a reviewer checks, read from the text alone: (1) no declaration in main() reuses the
+// name of a global (input, output, uniform, buffer, function) or of a local in an enclosing
+// scope; (2) each line of a rule's block is indented two spaces inside main() and two more
+// per open brace, and a line continuing a statement more than the statement's first line;
+// (3) each rule's block declares the local named for its semantic ("// r -> world.normal"
+// declares world_normal, or world_normal_N where that name was taken).
+std::vector<StyleFinding> styleFindings(const std::string& glsl) {
+  static const std::regex global(std::string(R"(\b)") + kGlslType + R"(\s+(\w+)\s*(?:\[\d*\])?\s*[;(])");
+  static const std::regex local(std::string(R"(^\s*)") + kGlslType + R"(\s+(\w+)\s*[=;])");
+  static const std::regex rule(R"(^  // \S+ -> (\S+) \(cost \d+\)$)");
+  std::vector<StyleFinding> out;
+  std::istringstream in(glsl);
+  std::string line;
+  std::set<std::string> globals;
+  std::vector<std::set<std::string>> scopes;  // inside main: one set per open brace
+  bool inMain = false, continues = false;
+  int n = 0, stmtIndent = 0, depth = 0;
+  std::string expectLocal;  // after a rule comment: the semantic's local it declares
+  while (std::getline(in, line)) {
+    ++n;
+    if (!inMain) {
+      if (line == "void main() {") {
+        inMain = true;
+        scopes.emplace_back();
+        continue;
+      }
+      if (line.rfind("//", 0) == 0 || line.rfind("#", 0) == 0) continue;
+      for (auto it = std::sregex_iterator(line.begin(), line.end(), global); it != std::sregex_iterator(); ++it)
+        globals.insert((*it)[1]);
+      continue;
+    }
+    if (line.rfind("#line ", 0) == 0 || line.empty()) continue;
+    if (line == "}" && scopes.size() == 1) break;  // the end of main
+    const size_t b = line.find_first_not_of(' ');
+    const int indent = static_cast<int>(b);
+    std::string code = line.substr(b, line.find("//") == std::string::npos ? std::string::npos : line.find("//") - b);
+    while (!code.empty() && code.back() == ' ') code.pop_back();
+    // (2) indentation
+    if (continues) {
+      if (indent <= stmtIndent) out.push_back({n, "a continuation line not indented past its statement"});
+    } else {
+      const int want = 2 + 2 * std::max(0, depth - (!code.empty() && code[0] == '}' ? 1 : 0));
+      if (indent != want) out.push_back({n, fmt::format("indented {} at brace depth {}, not {}", indent, depth, want)});
+      stmtIndent = indent;
+    }
+    if (!code.empty()) continues = code.back() != ';' && code.back() != '{' && code.back() != '}';
+    // (3) the rule's local
+    std::smatch m;
+    if (std::regex_match(line, m, rule)) {
+      expectLocal = sg::semanticIdentifier(m[1]);
+      continue;
+    }
+    // (1) declarations
+    if (std::regex_search(line, m, local)) {
+      const std::string name = m[1];
+      if (globals.count(name)) out.push_back({n, "local '" + name + "' hides a global"});
+      for (const auto& scope : scopes)
+        if (scope.count(name)) out.push_back({n, "local '" + name + "' declared again in its scope or an inner one"});
+      scopes.back().insert(name);
+      if (!expectLocal.empty() && name != expectLocal && name.rfind(expectLocal + "_", 0) != 0)
+        out.push_back({n, "rule block declares '" + name + "', not the local of its semantic ('" + expectLocal + "')"});
+    }
+    expectLocal.clear();
+    for (char c : code) {
+      if (c == '{') scopes.emplace_back(), ++depth;
+      if (c == '}' && scopes.size() > 1) scopes.pop_back(), --depth;
+    }
+  }
+  return out;
+}
+
+std::string describe(const std::vector<StyleFinding>& f, const std::string& glsl) {
+  std::string s;
+  for (const auto& x : f) s += fmt::format("line {}: {}\n", x.line, x.what);
+  return s + glsl;
+}
+
+// The checks themselves catch what issue 34 found in the output of the time.
+TEST(GeneratedGlslStyle, TheChecksCatchShadowingAndRaggedBlocks) {
+  const std::string head = "#version 450\nlayout(location = 1) in vec4 a_normal;\nlayout(location = 0) out vec3 n;\n";
+  EXPECT_TRUE(styleFindings(head + "void main() {\n  vec4 n4 = a_normal;\n  n = n4.xyz;\n}\n").empty());
+  auto shadow = styleFindings(head + "void main() {\n  vec4 a_normal = a_normal;\n  n = a_normal.xyz;\n}\n");
+  ASSERT_EQ(shadow.size(), 1u);
+  EXPECT_EQ(shadow[0].line, 5);
+  EXPECT_EQ(styleFindings(head + "void main() {\n  vec3 x_;\n  {\n    vec3 x_ = n;\n  }\n}\n").size(), 1u);
+  // The skinning blend of the time: a shared snippet's lines at their own YAML indentation.
+  const std::string ragged = "void main() {\n  // skin_matrix_blend -> skin.matrix (cost 16)\n  mat4 skin_matrix;\n  {\n"
+                             "    vec4 w0_ = a_normal;\n  vec4 c0_ =\n    w0_;\n  }\n}\n";
+  auto r = styleFindings(head + ragged);
+  ASSERT_EQ(r.size(), 1u) << describe(r, ragged);
+  EXPECT_EQ(r[0].line, 9);
+  // A rule block whose local is not named for its semantic.
+  EXPECT_EQ(styleFindings(head + "void main() {\n  // r -> world.normal (cost 1)\n  vec3 t_world_normal;\n}\n").size(), 1u);
+}
+
+// Every example rig and test rig (and the shared glTF models) with every example and test
+// fragment shader it can serve: data not written for these checks.
+TEST(GeneratedGlslStyle, EveryExampleRigAndRequestReadsCleanly) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> rigs, frags;
+  for (const char* dir : {"examples/dawn", "examples/threejs", "examples/cmake-consumer", "tests/validate/data",
+                          "tests/examples/data"})
+    for (const auto& e : fs::directory_iterator(kSrc + "/" + dir)) {
+      const std::string p = e.path().string();
+      if (p.size() > 9 && p.compare(p.size() - 9, 9, ".rig.yaml") == 0) rigs.push_back(p);
+    }
+  const std::string models = std::string(SG_SHARED_DIR) + "/models";
+  for (const char* m : {"CesiumMan/CesiumMan.glb#0/0", "MorphStressTest/MorphStressTest.gltf#0/1",
+                        "AnimatedMorphSphere/AnimatedMorphSphere.gltf#0/0", "RiggedFigure/RiggedFigure.glb#0/0"})
+    if (fs::exists(models)) rigs.push_back(models + "/" + m);
+  for (const char* dir : {"examples/dawn", "examples/threejs", "examples/render", "examples/cmake-consumer",
+                          "tests/validate/data", "tests/gltf/data", "tests/examples/data", "tests/bake/data"})
+    for (const auto& e : fs::directory_iterator(kSrc + "/" + dir))
+      if (e.path().extension() == ".frag") frags.push_back(e.path().string());
+  std::sort(rigs.begin(), rigs.end());
+  std::sort(frags.begin(), frags.end());
+  std::vector<std::vector<std::string>> ruleSets = {{kSrc + "/examples/dawn/rules.yaml"},
+                                                    {kStandardRules, kSrc + "/examples/cmake-consumer/prop.rules.yaml"}};
+#if defined(SG_SANITIZED)
+  ruleSets.pop_back();  // several times slower there: the Dawn rules alone (about 560 pairs)
+#endif
+  const sg::TemplateSet templates = sg::loadTemplatesStage(kSrc + "/templates");
+  std::map<std::string, sg::FragmentInterface> fragments;
+  for (const auto& f : frags) fragments.emplace(f, sg::loadFragmentStage(f, sg::TargetEnv::Vulkan1_0));
+  int generated = 0, withParts = 0, withBlocks = 0;
+  for (const auto& rules : ruleSets) {
+    const sg::RuleSet ruleSet = sg::loadRulesStage(rules);
+    for (const auto& rigPath : rigs) {
+      const sg::Rig rig = sg::loadRigStage(rigPath);
+      for (const auto& [fragPath, fragment] : fragments) {
+        sg::LoadedInputs in;
+        sg::Plan plan;
+        try {
+          in = sg::instantiateStage(rig, ruleSet, fragment, {});
+          plan = sg::searchStage(in, sg::SearchOptions{});
+        } catch (const sg::InputError&) {
+          continue;  // a request this rig cannot serve
+        }
+        const sg::EmittedGlsl glsl = sg::emitStage(in, plan, templates, sg::EmitOptions{});
+        SCOPED_TRACE(rigPath + " x " + fragPath);
+        const auto findings = styleFindings(glsl.text);
+        EXPECT_TRUE(findings.empty()) << describe(findings, glsl.text);
+        ++generated;
+        withParts += glsl.text.find("// Attributes read in parts") != std::string::npos;
+        withBlocks += glsl.text.find("\n  {\n") != std::string::npos;
+      }
+    }
+  }
+  // Enough pairs to mean something, including attributes read in parts and snippet blocks.
+  EXPECT_GE(generated, 100);
+  EXPECT_GE(withParts, 10);
+  EXPECT_GE(withBlocks, 20);
+  std::printf("%d rig x request x rules generations checked (%d with attributes read in parts, %d with blocks)\n",
+              generated, withParts, withBlocks);
+}
+
+// A fragment shader whose inputs take the names the locals would have: the locals give way
+// (world_normal_2), the program still compiles and validates, and nothing is hidden.
+TEST(GeneratedGlslStyle, LocalsGiveWayToOutputsOfTheSameName) {
+  auto dir = freshDir("names");
+  const std::string frag = (dir / "names.frag").string();
+  writeText(frag, "#version 450\nlayout(location = 0) in vec3 world_normal;\nlayout(location = 1) in vec3 object_normal;\n"
+                  "layout(location = 2) in vec3 t_world_normal;\nlayout(location = 0) out vec4 c;\n"
+                  "void main() { c = vec4(world_normal + object_normal + t_world_normal, 1.0); }\n");
+  sg::GenerateOptions o = dawnOptions();
+  o.fragmentPath = frag;
+  o.overrides = {{"t_world_normal", {"world.normal"}}};
+  sg::GenerateResult r = sg::generate(o);
+  EXPECT_TRUE(styleFindings(r.glsl.text).empty()) << describe(styleFindings(r.glsl.text), r.glsl.text);
+  EXPECT_NE(r.glsl.text.find("  world_normal = world_normal_2;\n"), std::string::npos) << r.glsl.text;
+  EXPECT_NE(r.glsl.text.find("  object_normal = object_normal_2;\n"), std::string::npos) << r.glsl.text;
+  EXPECT_NE(r.glsl.text.find("  t_world_normal = world_normal_2;\n"), std::string::npos) << r.glsl.text;
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -1730,7 +1730,7 @@ TEST(Hostile, FragmentDeclarationScannerSkipsCommentsAndFindsSplitDeclarations) 
 
 TEST(Hostile, FragmentInputsCannotUseGeneratedNames) {
   sg::RuleSet rules = sg::loadRules({kSrc + "/rules/standard.yaml"});
-  for (const std::string name : {"t_world_normal", "a_position", "u_bones", "ShadergenUniforms"}) {
+  for (const std::string name : {"a_position", "u_bones", "ShadergenUniforms"}) {
     const std::string src = "#version 450\nlayout(location = 0) in vec3 " + name +
                             ";\nlayout(location = 0) out vec4 c;\nvoid main() { c = vec4(" + name + ", 1); }\n";
     sg::FragmentInterface fi = sg::reflectFragmentSource(src, "n.frag");

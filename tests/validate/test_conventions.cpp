@@ -96,8 +96,8 @@ struct Planted {
 // declared (tangent, binormal, normal) order fails.
 TEST(Conventions, Mat3ColumnsAreComparedInOrder) {
   Planted p(kSrc + "/examples/dawn/face.rig.yaml", kSrc + "/tests/validate/data/conventions/gltf_sample_viewer.frag", 7, 1);
-  EXPECT_EQ(p.failing("mat3(t_world_tangent, t_world_binormal, t_world_normal)",
-                      "mat3(t_world_normal, t_world_binormal, t_world_tangent)"),
+  EXPECT_EQ(p.failing("mat3(world_tangent, world_binormal, world_normal)",
+                      "mat3(world_normal, world_binormal, world_tangent)"),
             std::set<std::string>{"v_TBN"});
 }
 
@@ -204,9 +204,9 @@ TEST(ThreeJs, StandardMaterialOnMorphedModels) {
 TEST(ThreeJs, PlantedErrorsFail) {
   Planted p(kSrc + "/examples/threejs/mesh.rig.yaml", kSrc + "/examples/threejs/standard_normalmap.frag", 3, 2);
   EXPECT_EQ(p.failing("", ""), std::set<std::string>{});
-  EXPECT_EQ(p.failing("= -t_eye_position.xyz;", "= t_eye_position.xyz;"), std::set<std::string>{"vViewPosition"});
+  EXPECT_EQ(p.failing("= -eye_position.xyz;", "= eye_position.xyz;"), std::set<std::string>{"vViewPosition"});
   // The normal feeds the bitangent's cross product, so both go wrong.
-  EXPECT_EQ(p.failing("normalize(u_normalMatrix * t_object_normal)", "normalize(mat3(u_modelViewMatrix) * t_object_normal)"),
+  EXPECT_EQ(p.failing("normalize(u_normalMatrix * object_normal)", "normalize(mat3(u_modelViewMatrix) * object_normal)"),
             (std::set<std::string>{"vNormal", "vBitangent"}));
 }
 

@@ -1,4 +1,0 @@
-#version 450
-layout(location = 0) in vec3 t_object_normal;
-layout(location = 0) out vec4 color;
-void main() { color = vec4(t_object_normal, 1.0); }
