@@ -6,9 +6,10 @@
 #   - by CMake + Ninja through shadergen_add_shader_variants() (an edge per variant), and
 #   - by `shadergen build MANIFEST`, one command per manifest, as today,
 # each cold (empty cache), warm (nothing changed), after touching one rig (its mtime) and
-# after editing it (its bytes: its variants are regenerated). Both start from their own
-# copy of the rigs, so each does the same work; their outputs are compared byte for byte
-# at the end. Prints a Markdown table. No validation (2 cores).
+# after editing it (its bytes: its variants are regenerated); their outputs are compared
+# byte for byte at the end. Prints a Markdown table. No validation (2 cores).
+# Ninja's side runs first (cold, warm, touched, edited), then the rig is restored and the
+# single commands take the same steps.
 #
 #   bench/variants_ninja.sh [build-dir]
 set -euo pipefail
@@ -21,17 +22,23 @@ jobs=$(nproc)
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 
-now() { date +%s%N; }
-secs() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f", (b - a) / 1e9 }'; }
+# timed <name> <command...>: runs it, its output to <name>.log; prints "wall cpu" seconds
+# (CPU: user + system of every process it ran; the machine is shared, so the wall time
+# depends on its load, the CPU time much less).
+timed() {
+  local name=$1 t
+  shift
+  t=$( { TIMEFORMAT='%R %U %S'; time "$@" >"$work/$name.log" 2>&1; } 2>&1 ) || { tail -n 30 "$work/$name.log" >&2; exit 1; }
+  awk '{ printf "%.2f %.2f", $1, $2 + $3 }' <<<"$t"
+}
 
-# Two identical source trees: one for Ninja, one for the single commands.
+# The rigs are copied (to be touched and edited); one manifest per device profile.
 profiles=(example llvmpipe-2core nvidia-h200)
-for side in ninja single; do
-  src="$work/$side-src"
-  mkdir -p "$src"
-  cp "$here/examples/dawn/face.rig.yaml" "$here/examples/dawn/body.rig.yaml" "$src/"
-  for p in "${profiles[@]}"; do
-    cat >"$src/$p.variants.yaml" <<YAML
+src="$work/src"
+mkdir -p "$src"
+cp "$here/examples/dawn/face.rig.yaml" "$here/examples/dawn/body.rig.yaml" "$src/"
+for p in "${profiles[@]}"; do
+  cat >"$src/$p.variants.yaml" <<YAML
 output: out/$p
 rules: $here/examples/dawn/rules.yaml
 device_profile: $here/devices/$p.yaml
@@ -51,9 +58,7 @@ axes:
 exclude: [{ rig: body, morph_targets: 5 }, { rig: body, morph_targets: 4 }, { rig: body, morph_targets: 2 }]
 name: "{rig}-{pass}-m{morph_targets}-i{influences}-b{bones}"
 YAML
-  done
 done
-src="$work/ninja-src"
 {
   echo "cmake_minimum_required(VERSION 3.22)"
   echo "project(variants_bench CXX)"
@@ -69,49 +74,59 @@ for p in "${profiles[@]}"; do total=$((total + $("$sg" build "$src/$p.variants.y
 body=$(( $("$sg" build "$src/example.variants.yaml" --list | grep -c '^body-') * ${#profiles[@]} ))
 
 b="$work/ninja-build"
-t0=$(now); cmake -S "$src" -B "$b" -G Ninja -DCMAKE_MAKE_PROGRAM="$ninja" >"$work/cfg.log" 2>&1 || { cat "$work/cfg.log"; exit 1; }; t1=$(now)
-configure=$(secs "$t0" "$t1")
+configure=$(timed configure cmake -S "$src" -B "$b" -G Ninja -DCMAKE_MAKE_PROGRAM="$ninja")
 indexes=()
 for p in "${profiles[@]}"; do indexes+=("$b/shadergen/app/$p/index.json"); done
-nin() {  # nin <name>: build the indexes, print the seconds; the commands run go to <name>.log
-  local a z
-  a=$(now); "$ninja" -C "$b" -j "$jobs" -v "${indexes[@]}" >"$work/$1.log" 2>&1 || { tail -n 30 "$work/$1.log"; exit 1; }; z=$(now)
-  secs "$a" "$z"
-}
-ran() { grep -c -- '--variant ' "$work/$1.log" || true; }
-one() {  # one: every manifest by one `shadergen build` each, print the seconds
-  local a z
-  a=$(now)
-  for p in "${profiles[@]}"; do "$sg" build "$work/single-src/$p.variants.yaml" -j "$jobs" -q; done
-  z=$(now)
-  secs "$a" "$z"
-}
+nin() { timed "$1" "$ninja" -C "$b" -j "$jobs" -v "${indexes[@]}"; }  # nin <name>: Ninja builds the indexes
+ran() { grep -c -- ' --variant ' "$work/$1.log" || true; }                # variant commands it ran
+singles() { for p in "${profiles[@]}"; do "$sg" build "$src/$p.variants.yaml" -j "$jobs" -q; done; }
+one() { timed "$1-single" singles; }                                       # one <name>: one command per manifest
 edges=$("$ninja" -C "$b" -t commands "${indexes[@]}" | grep -c -- '--variant ')
 
+# The same steps by each way, from the same rigs (restored in between).
+cp "$src/body.rig.yaml" "$work/body.rig.yaml.orig"
 n_cold=$(nin cold); c_cold=$(ran cold)
-s_cold=$(one)
 n_warm=$(nin warm); c_warm=$(ran warm)
-s_warm=$(one)
-sleep 1.1
-touch "$src/body.rig.yaml" "$work/single-src/body.rig.yaml"
+sleep 1.1; touch "$src/body.rig.yaml"
 n_touch=$(nin touch); c_touch=$(ran touch)
-s_touch=$(one)
-sleep 1.1
-for s in "$src" "$work/single-src"; do echo "# edited" >>"$s/body.rig.yaml"; done
+sleep 1.1; echo "# edited" >>"$src/body.rig.yaml"
 n_edit=$(nin edit); c_edit=$(ran edit)
-s_edit=$(one)
 
-for p in "${profiles[@]}"; do
-  diff -r -x .shadergen-cache -x .shadergen-variants "$b/shadergen/app/$p" "$work/single-src/out/$p" >/dev/null ||
-    { echo "DIFFERENT outputs for $p" >&2; exit 1; }
-done
-files=$(find "$b/shadergen/app" -type f -not -path '*/.shadergen-*' | wc -l)
-echo "byte-identical: $files files (${#profiles[@]} manifests, $total variants); $edges variant edges in build.ninja"
+cp "$work/body.rig.yaml.orig" "$src/body.rig.yaml"
+s_cold=$(one cold)
+s_warm=$(one warm)
+sleep 1.1; touch "$src/body.rig.yaml"
+s_touch=$(one touch)
+sleep 1.1; echo "# edited" >>"$src/body.rig.yaml"
+s_edit=$(one edit)
+
+row() { # row <label> <ninja "wall cpu"> <commands> <single "wall cpu">
+  read -r nw nc <<<"$2"; read -r sw sc <<<"$4"
+  echo "| $1 | $nw | $nc | $3 | $sw | $sc |"
+}
+echo "$edges variant edges in build.ninja"
+echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), load average $(cut -d' ' -f1-3 /proc/loadavg)"
 echo
-echo "| $total variants, $jobs cores | CMake + Ninja, an edge per variant: s | commands run | one \`shadergen build\` per manifest: s |"
-echo "|---|---:|---:|---:|"
-echo "| configure (expands the ${#profiles[@]} manifests) | $configure | | - |"
-echo "| cold (empty cache) | $n_cold | $c_cold | $s_cold |"
-echo "| warm, nothing changed | $n_warm | $c_warm | $s_warm |"
-echo "| body.rig.yaml touched ($body variants) | $n_touch | $c_touch | $s_touch |"
-echo "| body.rig.yaml edited ($body variants regenerated) | $n_edit | $c_edit | $s_edit |"
+echo "| $total variants | Ninja wall s | Ninja CPU s | commands | one \`shadergen build\` per manifest: wall s | CPU s |"
+echo "|---|---:|---:|---:|---:|---:|"
+read -r cw cc <<<"$configure"
+echo "| configure (expands the ${#profiles[@]} manifests) | $cw | $cc | | - | - |"
+row "cold (empty cache)" "$n_cold" "$c_cold" "$s_cold"
+row "warm, nothing changed" "$n_warm" "$c_warm" "$s_warm"
+row "body.rig.yaml touched ($body variants)" "$n_touch" "$c_touch" "$s_touch"
+row "body.rig.yaml edited ($body variants regenerated)" "$n_edit" "$c_edit" "$s_edit"
+
+# Byte for byte: the depfiles name their outputs, so each manifest is built once more by
+# the single command (from its cache) into Ninja's folder, Ninja's outputs moved aside.
+files=0
+for p in "${profiles[@]}"; do
+  out="$b/shadergen/app/$p"
+  mv "$out" "$work/ninja-out"
+  "$sg" build "$src/$p.variants.yaml" -o "$out" --cache-dir "$src/out/$p/.shadergen-cache" -q
+  diff -r -x .shadergen-cache -x .shadergen-variants "$out" "$work/ninja-out" >"$work/diff.log" ||
+    { echo "DIFFERENT outputs for $p:" >&2; head -n 20 "$work/diff.log" >&2; exit 1; }
+  files=$((files + $(find "$out" -type f -not -path '*/.shadergen-*' | wc -l)))
+  rm -rf "$out" && mv "$work/ninja-out" "$out"
+done
+echo
+echo "byte-identical to the single commands: $files files"
