@@ -107,9 +107,10 @@ struct BuildCommand {
         if (it == variants.end())
           throw InputError(SourceLoc{m.file, 0, 0},
                            fmt::format("no variant named '{}' (`shadergen build {} --list` lists them)", name, m.file));
-        picked.push_back(*it);
         VariantEntryFiles ef = entryFiles(m, *it);
+        if (always.count(ef.entry)) continue;  // named twice
         always.insert({ef.entry, ef.depfile});
+        picked.push_back(*it);
         std::error_code ec;  // a failing variant leaves no entry for --join to take
         std::filesystem::remove(ef.entry, ec);
       }
