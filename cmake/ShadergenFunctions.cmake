@@ -216,7 +216,8 @@ endfunction()
 #     [DEVICE_PROFILE <file>]    # --device-profile for every variant, in place of the manifest's
 #     [VALIDATE]                 # --validate: every variant validated after it is built
 #     [CACHE_URL <url>]          # --cache-url: a shared cache over the local one
-#     [JOBS <n>]                 # worker threads of the single command (default: every hardware thread)
+#     [ONE_COMMAND]              # one `shadergen build` for the whole manifest instead (below)
+#     [JOBS <n>]                 # worker threads of that command (default: every hardware thread)
 #     [DEPENDS <file>...])       # extra dependencies
 #
 # The manifest is expanded at configure time (`shadergen build MANIFEST --list-cmake`) and
@@ -231,14 +232,15 @@ endfunction()
 #
 # Expanding the manifest needs the generator at configure time: an installed package's
 # imported shadergen::shadergen. When shadergen is built by the same project
-# (add_subdirectory), the manifest is built by one command instead (`shadergen build`, all
-# cores: JOBS), whose DEPFILE lists every file any variant read.
+# (add_subdirectory), or with ONE_COMMAND, the manifest is built by one command instead
+# (`shadergen build`, all cores: JOBS), whose DEPFILE lists every file any variant read:
+# cheaper on one machine (process start-up is paid once), but one unit of scheduling.
 #
 # The target gets the compile definition SHADERGEN_<NAME>_INDEX="<dir>/index.json" (NAME:
 # the manifest's file name up to the first '.', upper-cased, non-alphanumerics as '_'),
 # also set in the caller's scope.
 function(shadergen_add_shader_variants target)
-  cmake_parse_arguments(PARSE_ARGV 1 SG "VALIDATE" "MANIFEST;OUTPUT_DIR;JOBS;DEVICE_PROFILE;CACHE_URL" "RULES;DEPENDS")
+  cmake_parse_arguments(PARSE_ARGV 1 SG "VALIDATE;ONE_COMMAND" "MANIFEST;OUTPUT_DIR;JOBS;DEVICE_PROFILE;CACHE_URL" "RULES;DEPENDS")
   if(SG_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "shadergen_add_shader_variants(${target}): unknown arguments: ${SG_UNPARSED_ARGUMENTS}")
   endif()
@@ -288,8 +290,8 @@ function(shadergen_add_shader_variants target)
   if(_imported)
     get_target_property(_sg_path ${_sg_exe} LOCATION)
   endif()
-  if(NOT _imported OR NOT EXISTS "${_sg_path}")
-    message(VERBOSE "shadergen_add_shader_variants(${target}): the generator is built by this project, so ${_name} is built by one command")
+  if(SG_ONE_COMMAND OR NOT _imported OR NOT EXISTS "${_sg_path}")
+    message(VERBOSE "shadergen_add_shader_variants(${target}): ${_name} is built by one command (ONE_COMMAND, or a generator built by this project)")
     if(SG_JOBS)
       list(APPEND _args -j "${SG_JOBS}")
     endif()

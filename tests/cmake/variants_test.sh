@@ -2,7 +2,7 @@
 # shadergen_add_shader_variants() with one build edge per variant (docs/cmake.md,
 # docs/variants.md), through CMake + Ninja with this build's generator as an imported
 # executable: a 36-variant manifest of the Dawn face and body (copied, so they can be
-# touched) and a whole glTF model (MODEL.gltf#*).
+# touched) and a whole glTF model (MODEL.gltf#*), also built by ONE_COMMAND.
 #   - every variant is its own edge in build.ninja, with its own depfile;
 #   - the first build runs each variant's command once and one --join;
 #   - the outputs equal a single-process `shadergen build` of the manifest byte for byte;
@@ -50,6 +50,9 @@ file(WRITE "\${CMAKE_BINARY_DIR}/main.cpp" "#include <cstdio>\nint main() { std:
 add_executable(app "\${CMAKE_BINARY_DIR}/main.cpp")
 shadergen_add_shader_variants(app MANIFEST chars.variants.yaml)
 shadergen_add_shader_variants(app MANIFEST model.variants.yaml)
+file(WRITE "\${CMAKE_BINARY_DIR}/one.cpp" "int main() {}\n")
+add_executable(one "\${CMAKE_BINARY_DIR}/one.cpp")
+shadergen_add_shader_variants(one MANIFEST model.variants.yaml ONE_COMMAND)
 CMAKE
 OUT=$B/shadergen/app/chars
 tick() { sleep 1.1; }  # mtime granularity on some file systems
@@ -85,7 +88,11 @@ edges_with_depfile=$(awk '/^build [^ ]*\.entry .*: CUSTOM_COMMAND/{e=1; next} e 
 [ "$edges_with_depfile" = $((n + 1)) ] && ok "every variant edge has a depfile" ||
   fail "$edges_with_depfile variant edges with a depfile, expected $((n + 1)) (36 + the model's)"
 
+grep -q -- "model.variants.yaml -o $B/shadergen/one/model -q && " "$T/commands" &&
+  ok "ONE_COMMAND: one shadergen build for the manifest" || fail "ONE_COMMAND: $(grep -- /one/model "$T/commands")"
+
 build cold
+[ -s "$B/shadergen/one/model/index.json" ] && ok "ONE_COMMAND builds the index" || fail "ONE_COMMAND: no index"
 ran cold >"$T/cold.ran"
 cmp -s "$T/cold.ran" "$T/all" && [ "$(joins cold)" = 1 ] && ok "first build: each variant's command once, one --join" ||
   fail "first build ran $(wc -l <"$T/cold.ran") variant commands, $(joins cold) joins"
