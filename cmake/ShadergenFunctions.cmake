@@ -207,25 +207,40 @@ function(shadergen_add_vertex_shader target)
 endfunction()
 
 # shadergen_add_shader_variants(): every variant of a manifest (docs/variants.md) built at
-# build time by one `shadergen build` run, and attached to a target.
+# build time, one build edge per variant, and attached to a target.
 #
 #   shadergen_add_shader_variants(<target>
 #     MANIFEST <file>            # the variant manifest (YAML)
 #     [OUTPUT_DIR <dir>]         # default: ${CMAKE_CURRENT_BINARY_DIR}/shadergen/<target>/<manifest name>
 #     [RULES <file>...]          # rules files read before the manifest's (e.g. ${SHADERGEN_RULES_DIR}/standard.yaml)
-#     [JOBS <n>]                 # worker threads (default: every hardware thread)
 #     [DEVICE_PROFILE <file>]    # --device-profile for every variant, in place of the manifest's
+#     [VALIDATE]                 # --validate: every variant validated after it is built
+#     [CACHE_URL <url>]          # --cache-url: a shared cache over the local one
+#     [ONE_COMMAND]              # one `shadergen build` for the whole manifest instead (below)
+#     [JOBS <n>]                 # worker threads of that command (default: every hardware thread)
 #     [DEPENDS <file>...])       # extra dependencies
 #
-# The custom command's output is <dir>/index.json (every variant with its plan cost and
-# output files, relative to <dir>); its DEPFILE lists the manifest and every file any
-# variant read, so editing one of them reruns the build. The build's content cache
-# (<dir>/.shadergen-cache) then regenerates only the variants whose inputs changed, and
-# outputs whose bytes did not change are not rewritten. The target gets the compile
-# definition SHADERGEN_<NAME>_INDEX="<dir>/index.json" (NAME: the manifest's file name up
-# to the first '.', upper-cased, non-alphanumerics as '_'), also set in the caller's scope.
+# The manifest is expanded at configure time (`shadergen build MANIFEST --list-cmake`) and
+# again whenever it (or a whole model it expands, MODEL.glb#*) changes. Each variant is its
+# own custom command (`shadergen build MANIFEST --variant NAME`) whose DEPFILE lists the
+# manifest and every file that variant reads, so Ninja reruns exactly the variants whose
+# inputs changed and a distributing build can spread them; one last command
+# (`--join`) writes <dir>/index.json (every variant with its plan cost and output files,
+# relative to <dir>) from the variants' entries. The outputs are those of one
+# `shadergen build` run, byte for byte. The content cache (<dir>/.shadergen-cache) is
+# shared by the variants' commands.
+#
+# Expanding the manifest needs the generator at configure time: an installed package's
+# imported shadergen::shadergen. When shadergen is built by the same project
+# (add_subdirectory), or with ONE_COMMAND, the manifest is built by one command instead
+# (`shadergen build`, all cores: JOBS), whose DEPFILE lists every file any variant read:
+# cheaper on one machine (process start-up is paid once), but one unit of scheduling.
+#
+# The target gets the compile definition SHADERGEN_<NAME>_INDEX="<dir>/index.json" (NAME:
+# the manifest's file name up to the first '.', upper-cased, non-alphanumerics as '_'),
+# also set in the caller's scope.
 function(shadergen_add_shader_variants target)
-  cmake_parse_arguments(PARSE_ARGV 1 SG "" "MANIFEST;OUTPUT_DIR;JOBS;DEVICE_PROFILE" "RULES;DEPENDS")
+  cmake_parse_arguments(PARSE_ARGV 1 SG "VALIDATE;ONE_COMMAND" "MANIFEST;OUTPUT_DIR;JOBS;DEVICE_PROFILE;CACHE_URL" "RULES;DEPENDS")
   if(SG_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "shadergen_add_shader_variants(${target}): unknown arguments: ${SG_UNPARSED_ARGUMENTS}")
   endif()
@@ -251,31 +266,90 @@ function(shadergen_add_shader_variants target)
     get_filename_component(_d "${d}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
     list(APPEND _extra "${_d}")
   endforeach()
-  set(_args build "${_manifest}" -o "${_dir}" -q)
+  # What every command is given; --list-cmake only what decides the variants' files.
+  set(_list_args -o "${_dir}")
   foreach(r IN LISTS SG_RULES)
     get_filename_component(_r "${r}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
-    list(APPEND _args -r "${_r}")
+    list(APPEND _list_args -r "${_r}")
   endforeach()
-  if(SG_JOBS)
-    list(APPEND _args -j "${SG_JOBS}")
-  endif()
   if(SG_DEVICE_PROFILE)
     get_filename_component(_profile "${SG_DEVICE_PROFILE}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
-    list(APPEND _args --device-profile "${_profile}")
+    list(APPEND _list_args --device-profile "${_profile}")
     list(APPEND _extra "${_profile}")
   endif()
-  add_custom_command(
-    OUTPUT "${_dir}/index.json"
-    COMMAND ${_sg_exe} ${_args}
-    DEPENDS "${_manifest}" ${_extra} ${_sg_exe}
-    DEPFILE "${_dir}/index.json.d"
-    WORKING_DIRECTORY "${CMAKE_CURRENT_BINARY_DIR}"
-    COMMENT "shadergen: building the shader variants of ${_name} for ${target}"
-    VERBATIM)
-  target_sources(${target} PRIVATE "${_dir}/index.json")
-  set_source_files_properties("${_dir}/index.json" PROPERTIES GENERATED TRUE)
-  target_compile_definitions(${target} PRIVATE "SHADERGEN_${_NAME}_INDEX=\"${_dir}/index.json\"")
-  set(SHADERGEN_${_NAME}_INDEX "${_dir}/index.json" PARENT_SCOPE)
+  set(_args ${_list_args} -q)
+  if(SG_VALIDATE)
+    list(APPEND _args --validate)
+  endif()
+  if(SG_CACHE_URL)
+    list(APPEND _args --cache-url "${SG_CACHE_URL}")
+  endif()
+  set(_index "${_dir}/index.json")
+
+  get_target_property(_imported ${_sg_exe} IMPORTED)
+  if(_imported)
+    get_target_property(_sg_path ${_sg_exe} LOCATION)
+  endif()
+  if(SG_ONE_COMMAND OR NOT _imported OR NOT EXISTS "${_sg_path}")
+    message(VERBOSE "shadergen_add_shader_variants(${target}): ${_name} is built by one command (ONE_COMMAND, or a generator built by this project)")
+    if(SG_JOBS)
+      list(APPEND _args -j "${SG_JOBS}")
+    endif()
+    add_custom_command(
+      OUTPUT "${_index}"
+      COMMAND ${_sg_exe} build "${_manifest}" ${_args}
+      DEPENDS "${_manifest}" ${_extra} ${_sg_exe}
+      DEPFILE "${_index}.d"
+      WORKING_DIRECTORY "${CMAKE_CURRENT_BINARY_DIR}"
+      COMMENT "shadergen: building the shader variants of ${_name} for ${target}"
+      VERBATIM)
+  else()
+    # The manifest's expansion, read back as SHADERGEN_LIST_* variables (function scope).
+    set(_list "${CMAKE_CURRENT_BINARY_DIR}/shadergen/${target}/${_name}.variants.cmake")
+    set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${_manifest}")  # also when it fails
+    file(MAKE_DIRECTORY "${CMAKE_CURRENT_BINARY_DIR}/shadergen/${target}")
+    execute_process(
+      COMMAND "${_sg_path}" build "${_manifest}" ${_list_args} --list-cmake
+      WORKING_DIRECTORY "${CMAKE_CURRENT_BINARY_DIR}"
+      OUTPUT_FILE "${_list}"
+      ERROR_VARIABLE _err
+      RESULT_VARIABLE _rc)
+    if(NOT _rc EQUAL 0)
+      message(FATAL_ERROR "shadergen_add_shader_variants(${target}): cannot expand the manifest:\n${_err}")
+    endif()
+    include("${_list}")
+    set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${SHADERGEN_LIST_CONFIGURE_DEPENDS})
+    # A variant depends on the manifest through its stamp, rewritten only when the manifest
+    # changes what that variant makes: adding a variant to the manifest reruns only it.
+    set(_stamps "${CMAKE_CURRENT_BINARY_DIR}/shadergen/${target}/${_name}.stamps")
+    set(_entries "")
+    foreach(_v IN LISTS SHADERGEN_LIST_VARIANTS)
+      file(CONFIGURE OUTPUT "${_stamps}/${_v}" CONTENT "${SHADERGEN_LIST_${_v}_STAMP}\n")
+      add_custom_command(
+        OUTPUT ${SHADERGEN_LIST_${_v}_ENTRY} ${SHADERGEN_LIST_${_v}_OUTPUTS}
+        COMMAND ${_sg_exe} build "${_manifest}" ${_args} --variant ${_v}
+        DEPENDS "${_stamps}/${_v}" ${SHADERGEN_LIST_${_v}_INPUTS} ${_extra} ${_sg_exe}
+        DEPFILE ${SHADERGEN_LIST_${_v}_DEPFILE}
+        WORKING_DIRECTORY "${CMAKE_CURRENT_BINARY_DIR}"
+        COMMENT "shadergen: building shader variant ${_v} of ${_name}"
+        VERBATIM)
+      list(APPEND _entries ${SHADERGEN_LIST_${_v}_ENTRY})
+    endforeach()
+    list(LENGTH SHADERGEN_LIST_VARIANTS _count)
+    add_custom_command(
+      OUTPUT "${_index}" "${_index}.d"
+      COMMAND ${_sg_exe} build "${_manifest}" ${_args} --join
+      DEPENDS "${_manifest}" ${_entries} ${_sg_exe}
+      WORKING_DIRECTORY "${CMAKE_CURRENT_BINARY_DIR}"
+      COMMENT "shadergen: indexing the ${_count} shader variants of ${_name} for ${target}"
+      VERBATIM)
+    # SPIR-V files are named by their content (unknown here): cleaned as a folder.
+    set_property(TARGET ${target} APPEND PROPERTY ADDITIONAL_CLEAN_FILES "${_dir}/spirv")
+  endif()
+  target_sources(${target} PRIVATE "${_index}")
+  set_source_files_properties("${_index}" PROPERTIES GENERATED TRUE)
+  target_compile_definitions(${target} PRIVATE "SHADERGEN_${_NAME}_INDEX=\"${_index}\"")
+  set(SHADERGEN_${_NAME}_INDEX "${_index}" PARENT_SCOPE)
 endfunction()
 
 cmake_policy(POP)

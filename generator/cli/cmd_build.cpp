@@ -3,11 +3,13 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <set>
 #include <sstream>
 
 #include "cli/commands.h"
@@ -29,6 +31,37 @@ bool sameContents(const std::string& path, const std::string& contents) {
   return s.str() == contents;
 }
 
+// `--list-cmake`: the variants as CMake set() commands, for shadergen_add_shader_variants()
+// (cmake/ShadergenFunctions.cmake), which gives each variant its own build edge. Paths are
+// absolute (CMake resolves relative ones against the source directory, not ours).
+std::string cmakeListing(const Manifest& m, const std::vector<Variant>& variants,
+                         const std::vector<PlannedVariant>& planned) {
+  auto quote = [&](const std::string& path) {
+    std::string p = std::filesystem::absolute(path).lexically_normal().string();
+    if (p.find_first_of(";\n\r") != std::string::npos)
+      throw InputError(SourceLoc{m.file, 0, 0}, fmt::format("cannot list '{}' for CMake: the path contains ';' or a newline", p));
+    std::string eq;
+    while ((p + "]" + eq + "]").find("]" + eq + "]") < p.size()) eq += "=";  // no early end of the bracket
+    return fmt::format(" [{}[{}]{}]", eq, p, eq);
+  };
+  std::string out = fmt::format("# `shadergen build {} --list-cmake`: one build edge per variant\n", m.file);
+  out += "set(SHADERGEN_LIST_CONFIGURE_DEPENDS" + quote(m.file);  // what the list itself depends on
+  for (const auto& f : m.wholeModelFiles) out += quote(f);
+  out += ")\nset(SHADERGEN_LIST_VARIANTS";
+  for (const auto& v : variants) out += " " + v.name;  // safe file stems
+  out += ")\n";
+  for (size_t i = 0; i < variants.size(); ++i) {
+    const std::string var = "SHADERGEN_LIST_" + variants[i].name;
+    VariantEntryFiles ef = entryFiles(m, variants[i]);
+    out += fmt::format("set({}_ENTRY{})\nset({}_DEPFILE{})\nset({}_OUTPUTS", var, quote(ef.entry), var, quote(ef.depfile), var);
+    for (const auto& [kind, path] : planned[i].outputs) out += quote(path);
+    out += fmt::format(")\nset({}_STAMP {})\nset({}_INPUTS", var, planned[i].stamp, var);
+    for (const auto& f : planned[i].inputs) out += quote(f);
+    out += ")\n";
+  }
+  return out;
+}
+
 struct BuildCommand {
   std::string manifest;
   std::string output;
@@ -43,6 +76,9 @@ struct BuildCommand {
   bool validate = false;
   std::string cacheUrl;
   GltfReadOptions gltf;
+  bool listCmake = false;
+  std::vector<std::string> only;  // --variant
+  bool join = false;
 
   int run() {
     if (noCache && !cacheDir.empty())
@@ -57,6 +93,33 @@ struct BuildCommand {
     if (list) {  // for build systems: the variants and their name-derived outputs
       for (const auto& v : variants) std::cout << v.name << "\n";
       return 0;
+    }
+    if (listCmake) {
+      std::cout << cmakeListing(m, variants, planVariants(m, variants));
+      return 0;
+    }
+    if (join) {  // the final edge after one `--variant` edge per variant
+      std::vector<PendingFile> index;
+      for (auto& f : joinIndex(m, variants)) index.push_back({f.path, f.contents});
+      writeFilesAtomically(index);
+      return 0;
+    }
+    std::set<std::string> always;  // rewritten even when unchanged: a build edge's outputs
+    if (!only.empty()) {           // one build edge per variant: its outputs and its index entry
+      std::vector<Variant> picked;
+      for (const auto& name : only) {
+        auto it = std::find_if(variants.begin(), variants.end(), [&](const Variant& v) { return v.name == name; });
+        if (it == variants.end())
+          throw InputError(SourceLoc{m.file, 0, 0},
+                           fmt::format("no variant named '{}' (`shadergen build {} --list` lists them)", name, m.file));
+        VariantEntryFiles ef = entryFiles(m, *it);
+        if (always.count(ef.entry)) continue;  // named twice
+        always.insert({ef.entry, ef.depfile});
+        picked.push_back(*it);
+        std::error_code ec;  // a failing variant leaves no entry for --join to take
+        std::filesystem::remove(ef.entry, ec);
+      }
+      variants = std::move(picked);
     }
     BuildOptions bo;
     bo.jobs = jobs;
@@ -102,6 +165,7 @@ struct BuildCommand {
       }
     }
     bo.gltf = gltf;
+    bo.index = only.empty();
     // Progress on a terminal, quiet in CI and in logs.
     bool showProgress = progress || (!quiet && isatty(STDERR_FILENO) && !std::getenv("CI"));
     if (showProgress)
@@ -120,7 +184,7 @@ struct BuildCommand {
     // the index is always rewritten: it is the build step's output, newer than its inputs.
     std::vector<PendingFile> changed;
     for (const auto& f : r.files)
-      if (f.path == r.indexPath || f.path == r.indexPath + ".d" || !sameContents(f.path, f.contents))
+      if (f.path == r.indexPath || f.path == r.indexPath + ".d" || always.count(f.path) || !sameContents(f.path, f.contents))
         changed.push_back({f.path, f.contents});
     if (!changed.empty()) writeFilesAtomically(changed);
     if (r.failed) {  // an index left from an earlier build must not vouch for this one's outputs
@@ -173,6 +237,17 @@ void registerBuild(CLI::App& app, CliState& state) {
                   "$SHADERGEN_CACHE_URL, then the manifest's 'cache_url'); credentials only from the environment "
                   "(SHADERGEN_CACHE_AUTH=user:password)");
   addGltfReadOptions(*sub, cmd->gltf);
+  sub->add_option("--variant", cmd->only,
+                  "Build only this variant (repeatable), leaving its index entry for --join instead of the index "
+                  "(one build edge per variant)");
+  sub->add_flag("--join", cmd->join, "Write index.json from the entries the --variant builds left; build nothing")
+      ->excludes("--variant");
+  sub->add_flag("--list-cmake", cmd->listCmake,
+                "Print each variant's outputs and input files as CMake set() commands (for "
+                "shadergen_add_shader_variants) and build nothing")
+      ->excludes("--variant")
+      ->excludes("--join")
+      ->excludes("--list");
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }
 

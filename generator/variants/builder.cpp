@@ -84,9 +84,9 @@ std::vector<std::string> inputsOf(const SharedInputs& s, const Variant& v) {
 
 // Every byte that can change a variant's outputs: the tool, the options, the variant's
 // parameters and mappings, and each input file's path (outputs name them) and contents
-// (through the SHA-256 of the file).
+// (through the SHA-256 of the file; left out with contents = false: the settings alone).
 std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v, const std::vector<std::string>& inputs,
-                     const Workload* workload) {
+                     const Workload* workload, bool contents = true) {
   Sha256 h;
   h.field(kCacheFormat).field(shadergenVersion()).field(targetEnvName(m.targetEnv)).field(m.heuristic);
   h.field(m.optimize ? "optimize" : "no-optimize");
@@ -115,7 +115,7 @@ std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v,
   if (const std::string& w = s.rigs.at(v.rig->path).skinWeights; !w.empty())  // the reflection records it
     h.field("skin_weights").field(w);
   h.field("inputs");
-  for (const auto& f : inputs) h.field(f).field(s.digests.at(f));
+  for (const auto& f : inputs) h.field(f).field(contents ? s.digests.at(f) : "");
   return h.hex();
 }
 
@@ -331,7 +331,8 @@ std::string relativeTo(const std::string& dir, const std::string& path) {
   return fs::path(path).lexically_relative(dir).generic_string();
 }
 
-std::string indexJson(const Manifest& m, const BuildReport& r) {
+// index.json: the build's settings, then each variant's entry (indexEntry), in manifest order.
+std::string indexJson(const Manifest& m, const std::vector<std::string>& entries) {
   std::string out = "{\n";
   out += fmt::format("  \"shadergen\": {},\n", jsonString(shadergenVersion()));
   out += fmt::format("  \"target_env\": {},\n", jsonString(targetEnvName(m.targetEnv)));
@@ -352,40 +353,94 @@ std::string indexJson(const Manifest& m, const BuildReport& r) {
   for (const auto& f : m.rules) rules += (rules.empty() ? "" : ", ") + jsonString(f);
   out += fmt::format("  \"rules\": [{}],\n", rules);
   out += fmt::format("  \"variants\": [\n");
-  for (size_t i = 0; i < r.variants.size(); ++i) {
-    const BuiltVariant& b = r.variants[i];
-    const Variant& v = *b.variant;
-    out += "    {\n";
-    out += fmt::format("      \"name\": {},\n", jsonString(v.name));
-    out += fmt::format("      \"rig\": {},\n", jsonString(v.rig->name));
-    out += fmt::format("      \"rig_file\": {},\n", jsonString(v.rig->path));
-    if (!b.skinWeights.empty())  // the weights the host must feed (docs/gltf.md#import-diagnostics-and-weights)
-      out += fmt::format("      \"skin_weights\": {},\n", jsonString(b.skinWeights));
-    out += fmt::format("      \"pass\": {},\n", jsonString(v.pass->name));
-    out += fmt::format("      \"fragment_file\": {},\n", jsonString(v.pass->fragment));
-    std::string params;
-    for (const auto& [k, val] : v.params) params += fmt::format("{}{}: {}", params.empty() ? "" : ", ", jsonString(k), val);
-    out += fmt::format("      \"parameters\": {{{}}},\n", params);
-    out += fmt::format("      \"cost\": {},\n", b.cost);
-    std::string rules;
-    for (const auto& rule : b.rules) rules += (rules.empty() ? "" : ", ") + jsonString(rule);
-    out += fmt::format("      \"rules\": [{}],\n", rules);
-    out += fmt::format("      \"spirv_sha256\": {},\n", jsonString(b.spirvHash));
-    out += fmt::format("      \"validated\": {},\n", b.validation ? "true" : "false");
-    if (const auto& val = b.validation)  // where and when the result was made (cached with it)
-      out += fmt::format("      \"validation\": {{\"device\": {}, \"driver\": {}, \"shadergen\": {}, \"made\": {}, "
-                         "\"runs\": {}, \"worst_output\": {}, \"max_abs_error\": {:.17g}, \"max_rel_error\": {:.17g}}},\n",
-                         jsonString(val->device), jsonString(val->driver), jsonString(val->tool), jsonString(val->made),
-                         val->runs, jsonString(val->worstOutput), val->maxAbsError, val->maxRelError);
-    std::string outputs;
-    for (const auto& [kind, path] : b.outputs)
-      outputs += fmt::format("{}{}: {}", outputs.empty() ? "" : ", ", jsonString(kind),
-                             jsonString(relativeTo(m.outputDir, path)));
-    out += fmt::format("      \"outputs\": {{{}}}\n", outputs);
-    out += i + 1 < r.variants.size() ? "    },\n" : "    }\n";
-  }
+  for (size_t i = 0; i < entries.size(); ++i) out += entries[i] + (i + 1 < entries.size() ? ",\n" : "\n");
   out += "  ]\n}\n";
   return out;
+}
+
+// One element of index.json's "variants" (no trailing comma or newline).
+std::string indexEntry(const Manifest& m, const BuiltVariant& b) {
+  const Variant& v = *b.variant;
+  std::string out = "    {\n";
+  out += fmt::format("      \"name\": {},\n", jsonString(v.name));
+  out += fmt::format("      \"rig\": {},\n", jsonString(v.rig->name));
+  out += fmt::format("      \"rig_file\": {},\n", jsonString(v.rig->path));
+  if (!b.skinWeights.empty())  // the weights the host must feed (docs/gltf.md#import-diagnostics-and-weights)
+    out += fmt::format("      \"skin_weights\": {},\n", jsonString(b.skinWeights));
+  out += fmt::format("      \"pass\": {},\n", jsonString(v.pass->name));
+  out += fmt::format("      \"fragment_file\": {},\n", jsonString(v.pass->fragment));
+  std::string params;
+  for (const auto& [k, val] : v.params) params += fmt::format("{}{}: {}", params.empty() ? "" : ", ", jsonString(k), val);
+  out += fmt::format("      \"parameters\": {{{}}},\n", params);
+  out += fmt::format("      \"cost\": {},\n", b.cost);
+  std::string rules;
+  for (const auto& rule : b.rules) rules += (rules.empty() ? "" : ", ") + jsonString(rule);
+  out += fmt::format("      \"rules\": [{}],\n", rules);
+  out += fmt::format("      \"spirv_sha256\": {},\n", jsonString(b.spirvHash));
+  out += fmt::format("      \"validated\": {},\n", b.validation ? "true" : "false");
+  if (const auto& val = b.validation)  // where and when the result was made (cached with it)
+    out += fmt::format("      \"validation\": {{\"device\": {}, \"driver\": {}, \"shadergen\": {}, \"made\": {}, "
+                       "\"runs\": {}, \"worst_output\": {}, \"max_abs_error\": {:.17g}, \"max_rel_error\": {:.17g}}},\n",
+                       jsonString(val->device), jsonString(val->driver), jsonString(val->tool), jsonString(val->made),
+                       val->runs, jsonString(val->worstOutput), val->maxAbsError, val->maxRelError);
+  out += fmt::format("      \"validated\": {},\n", b.validation ? "true" : "false");
+  if (const auto& val = b.validation)  // where and when the result was made (cached with it)
+    out += fmt::format("      \"validation\": {{\"device\": {}, \"driver\": {}, \"shadergen\": {}, \"made\": {}, "
+                       "\"runs\": {}, \"worst_output\": {}, \"max_abs_error\": {:.17g}, \"max_rel_error\": {:.17g}}},\n",
+                       jsonString(val->device), jsonString(val->driver), jsonString(val->tool), jsonString(val->made),
+                       val->runs, jsonString(val->worstOutput), val->maxAbsError, val->maxRelError);
+  std::string outputs;
+  for (const auto& [kind, path] : b.outputs)
+    outputs += fmt::format("{}{}: {}", outputs.empty() ? "" : ", ", jsonString(kind),
+                           jsonString(relativeTo(m.outputDir, path)));
+  out += fmt::format("      \"outputs\": {{{}}}\n", outputs);
+  return out + "    }";
+}
+
+// index.json and its depfile (every input of every variant, and the manifest).
+std::vector<OutputFile> indexFiles(const Manifest& m, const std::vector<std::string>& entries,
+                                   const std::set<std::string>& inputs) {
+  std::string index = (fs::path(m.outputDir) / "index.json").string();
+  return {{index, indexJson(m, entries)},
+          {index + ".d", makeDepfile({index}, std::vector<std::string>(inputs.begin(), inputs.end()))}};
+}
+
+// The outputs named after the variant (the SPIR-V is named by its content).
+std::map<std::string, std::string> namedOutputs(const Manifest& m, const Variant& v) {
+  std::map<std::string, std::string> out;
+  for (auto [kind, suffix] : {std::pair{"glsl", ".vert"}, std::pair{"reflection", ".json"}, std::pair{"hlsl", ".hlsl"},
+                              std::pair{"msl", ".metal"}})
+    if (m.emits(kind)) out[kind] = (fs::path(m.outputDir) / (v.name + suffix)).string();
+  return out;
+}
+
+// A variant's entry file: its index element and its inputs, for joinIndex.
+constexpr const char* kEntryFormat = "shadergen-variant-entry 1";
+
+std::string entryText(const BuiltVariant& b) {
+  std::string out = fmt::format("{}\ninputs {}\n", kEntryFormat, b.inputs.size());
+  for (const auto& f : b.inputs) out += f + "\n";  // makeDepfile has refused paths with a newline
+  return out + fmt::format("entry {}\n{}", b.entry.size(), b.entry);
+}
+
+bool parseEntry(const std::string& text, std::string& entry, std::vector<std::string>& inputs) {
+  std::istringstream in(text);
+  std::string line;
+  if (!std::getline(in, line) || line != kEntryFormat) return false;
+  if (!std::getline(in, line) || line.rfind("inputs ", 0) != 0) return false;
+  size_t n = 0, size = 0;
+  try {
+    n = std::stoull(line.substr(7));
+    for (size_t i = 0; i < n && std::getline(in, line); ++i) inputs.push_back(line);
+    if (inputs.size() != n || !std::getline(in, line) || line.rfind("entry ", 0) != 0) return false;
+    size = std::stoull(line.substr(6));
+  } catch (const std::exception&) {
+    return false;
+  }
+  auto at = static_cast<size_t>(in.tellg());
+  if (at > text.size() || text.size() - at != size) return false;
+  entry = text.substr(at);
+  return true;
 }
 
 }  // namespace
@@ -431,42 +486,84 @@ BuildReport buildVariants(const Manifest& m, const std::vector<Variant>& variant
     }
     ++(b.cached ? report.cached : report.generated);
     const Variant& v = *b.variant;
-    auto has = [&](const char* kind) { return std::find(m.emit.begin(), m.emit.end(), kind) != m.emit.end(); };
+    b.outputs = namedOutputs(m, v);
+    const std::map<std::string, const std::string*> text{
+        {"glsl", &b.glsl}, {"reflection", &b.reflection}, {"hlsl", &b.hlsl}, {"msl", &b.msl}};
     std::vector<std::string> targets;
-    if (has("glsl")) {
-      b.outputs["glsl"] = (fs::path(m.outputDir) / (v.name + ".vert")).string();
-      report.files.push_back({b.outputs["glsl"], b.glsl});
-      targets.push_back(b.outputs["glsl"]);
-    }
-    if (has("spv")) {
-      b.outputs["spv"] = (fs::path(m.outputDir) / "spirv" / (b.spirvHash.substr(0, 16) + ".spv")).string();
-      if (spirvWritten.insert(b.spirvHash).second) report.files.push_back({b.outputs["spv"], b.spirv});
-      else ++report.sharedSpirv;
-      targets.push_back(b.outputs["spv"]);
-    }
-    if (has("reflection")) {
-      b.outputs["reflection"] = (fs::path(m.outputDir) / (v.name + ".json")).string();
-      report.files.push_back({b.outputs["reflection"], b.reflection});
-      targets.push_back(b.outputs["reflection"]);
-    }
-    for (auto [kind, suffix, text] : {std::tuple{"hlsl", ".hlsl", &b.hlsl}, std::tuple{"msl", ".metal", &b.msl}}) {
-      if (!has(kind)) continue;
-      b.outputs[kind] = (fs::path(m.outputDir) / (v.name + suffix)).string();
-      report.files.push_back({b.outputs[kind], *text});
+    // In the order of the depfile's targets: GLSL, SPIR-V, reflection, HLSL, MSL.
+    for (const char* kind : {"glsl", "spv", "reflection", "hlsl", "msl"}) {
+      if (!m.emits(kind)) continue;
+      if (std::string(kind) == "spv") {
+        b.outputs["spv"] = (fs::path(m.outputDir) / "spirv" / (b.spirvHash.substr(0, 16) + ".spv")).string();
+        if (spirvWritten.insert(b.spirvHash).second) report.files.push_back({b.outputs["spv"], b.spirv});
+        else ++report.sharedSpirv;
+      } else {
+        report.files.push_back({b.outputs[kind], *text.at(kind)});
+      }
       targets.push_back(b.outputs[kind]);
     }
     std::vector<std::string> deps{m.file};
     deps.insert(deps.end(), b.inputs.begin(), b.inputs.end());
     report.files.push_back({(fs::path(m.outputDir) / (v.name + ".d")).string(), makeDepfile(targets, deps)});
     allInputs.insert(b.inputs.begin(), b.inputs.end());
+    b.entry = indexEntry(m, b);
+    if (!opts.index) {
+      VariantEntryFiles ef = entryFiles(m, v);
+      report.files.push_back({ef.entry, entryText(b)});
+      report.files.push_back({ef.depfile, makeDepfile(ef.entry, b.inputs)});  // the manifest: PlannedVariant::stamp
+    }
   }
-  if (report.failed == 0) {
+  if (report.failed == 0 && opts.index) {
+    std::vector<std::string> entries;
+    for (const auto& b : report.variants) entries.push_back(b.entry);
+    for (auto& f : indexFiles(m, entries, allInputs)) report.files.push_back(std::move(f));
     report.indexPath = (fs::path(m.outputDir) / "index.json").string();
-    report.files.push_back({report.indexPath, indexJson(m, report)});
-    report.files.push_back({report.indexPath + ".d",
-                            makeDepfile({report.indexPath}, std::vector<std::string>(allInputs.begin(), allInputs.end()))});
   }
   return report;
+}
+
+VariantEntryFiles entryFiles(const Manifest& m, const Variant& v) {
+  std::string entry = (fs::path(m.outputDir) / ".shadergen-variants" / (v.name + ".entry")).string();
+  return {entry, entry + ".d"};
+}
+
+std::vector<OutputFile> joinIndex(const Manifest& m, const std::vector<Variant>& variants) {
+  std::vector<std::string> entries;
+  std::set<std::string> inputs{m.file};
+  for (const auto& v : variants) {
+    const std::string file = entryFiles(m, v).entry;
+    std::string text, entry;
+    std::vector<std::string> files;
+    std::ifstream in(file, std::ios::binary);
+    if (!in)
+      throw InputError(SourceLoc{m.file, 0, 0},
+                       fmt::format("variant '{}' has not been built: no '{}' (`shadergen build {} --variant {}` makes it)",
+                                   v.name, file, m.file, v.name));
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    if (!parseEntry(text, entry, files))
+      throw InputError(SourceLoc{file, 0, 0},
+                       fmt::format("not an entry of variant '{}' (damaged, or from another shadergen version): "
+                                   "build the variant again",
+                                   v.name));
+    entries.push_back(std::move(entry));
+    inputs.insert(files.begin(), files.end());
+  }
+  return indexFiles(m, entries, inputs);
+}
+
+std::vector<PlannedVariant> planVariants(const Manifest& m, const std::vector<Variant>& variants) {
+  std::vector<Diagnostic> warnings;  // the build that follows reports them
+  SharedInputs shared = loadShared(m, variants, GltfReadOptions{}, warnings);
+  std::vector<PlannedVariant> out;
+  for (const auto& v : variants) {
+    PlannedVariant p{inputsOf(shared, v), namedOutputs(m, v), ""};
+    Sha256 h;
+    h.field(cacheKey(m, shared, v, p.inputs, nullptr, false)).field(v.name).field(v.rig->name).field(v.pass->name).field(m.outputDir);
+    for (const auto& kind : m.emit) h.field(kind);
+    p.stamp = h.hex();
+    out.push_back(std::move(p));
+  }
+  return out;
 }
 
 }  // namespace sg

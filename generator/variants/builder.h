@@ -52,6 +52,9 @@ struct BuildOptions {
   std::function<void(const std::string&)> warn;  // cache warnings (under a lock)
   VariantValidator* validator = nullptr;         // validate every variant (nullptr = do not)
   unsigned jobs = 0;     // 0 = every hardware thread
+  // false: the index is left out; each variant leaves its index entry instead (entryFiles),
+  // for a build system that builds variants one by one and joins the entries (joinIndex).
+  bool index = true;
   // Called (under a lock) as each variant finishes.
   std::function<void(size_t done, size_t total, const std::string& variant, bool cached)> progress;
   // The workload each variant is priced for, by variant name (measured by the caller,
@@ -76,6 +79,7 @@ struct BuiltVariant {
   std::map<std::string, std::string> outputs;  // kind -> path written
   std::optional<ValidationResult> validation;  // when validated (passing, or why it failed)
   bool validationCached = false;                // the result came from the cache
+  std::string entry;                   // its element of index.json's "variants" (when ok)
 };
 
 struct OutputFile {
@@ -97,5 +101,36 @@ struct BuildReport {
 // templates) cannot be loaded; per-variant failures are reported in BuiltVariant::errors
 // and leave the index out of `files`.
 BuildReport buildVariants(const Manifest& m, const std::vector<Variant>& variants, const BuildOptions& opts);
+
+// ---- one build edge per variant (docs/variants.md, "One build edge per variant") --------
+// `build --variant NAME` is buildVariants() of that variant with index = false: its outputs
+// and depfile as a whole build writes them, plus its entry (<output>/.shadergen-variants/
+// NAME.entry: its index element and inputs) and the entry's depfile. `build --join` then
+// writes index.json and index.json.d from every variant's entry, byte-identical to the
+// whole build's.
+struct VariantEntryFiles {
+  std::string entry;    // <output>/.shadergen-variants/NAME.entry
+  std::string depfile;  // NAME.entry.d: the entry depends on the manifest and every input
+};
+VariantEntryFiles entryFiles(const Manifest& m, const Variant& v);
+
+// index.json and index.json.d from the entries of `variants`. Throws InputError naming a
+// variant whose entry is missing or unreadable.
+std::vector<OutputFile> joinIndex(const Manifest& m, const std::vector<Variant>& variants);
+
+// Every file each variant reads (its depfile's inputs, less the manifest), in the order of
+// `variants`, and the outputs named after it (kind -> path; the SPIR-V, named by its
+// content, is not known before the build): what a build system needs to give each variant
+// its own edge. Loads the inputs (rigs, rules, fragment shaders); generates nothing.
+struct PlannedVariant {
+  std::vector<std::string> inputs;
+  std::map<std::string, std::string> outputs;
+  // Changes when the manifest or the options change what the variant makes (its cache key
+  // less the files' contents, its name and outputs): the build system reruns it then, and
+  // not for every manifest edit (the inputs' contents are the depfile's business).
+  // Its entry's depfile lists its inputs but not the manifest, in favour of this.
+  std::string stamp;
+};
+std::vector<PlannedVariant> planVariants(const Manifest& m, const std::vector<Variant>& variants);
 
 }  // namespace sg

@@ -200,7 +200,9 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
                                     r.path.substr(0, r.path.size() - 2)));
     std::vector<GltfPart> parts;
     try {
-      parts = gltfParts(parseGltfRef(r.path, true).file);
+      const std::string model = parseGltfRef(r.path, true).file;
+      parts = gltfParts(model);
+      m.wholeModelFiles.push_back(model);
     } catch (const InputError& e) {
       y.fail(kv.second, fmt::format("rig '{}': {}: {}", r.name, e.diagnostic().loc.file, e.diagnostic().message));
     }

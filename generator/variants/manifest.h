@@ -70,6 +70,7 @@ struct Manifest {
   std::vector<std::string> rules;
   std::string templates;               // "" = the default templates
   std::vector<ManifestRig> rigs;
+  std::vector<std::string> wholeModelFiles;  // glTF files whose primitives became rigs (MODEL.glb#*)
   std::vector<ManifestPass> passes;
   std::vector<ManifestAxis> axes;      // in manifest order (the first varies slowest)
   std::vector<ManifestExclusion> exclude;

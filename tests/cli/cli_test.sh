@@ -439,6 +439,23 @@ EOF
   expect 1 "a variant that cannot be made" -- "$SG" build nine.yaml -o bad-out
   grep -q "error: variant 'face-color-influences9' failed" last.err && ok "failed variant named" || fail "$(cat last.err)"
   [ ! -e bad-out/index.json ] && ok "no index after a failure" || fail "index written despite a failure"
+  # One build edge per variant: --variant each, then --join, gives the whole build's index;
+  # a failing variant names itself and leaves no entry; --join names what is missing or damaged.
+  for v in $("$SG" build m.yaml --list); do "$SG" build m.yaml -o edges --variant "$v" -q || fail "--variant $v"; done
+  expect 0 "--join" -- "$SG" build m.yaml -o edges --join
+  cmp -s edges/index.json out/index.json && ok "--variant x6 + --join: the whole build's index" || fail "index differs"
+  head -c 40 edges/.shadergen-variants/face-depth-influences1.entry >cut && mv cut edges/.shadergen-variants/face-depth-influences1.entry
+  expect 1 "--join over a truncated entry" -- "$SG" build m.yaml -o edges --join
+  grep -q "face-depth-influences1.entry: error: not an entry of variant 'face-depth-influences1'" last.err &&
+    ok "truncated entry named" || fail "$(cat last.err)"
+  echo stale >edges/.shadergen-variants/face-color-influences9.entry
+  expect 1 "--variant of a variant that cannot be made" -- "$SG" build nine.yaml -o edges --variant face-color-influences9
+  grep -q "error: variant 'face-color-influences9' failed" last.err && [ ! -e edges/.shadergen-variants/face-color-influences9.entry ] &&
+    ok "failed variant named, no entry left" || fail "$(cat last.err)"
+  expect 1 "--join without that entry" -- "$SG" build nine.yaml -o edges --join
+  grep -q "variant 'face-color-influences9' has not been built" last.err && ok "missing entry named" || fail "$(cat last.err)"
+  expect 1 "--variant with an unknown name" -- "$SG" build m.yaml --variant nope
+  grep -q "m.yaml: error: no variant named 'nope'" last.err && ok "unknown variant named" || fail "$(cat last.err)"
   ;;
 
 device_profile)
