@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -383,12 +384,6 @@ std::string indexEntry(const Manifest& m, const BuiltVariant& b) {
                        "\"runs\": {}, \"worst_output\": {}, \"max_abs_error\": {:.17g}, \"max_rel_error\": {:.17g}}},\n",
                        jsonString(val->device), jsonString(val->driver), jsonString(val->tool), jsonString(val->made),
                        val->runs, jsonString(val->worstOutput), val->maxAbsError, val->maxRelError);
-  out += fmt::format("      \"validated\": {},\n", b.validation ? "true" : "false");
-  if (const auto& val = b.validation)  // where and when the result was made (cached with it)
-    out += fmt::format("      \"validation\": {{\"device\": {}, \"driver\": {}, \"shadergen\": {}, \"made\": {}, "
-                       "\"runs\": {}, \"worst_output\": {}, \"max_abs_error\": {:.17g}, \"max_rel_error\": {:.17g}}},\n",
-                       jsonString(val->device), jsonString(val->driver), jsonString(val->tool), jsonString(val->made),
-                       val->runs, jsonString(val->worstOutput), val->maxAbsError, val->maxRelError);
   std::string outputs;
   for (const auto& [kind, path] : b.outputs)
     outputs += fmt::format("{}{}: {}", outputs.empty() ? "" : ", ", jsonString(kind),
@@ -415,10 +410,10 @@ std::map<std::string, std::string> namedOutputs(const Manifest& m, const Variant
 }
 
 // A variant's entry file: its index element and its inputs, for joinIndex.
-constexpr const char* kEntryFormat = "shadergen-variant-entry 1";
+constexpr const char* kIndexEntryFormat = "shadergen-variant-entry 1";
 
 std::string entryText(const BuiltVariant& b) {
-  std::string out = fmt::format("{}\ninputs {}\n", kEntryFormat, b.inputs.size());
+  std::string out = fmt::format("{}\ninputs {}\n", kIndexEntryFormat, b.inputs.size());
   for (const auto& f : b.inputs) out += f + "\n";  // makeDepfile has refused paths with a newline
   return out + fmt::format("entry {}\n{}", b.entry.size(), b.entry);
 }
@@ -426,7 +421,7 @@ std::string entryText(const BuiltVariant& b) {
 bool parseEntry(const std::string& text, std::string& entry, std::vector<std::string>& inputs) {
   std::istringstream in(text);
   std::string line;
-  if (!std::getline(in, line) || line != kEntryFormat) return false;
+  if (!std::getline(in, line) || line != kIndexEntryFormat) return false;
   if (!std::getline(in, line) || line.rfind("inputs ", 0) != 0) return false;
   size_t n = 0, size = 0;
   try {
