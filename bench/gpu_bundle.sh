@@ -27,6 +27,12 @@ mkdir -p "$stage/sg/examples/heldout"
 cp "$root"/tests/validate/data/*.rig.yaml "$root"/tests/validate/data/*.frag "$root"/examples/threejs/*.frag \
   "$stage/sg/examples/heldout/"
 cp "$root/examples/threejs/mesh.rig.yaml" "$stage/sg/examples/heldout/threejs-mesh.rig.yaml"
+# Real models (../shared, when beside the checkout) and the requests the tests make of them.
+mkdir -p "$stage/sg/examples/models" "$stage/sg/examples/gltf"
+cp "$root"/tests/gltf/data/*.frag "$stage/sg/examples/gltf/"
+for m in CesiumMan/CesiumMan.glb RobotExpressive/RobotExpressive.glb Fox/Fox.glb RiggedFigure/RiggedFigure.glb; do
+  [ -f "$root/../shared/models/$m" ] && cp "$root/../shared/models/$m" "$stage/sg/examples/models/"
+done
 cp "$root/bench/gpu_env.sh" "$root/bench/gpu_run.sh" "$root/bench/gpu_calibrate.sh" "$root/bench/gpu_layouts.sh" \
   "$root/bench/gpu_collect.sh" "$stage/sg/"
 tar -C "$stage" -czf "$out" sg

@@ -1,31 +1,36 @@
 #!/usr/bin/env bash
 # Runs on the GPU machine, from the unpacked bundle (bench/gpu_bundle.sh): times every plan and
-# forced alternative of many (rig, request) pairs at Dawn scale and on the cached head, each
-# validated on the device first, and the probes once: the samples of `calibrate`, written as
-# one log per group, for fits and held-out checks made offline (docs/device-profiles.md,
-# "Held-out check"). Usage: bash gpu_collect.sh [DEVICE=NVIDIA] [OUTDIR=.]
+# forced alternative of many (rig, request) pairs, each validated on the device first, as
+# `calibrate` samples, one log per group (docs/device-profiles.md, "Held-out check"):
+#   train     the probes, the Dawn face's two layouts and a random corpus (the fit's data)
+#   world, body-depth, pbr, models   rigs and requests the fit never sees (the check's data)
+# Fits and the held-out check are made offline from the logs (shadergen calibrate --from-logs).
+# Usage: bash gpu_collect.sh [DEVICE=NVIDIA] [OUTDIR=.]; SG_BUDGET scales every group's time limit.
 set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
-device=${1:-NVIDIA}
+device=${1-NVIDIA}
 outdir=${2:-.}
 source "$here/gpu_env.sh"
-t=(--device "$device" --no-validation-layers --meshes "${SG_MESHES:-dawn,head}" --draws "${SG_DRAWS:-32}"
+t=(--no-validation-layers --meshes "${SG_MESHES:-dawn,head}" --draws "${SG_DRAWS:-32}"
    --frames "${SG_FRAMES:-7}" --rounds "${SG_ROUNDS:-2}" --refits 0 --no-check)
+[ -n "$device" ] && t+=(--device "$device")
 dawnRules=(-r "$here/examples/dawn/rules.yaml" --templates "$here/templates")
 std=(-r "$here/rules/standard.yaml" --templates "$here/templates")
 data="$here/examples/heldout"
-group() {  # group NAME ARGS...: one calibrate run, its log in OUTDIR/NAME.log
-  local name=$1; shift
-  echo "== $name"
+models="$here/examples/models"
+group() {  # group NAME SECONDS ARGS...: one calibrate run, its log in OUTDIR/NAME.log
+  local name=$1 limit=$2; shift 2
+  limit=$(awk -v l="$limit" -v s="${SG_BUDGET:-1}" 'BEGIN { printf "%d", l * s }')
   local t0=$SECONDS
-  "$sg" calibrate "${t[@]}" "$@" -o "$outdir/$name.yaml" > "$outdir/$name.log" 2>&1
-  echo "   exit $?, $((SECONDS - t0)) s"
+  timeout -s INT "$limit" "$sg" calibrate "${t[@]}" "$@" -o "${SG_PROFILE_DIR:-$outdir}/$name.yaml" > "$outdir/$name.log" 2>&1
+  echo "== $name: exit $?, $((SECONDS - t0)) s (limit $limit)"
 }
-group face --rig "$here/examples/dawn/face.rig.yaml" --rig "$here/examples/dawn/face-packed.rig.yaml" \
-  -f "$here/examples/dawn/face.frag" "${dawnRules[@]}"
-group body-depth --no-probes --rig "$here/examples/dawn/body.rig.yaml" --rig "$here/examples/dawn/face.rig.yaml" \
-  -f "$here/examples/dawn/depth.frag" "${dawnRules[@]}"
-group world --no-probes --rig "$data/limb16.rig.yaml" --rig "$data/limb8_palette300.rig.yaml" --rig "$data/face52.rig.yaml" \
-  --rig "$data/octahedral.rig.yaml" --rig "$data/qtangent.rig.yaml" -f "$data/world.frag" "${std[@]}"
-group pbr --no-probes --rig "$data/pbr_character.rig.yaml" --rig "$data/limb16.rig.yaml" --rig "$data/limb8_palette300.rig.yaml" \
+group train 230 --corpus "${SG_CORPUS:-16}" --seed 1 --rig "$here/examples/dawn/face.rig.yaml" \
+  --rig "$here/examples/dawn/face-packed.rig.yaml" -f "$here/examples/dawn/face.frag" "${dawnRules[@]}"
+group world 110 --no-probes --rig "$data/limb16.rig.yaml" --rig "$data/limb8_palette300.rig.yaml" \
+  --rig "$data/face52.rig.yaml" --rig "$data/octahedral.rig.yaml" --rig "$data/qtangent.rig.yaml" -f "$data/world.frag" "${std[@]}"
+group body-depth 30 --no-probes --rig "$here/examples/dawn/body.rig.yaml" -f "$here/examples/dawn/depth.frag" "${dawnRules[@]}"
+group pbr 70 --no-probes --rig "$data/pbr_character.rig.yaml" --rig "$data/limb8_palette300.rig.yaml" \
   -f "$data/standard_normalmap.frag" "${std[@]}"
+group models 90 --no-probes --rig "$models/CesiumMan.glb#*" --rig "$models/RobotExpressive.glb#*" \
+  -f "$here/examples/gltf/lit.frag" "${std[@]}"
