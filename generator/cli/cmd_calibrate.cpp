@@ -3,8 +3,11 @@
 #include <fmt/format.h>
 
 #include <iostream>
+#include <sstream>
 
 #include "cli/commands.h"
+#include "common/input_file.h"
+#include "cli/output_files.h"
 #include "cli/whole_model.h"
 #include "measure/calibrate.h"
 
@@ -19,8 +22,50 @@ struct CalibrateCommand {
   bool noCheck = false;
   bool noProbes = false;
   std::string form = "additive";
+  std::vector<std::string> fromLogs, checkLogs;
+
+  // Samples of earlier runs (the tables calibrate prints): the device line and its rows.
+  static std::vector<CalibrationSample> readLogs(const std::vector<std::string>& files, std::string* device) {
+    std::vector<CalibrationSample> all;
+    for (const auto& f : files) {
+      std::istringstream in(readInputFile(f));
+      std::string first;
+      std::getline(in, first);
+      if (device && device->empty() && first.rfind("device: ", 0) == 0) {
+        const size_t driver = first.find(" (driver: "), end = first.find(')', driver);
+        *device = driver == std::string::npos ? first.substr(8)
+                                              : first.substr(8, driver - 8) + " (" + first.substr(driver + 10, end - driver - 10) + ")";
+      }
+      for (auto& s : parseCalibrationSamples(in, {{"dawn", 180000}, {"head", 2009}})) all.push_back(std::move(s));
+    }
+    if (all.empty()) throw InputError(SourceLoc{files.front(), 0, 0}, "no calibration samples in these logs");
+    return all;
+  }
+
+  int refit() {
+    CalibrationReport rep;
+    rep.samples = readLogs(fromLogs, &rep.device);
+    rep.clock = "as recorded (" + std::to_string(fromLogs.size()) + " logs)";
+    rep.nearBestPower = co.nearBestPower;
+    rep.profile = fitDeviceProfile(rep.samples, rep.device, 180000, co.nearBestPower, co.form);
+    rep.fits = evaluateFit(rep.samples, rep.profile, {"dawn", "head"});
+    rep.heldOut = leaveOneRigOut(rep.samples, rep.device, 180000, co.nearBestPower, co.form);
+    if (!checkLogs.empty()) rep.check = checkHeldOut(readLogs(checkLogs, nullptr), rep.profile);
+    std::cout << formatCalibration(rep);
+    if (!output.empty()) {
+      std::vector<InputFile> inputs;
+      for (const auto& f : fromLogs) inputs.push_back({f, "a log"});
+      for (const auto& f : checkLogs) inputs.push_back({f, "a log"});
+      refuseClobbering({output}, inputs);
+      writeFilesAtomically({{output, deviceProfileYaml(rep)}});
+      std::cout << fmt::format("{}: device profile of {}\n", output, rep.device);
+    }
+    return 0;
+  }
 
   int run() {
+    co.form = form == "roofline" ? ProfileForm::Roofline : ProfileForm::Additive;
+    if (!fromLogs.empty()) return refit();
     co.validationLayers = !noLayers;
     co.meshes.clear();
     size_t start = 0;
@@ -104,6 +149,12 @@ void registerCalibrate(CLI::App& app, CliState& state) {
       ->check(CLI::Range(0, 1000));
   sub->add_option("--seed", cmd->co.corpusSeed, "The corpus's seed (default 1): the same seed, the same rigs");
   sub->add_flag("--no-check", cmd->noCheck, "With --rig: do not time the rigs' plans under the fitted profile afterwards");
+  sub->add_option("--from-log", cmd->fromLogs,
+                  "Fit the samples of earlier runs' logs (their tables) instead of measuring; no device is opened")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--check-log", cmd->checkLogs,
+                  "With --from-log: logs of rigs the fit must not see, predicted by the fitted profile (the held-out check)")
+      ->check(CLI::ExistingFile);
   sub->add_flag("--no-probes", cmd->noProbes, "With --rig: time only the rigs' programs (samples for another fit)");
   sub->add_option("--form", cmd->form, "The model fitted: additive (default) or roofline (docs/device-profiles.md)")
       ->check(CLI::IsMember({"additive", "roofline"}));

@@ -415,55 +415,54 @@ double medianOfFinite(std::vector<double> v) {
   return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
-std::string heldOutSummary(const LeaveOneRigOut& loo) {
-  return fmt::format("leave-one-rig-out over {} (rig, mesh) pairs: median Spearman {:.3f}, worst chosen / fastest {:.3f}, "
+std::string heldOutSummary(const LeaveOneRigOut& loo, const char* what = "leave-one-rig-out") {
+  return fmt::format("{} over {} (rig, mesh) pairs: median Spearman {:.3f}, worst chosen / fastest {:.3f}, "
                      "RMS relative error median {:.1f} %, max {:.1f} %",
-                     loo.rows.size(), loo.medianSpearman, loo.worstChosenOverFastest, 100 * loo.medianRms, 100 * loo.maxRms);
+                     what, loo.rows.size(), loo.medianSpearman, loo.worstChosenOverFastest, 100 * loo.medianRms, 100 * loo.maxRms);
 }
 
-}  // namespace
-
-LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
-                              double workloadVertices, double nearBestPower, ProfileForm form) {
-  LeaveOneRigOut out;
-  std::set<std::string> rigs;
+// Each (rig, mesh) of `rig` ("" = every rig) in `samples`: its plans predicted by `profile`.
+std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& samples, const std::string& rig,
+                                    const DeviceProfile& profile) {
+  std::vector<std::pair<std::string, std::string>> keys;  // (rig, mesh) in the samples' order
   for (const auto& s : samples)
-    if (!s.rig.empty()) rigs.insert(s.rig);
-  if (rigs.size() < 2) return out;
-  for (const auto& rig : rigs) {
-    std::vector<CalibrationSample> rest;
-    for (const auto& s : samples)
-      if (s.rig != rig) rest.push_back(s);
-    const DeviceProfile profile = fitDeviceProfile(rest, deviceName, workloadVertices, nearBestPower, form);
-    std::vector<std::string> meshes;  // in the samples' order
-    for (const auto& s : samples)
-      if (s.rig == rig && std::find(meshes.begin(), meshes.end(), s.mesh) == meshes.end()) meshes.push_back(s.mesh);
-    for (const auto& mesh : meshes) {
-      HeldOutRig h;
-      h.rig = rig;
-      h.mesh = mesh;
-      std::set<TermAmounts> seen;  // a plan timed twice (chosen by two profiles) counts once
-      for (const auto& s : samples) {
-        if (s.rig != rig || s.mesh != mesh || !isPlanSample(s) || !s.validated || s.measuredNs <= 0) continue;
-        if (!seen.insert(s.amounts).second) continue;
-        h.predicted.push_back(profile.predictNanoseconds(s.amounts, s.vertices));
-        h.measured.push_back(s.measuredNs);
-      }
-      h.plans = h.measured.size();
-      if (h.plans == 0) continue;
-      double sq = 0;
-      size_t best = 0;
-      for (size_t i = 0; i < h.plans; ++i) {
-        const double rel = (h.predicted[i] - h.measured[i]) / h.measured[i];
-        sq += rel * rel;
-        if (h.predicted[i] < h.predicted[best]) best = i;
-      }
-      h.rmsRelativeError = std::sqrt(sq / double(h.plans));
-      h.chosenOverFastest = h.measured[best] / *std::min_element(h.measured.begin(), h.measured.end());
-      h.spearman = spearmanWithinSpread(h.predicted, h.measured, 0.005);
-      out.rows.push_back(std::move(h));
+    if (!s.rig.empty() && (rig.empty() || s.rig == rig) &&
+        std::find(keys.begin(), keys.end(), std::make_pair(s.rig, s.mesh)) == keys.end())
+      keys.emplace_back(s.rig, s.mesh);
+  std::vector<HeldOutRig> rows;
+  for (const auto& [r, mesh] : keys) {
+    HeldOutRig h;
+    h.rig = r;
+    h.mesh = mesh;
+    std::set<TermAmounts> seen;  // a plan timed twice (chosen by two profiles) counts once
+    for (const auto& s : samples) {
+      if (s.rig != r || s.mesh != mesh || !isPlanSample(s) || !s.validated || s.measuredNs <= 0) continue;
+      if (!seen.insert(s.amounts).second) continue;
+      DeviceProfile at = profile;
+      at.workload = s.workload;
+      h.predicted.push_back(at.predictNanoseconds(s.amounts, s.vertices));
+      h.measured.push_back(s.measuredNs);
     }
+    h.plans = h.measured.size();
+    if (h.plans == 0) continue;
+    double sq = 0;
+    size_t best = 0;
+    for (size_t i = 0; i < h.plans; ++i) {
+      const double rel = (h.predicted[i] - h.measured[i]) / h.measured[i];
+      sq += rel * rel;
+      if (h.predicted[i] < h.predicted[best]) best = i;
+    }
+    h.rmsRelativeError = std::sqrt(sq / double(h.plans));
+    h.chosenOverFastest = h.measured[best] / *std::min_element(h.measured.begin(), h.measured.end());
+    h.spearman = spearmanWithinSpread(h.predicted, h.measured, 0.005);
+    rows.push_back(std::move(h));
   }
+  return rows;
+}
+
+LeaveOneRigOut summarise(std::vector<HeldOutRig> rows) {
+  LeaveOneRigOut out;
+  out.rows = std::move(rows);
   std::vector<double> rho, rms;
   for (const auto& h : out.rows) {
     rho.push_back(h.spearman);
@@ -476,6 +475,29 @@ LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, con
   return out;
 }
 
+}  // namespace
+
+LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
+                              double workloadVertices, double nearBestPower, ProfileForm form) {
+  std::set<std::string> rigs;
+  for (const auto& s : samples)
+    if (!s.rig.empty()) rigs.insert(s.rig);
+  if (rigs.size() < 2) return {};
+  std::vector<HeldOutRig> rows;
+  for (const auto& rig : rigs) {
+    std::vector<CalibrationSample> rest;
+    for (const auto& s : samples)
+      if (s.rig != rig) rest.push_back(s);
+    const DeviceProfile profile = fitDeviceProfile(rest, deviceName, workloadVertices, nearBestPower, form);
+    for (auto& h : predictRigs(samples, rig, profile)) rows.push_back(std::move(h));
+  }
+  return summarise(std::move(rows));
+}
+
+LeaveOneRigOut checkHeldOut(const std::vector<CalibrationSample>& heldOut, const DeviceProfile& profile) {
+  return summarise(predictRigs(heldOut, "", profile));
+}
+
 std::string formatLeaveOneRigOut(const LeaveOneRigOut& loo) {
   if (loo.rows.empty()) return "";
   std::string s = "\nleave-one-rig-out: each rig's plans predicted by the profile fitted without that rig\n\n"
@@ -484,6 +506,16 @@ std::string formatLeaveOneRigOut(const LeaveOneRigOut& loo) {
     s += fmt::format("| {} | {} | {} | {:.3f} | {:.3f} | {:.1f} % |\n", h.rig, h.mesh, h.plans, h.spearman, h.chosenOverFastest,
                      100 * h.rmsRelativeError);
   return s + heldOutSummary(loo) + "\n";
+}
+
+std::string formatHeldOutCheck(const LeaveOneRigOut& check) {
+  if (check.rows.empty()) return "";
+  std::string s = "\nheld-out check: rigs and requests no fit saw, their plans predicted by the profile\n\n"
+                  "| rig | mesh | plans | Spearman | chosen / fastest | RMS relative error |\n|---|---|---:|---:|---:|---:|\n";
+  for (const auto& h : check.rows)
+    s += fmt::format("| {} | {} | {} | {:.3f} | {:.3f} | {:.1f} % |\n", h.rig, h.mesh, h.plans, h.spearman, h.chosenOverFastest,
+                     100 * h.rmsRelativeError);
+  return s + heldOutSummary(check, "held-out check") + "\n";
 }
 
 std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, const std::map<std::string, double>& meshVertices) {
@@ -496,11 +528,20 @@ std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, cons
       const size_t a = cell.find_first_not_of(' '), b = cell.find_last_not_of(' ');
       cells.push_back(a == std::string::npos ? "" : cell.substr(a, b - a + 1));
     }
-    // "| mesh | rig | program | amounts... | measured | predicted |", with the empty first cell.
-    if (cells.size() != 6 + size_t(kTermCount) || !meshVertices.count(cells[1])) continue;
+    // "| mesh | rig | program | amounts... | measured | predicted |", with the empty first cell;
+    // since issue 33 also "| joints per warp | vertices per draw |" (any mesh, "own" too).
+    const bool workload = cells.size() == 8 + size_t(kTermCount);
+    if (cells.size() != 6 + size_t(kTermCount) && !workload) continue;
+    if (!workload && !meshVertices.count(cells[1])) continue;
     CalibrationSample s;
     s.mesh = cells[1];
-    s.vertices = meshVertices.at(s.mesh);
+    try {
+      s.vertices = workload ? std::stod(cells[7 + size_t(kTermCount)]) : meshVertices.at(s.mesh);
+      if (workload) s.workload.jointsPerWarp = std::stod(cells[6 + size_t(kTermCount)]);
+    } catch (const std::exception&) {
+      continue;
+    }
+    if (workload) s.workload.verticesPerDraw = s.vertices;
     s.rig = cells[2] == "—" ? "" : cells[2];
     s.label = cells[3];
     s.fitted = s.label.rfind("checked plan", 0) != 0;
@@ -778,14 +819,16 @@ std::string fitLine(const CalibrationFit& f) {
 std::string formatCalibration(const CalibrationReport& r) {
   std::string s = fmt::format("device: {} (driver: {}); clock: {}\n\n| mesh | rig | program | ", r.device, r.driver, r.clock);
   for (int t = 0; t < kTermCount; ++t) s += fmt::format("{} | ", termName(t));
-  s += "measured ns/vertex | predicted |\n|---|---|---|";
+  s += "measured ns/vertex | predicted | joints per warp | vertices per draw |\n|---|---|---|";
   for (int t = 0; t < kTermCount; ++t) s += "---:|";
-  s += "---:|---:|\n";
+  s += "---:|---:|---:|---:|\n";
   for (const auto& x : r.samples) {
     s += fmt::format("| {} | {} | {} | ", x.mesh, x.rig.empty() ? "—" : x.rig, x.label);
     for (int t = 0; t < kTermCount; ++t) s += fmt::format("{} | ", x.amounts[size_t(t)]);
-    s += x.validated ? fmt::format("{:.4f} | {:.4f} |\n", x.measuredNs, x.predictedNs)
-                     : fmt::format("FAILED, not timed: {} | — |\n", x.failure);
+    s += x.validated ? fmt::format("{:.4f} | {:.4f} | ", x.measuredNs, x.predictedNs)
+                     : fmt::format("FAILED, not timed: {} | — | ", x.failure);
+    // The workload it was timed on: the fit scales terms by it, so a log refits (--from-log).
+    s += fmt::format("{:.4f} | {:g} |\n", x.workload.jointsPerWarp, x.vertices);
   }
   s += "\nfitted (ns per unit per vertex; draw weights: ns per unit per draw):\n" + weightLines(r.profile);
   for (const auto& f : r.fits) s += fitLine(f) + "\n";
@@ -794,6 +837,7 @@ std::string formatCalibration(const CalibrationReport& r) {
                      "the chosen plan takes {:.3f}x the fastest\n",
                      c.rig, c.mesh, c.plans, c.spearman, c.generatedOverFastest);
   s += formatLeaveOneRigOut(r.heldOut);
+  s += formatHeldOutCheck(r.check);
   for (const auto& n : r.notes) s += "note: " + n + "\n";
   return s;
 }
@@ -810,6 +854,8 @@ std::string deviceProfileYaml(const CalibrationReport& r) {
     s += fmt::format("# check of {} on '{}': {} plans, Spearman {:.3f}, chosen plan {:.3f}x the fastest\n", c.rig, c.mesh, c.plans,
                      c.spearman, c.generatedOverFastest);
   if (!r.heldOut.rows.empty()) s += "# " + heldOutSummary(r.heldOut) + "\n";
+  if (!r.check.rows.empty()) s += "# " + heldOutSummary(r.check, "held-out check") + "\n";
+  if (!r.profile.pipes.empty() || r.nearBestPower >= 0) s += fmt::format("# form: {}\n", r.profile.pipes.empty() ? "additive" : "roofline");
   s += fmt::format("device: \"{}\"\nunit: ns\n", r.profile.device);
   return s + weightLines(r.profile);
 }

@@ -115,6 +115,10 @@ struct LeaveOneRigOut {
 LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
                               double workloadVertices, double nearBestPower, ProfileForm form = ProfileForm::Additive);
 std::string formatLeaveOneRigOut(const LeaveOneRigOut& loo);
+// The held-out check: each (rig, mesh) of samples no fit saw, its plans predicted by `profile`
+// (same figures as leave-one-rig-out).
+LeaveOneRigOut checkHeldOut(const std::vector<CalibrationSample>& heldOut, const DeviceProfile& profile);
+std::string formatHeldOutCheck(const LeaveOneRigOut& check);
 
 struct CalibrationReport {
   std::string device, driver;
@@ -125,6 +129,7 @@ struct CalibrationReport {
   std::vector<CalibrationFit> fits;  // one per mesh
   std::vector<CalibrationCheck> checks;
   LeaveOneRigOut heldOut;  // with two rigs or more
+  LeaveOneRigOut check;    // rigs no fit saw (calibrate --check-log)
   std::vector<std::string> notes;  // corpus cases left out, and why
 };
 
