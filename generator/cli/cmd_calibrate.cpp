@@ -2,6 +2,7 @@
 // (docs/device-profiles.md).
 #include <fmt/format.h>
 
+#include <filesystem>
 #include <iostream>
 #include <sstream>
 
@@ -23,6 +24,7 @@ struct CalibrateCommand {
   bool noProbes = false;
   std::string form = "additive";
   std::vector<std::string> fromLogs, checkLogs;
+  std::string evaluate;  // --evaluate PROFILE: the held-out check of an existing profile
 
   // Samples of earlier runs (the tables calibrate prints): the device line and its rows.
   static std::vector<CalibrationSample> readLogs(const std::vector<std::string>& files, std::string* device) {
@@ -45,7 +47,9 @@ struct CalibrateCommand {
   int refit() {
     CalibrationReport rep;
     rep.samples = readLogs(fromLogs, &rep.device);
-    rep.clock = "as recorded (" + std::to_string(fromLogs.size()) + " logs)";
+    rep.clock = "as recorded in";
+    for (const auto& f : fromLogs) rep.clock += " " + std::filesystem::path(f).filename().string();
+    rep.driver = "as recorded (see the device)";
     rep.nearBestPower = co.nearBestPower;
     rep.profile = fitDeviceProfile(rep.samples, rep.device, 180000, co.nearBestPower, co.form);
     rep.fits = evaluateFit(rep.samples, rep.profile, {"dawn", "head"});
@@ -66,6 +70,14 @@ struct CalibrateCommand {
   int run() {
     co.form = form == "roofline" ? ProfileForm::Roofline : ProfileForm::Additive;
     if (!fromLogs.empty()) return refit();
+    if (!evaluate.empty()) {
+      if (checkLogs.empty()) throw CLI::ValidationError("--evaluate", "needs --check-log (the samples to predict)");
+      CalibrationReport rep;
+      rep.profile = loadDeviceProfile(evaluate);
+      rep.check = checkHeldOut(readLogs(checkLogs, nullptr), rep.profile);
+      std::cout << formatHeldOutCheck(rep.check);
+      return 0;
+    }
     co.validationLayers = !noLayers;
     co.meshes.clear();
     size_t start = 0;
@@ -154,6 +166,9 @@ void registerCalibrate(CLI::App& app, CliState& state) {
       ->check(CLI::ExistingFile);
   sub->add_option("--check-log", cmd->checkLogs,
                   "With --from-log: logs of rigs the fit must not see, predicted by the fitted profile (the held-out check)")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--evaluate", cmd->evaluate,
+                  "With --check-log: predict the logs' plans with this device profile (no fit, no device)")
       ->check(CLI::ExistingFile);
   sub->add_flag("--no-probes", cmd->noProbes, "With --rig: time only the rigs' programs (samples for another fit)");
   sub->add_option("--form", cmd->form, "The model fitted: additive (default) or roofline (docs/device-profiles.md)")

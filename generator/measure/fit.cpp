@@ -173,6 +173,14 @@ FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form) {
   double workload = 0;
   for (const FitRow& r : rows) workload = std::max(workload, r.vertices);
   out.profile = toProfile(skeleton, l, best, workload);
+  // Where a generation's mesh is unknown, price it like the median mesh the fit saw.
+  std::vector<double> joints;
+  for (const FitRow& r : rows)
+    if (r.workload.jointsPerWarp > 0) joints.push_back(r.workload.jointsPerWarp);
+  if (!joints.empty()) {
+    std::nth_element(joints.begin(), joints.begin() + static_cast<long>(joints.size() / 2), joints.end());
+    out.profile.workloadDefaults[kFeatureJointsPerWarp] = joints[joints.size() / 2];
+  }
   double sq = 0;
   for (const FitRow& r : rows) {
     DeviceProfile at = out.profile;
