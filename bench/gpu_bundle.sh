@@ -34,6 +34,6 @@ for m in CesiumMan/CesiumMan.glb RobotExpressive/RobotExpressive.glb Fox/Fox.glb
   [ -f "$root/../shared/models/$m" ] && cp "$root/../shared/models/$m" "$stage/sg/examples/models/"
 done
 cp "$root/bench/gpu_env.sh" "$root/bench/gpu_run.sh" "$root/bench/gpu_calibrate.sh" "$root/bench/gpu_layouts.sh" \
-  "$root/bench/gpu_collect.sh" "$stage/sg/"
+  "$root/bench/gpu_collect.sh" "$root/bench/gpu_verify.sh" "$stage/sg/"
 tar -C "$stage" -czf "$out" sg
 echo "$out: $(du -h "$out" | cut -f1)"
