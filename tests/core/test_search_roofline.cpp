@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "random_library.h"
+#include "search/device_profile.h"
 #include "search/ip_oracle.h"
 #include "search/problem.h"
 #include "search/regression.h"
@@ -200,6 +201,53 @@ TEST(SearchRoofline, OneComponentIsTheSum) {
       EXPECT_EQ(before->actions, after->actions);
       EXPECT_EQ(before->cost, after->cost);
     }
+  }
+}
+
+}  // namespace
+}  // namespace sg
+
+namespace sg {
+namespace {
+
+// A portable choice (docs/device-profiles.md, "Portable plans"): three ways to one goal; device
+// A pays locations, device B pays buffer loads. "fetch" is A's best (2 vs B's 10), "load" is
+// B's best (2 vs A's 10), "mixed" costs 3 on both: regrets fetch 5x (on B), load 5x (on A),
+// mixed 1.5x on both. The least worst-case regret is "mixed", though neither device prefers it.
+TEST(SearchRoofline, APortablePlanMinimisesTheWorstRegret) {
+  Problem p;
+  p.facts = {Fact{"in"}, Fact{"out"}};
+  p.init = {0};
+  p.goals = {1};
+  auto way = [&](const char* name, int locations, int loads) {
+    Action a{name, static_cast<int>(p.actions.size()), {0}, 1};
+    a.terms[kTermLocations] = locations;
+    a.terms[kTermBufferLoads] = loads;
+    p.actions.push_back(a);
+  };
+  way("fetch", 2, 10);
+  way("load", 10, 2);
+  way("mixed", 3, 3);
+  DeviceProfile a, b;
+  a.device = "A";
+  a.nanoseconds[kTermLocations] = 1;
+  b.device = "B";
+  b.nanoseconds[kTermBufferLoads] = 1;
+  std::vector<int64_t> best;
+  for (const DeviceProfile* d : {&a, &b}) {
+    Problem one = p;
+    applyDeviceProfile(one, *d);
+    auto plan = solveWith(one, "auto");
+    ASSERT_TRUE(plan);
+    best.push_back(plan->cost);
+  }
+  EXPECT_EQ(best, (std::vector<int64_t>{2 * kFemtosecondsPerNanosecond, 2 * kFemtosecondsPerNanosecond}));
+  applyPortableProfiles(p, {a, b}, best);
+  for (const char* engine : {"auto", "ip"}) {
+    auto plan = solveWith(p, engine);
+    ASSERT_TRUE(plan) << engine;
+    EXPECT_EQ(p.actions[plan->actions[0]].name, "mixed") << engine;
+    EXPECT_EQ(plan->cost, kRegretScale * 3 / 2) << engine;  // 1.5x the best on both devices
   }
 }
 
