@@ -64,6 +64,9 @@ struct RenderCommand {
 
   int run() {
     ro.gen = args.resolve();
+    // Priced for the model's own mesh under a profile, as generate prices it.
+    if (!ro.gen.deviceProfilePath.empty() && isGltfPath(ro.gen.rigPath) && !wholeModelParts(ro.gen.rigPath))
+      measureWorkloadOf(ro.gen, "");
     ro.limits = {!ro.device.empty(), args.maxAttributes->count() > 0, args.maxUniformBytes->count() > 0};
     ro.validationLayers = !noLayers;
     if (morphWeight) {

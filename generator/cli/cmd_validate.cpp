@@ -108,6 +108,10 @@ struct ValidateCommand {
     vo.checkFloatData = !noFloatCheck;
     vo.strict = strict;
     vo.keepOutputs = !saveOutputs.empty();
+    // Under a device profile a glTF rig is priced for its own mesh, as `generate` prices it, so
+    // the plan validated is the plan generated (a YAML rig: unknown, as generate without --mesh).
+    if (!vo.gen.deviceProfilePath.empty() && isGltfPath(vo.gen.rigPath) && !wholeModelParts(vo.gen.rigPath))
+      measureWorkloadOf(vo.gen, "");
     ValidationScene scene;
     std::string what;
     bool gltf = isGltfPath(vo.gen.rigPath);
@@ -204,6 +208,7 @@ struct ValidateCommand {
       GltfImport model = importGltf(parseGltfRef(part.ref).file, io);
       GenerateOptions gen = vo.gen;
       gen.rigPath = part.ref;
+      if (!gen.deviceProfilePath.empty()) measureWorkloadOf(gen, "");  // as generate prices each part
       GltfSceneInfo info;
       done[i] = validatePrimitive(v, model, gen, so, part.name, info);
       if (header.empty()) {
