@@ -256,13 +256,23 @@ Plan searchUnderOptions(LoadedInputs& in, const GenerateOptions& opts, SearchSta
   return searchStage(in, search, stats);
 }
 
+// A profile prices the workload of the generation: the draw's vertices (its per-draw weights)
+// and the mesh's features (terms scaled by one), each where known. Here, so that every path
+// that prepares inputs (generate, build's variants) prices alike.
+DeviceProfile pricedFor(DeviceProfile d, const GenerateOptions& opts) {
+  d.workload = opts.workload;
+  const double vertices = opts.maxVertices > 0 ? double(opts.maxVertices) : opts.workload.verticesPerDraw;
+  if (d.hasDrawWeights() && vertices > 0) d.verticesPerDraw = vertices;
+  return d;
+}
+
 LoadedInputs instantiateAndPrice(Rig rig, const RuleSet& rules, const FragmentInterface& fragment,
                                  const GenerateOptions& opts, const std::optional<DeviceProfile>& profile,
                                  const std::vector<DeviceProfile>& portable) {
   LoadedInputs in = instantiateStage(std::move(rig), rules, fragment, opts.overrides, opts.conventions);
   in.workload = opts.workload;  // before pricing: a profile's weights may depend on it
-  if (profile) priceStage(in, *profile);
-  in.portable = portable;
+  if (profile) priceStage(in, pricedFor(*profile, opts));
+  for (const DeviceProfile& d : portable) in.portable.push_back(pricedFor(d, opts));
   return in;
 }
 
@@ -347,16 +357,8 @@ LoadedInputs loadInputs(const GenerateOptions& opts) {
   std::vector<DeviceProfile> portable;
   if (!opts.portableProfilePaths.empty() && opts.deviceProfilePath.empty())
     throw InputError(SourceLoc{}, "a portable choice needs at least two device profiles (--device-profile given twice)");
-  // A profile prices the workload given: the draw's vertices (for per-draw weights) and the
-  // mesh's features (for terms scaled by one), each where known.
-  auto forWorkload = [&](DeviceProfile d) {
-    d.workload = opts.workload;
-    const double vertices = opts.maxVertices > 0 ? double(opts.maxVertices) : opts.workload.verticesPerDraw;
-    if (d.hasDrawWeights() && vertices > 0) d.verticesPerDraw = vertices;
-    return d;
-  };
-  if (!opts.deviceProfilePath.empty()) profile = forWorkload(loadDeviceProfileStage(opts.deviceProfilePath));
-  for (const std::string& path : opts.portableProfilePaths) portable.push_back(forWorkload(loadDeviceProfileStage(path)));
+  if (!opts.deviceProfilePath.empty()) profile = loadDeviceProfileStage(opts.deviceProfilePath);
+  for (const std::string& path : opts.portableProfilePaths) portable.push_back(loadDeviceProfileStage(path));
   LoadedInputs in = prepareInputs(std::move(rig), rules, fragment, opts, profile, portable);
   for (const auto& b : opts.bannedRules)  // a misspelt --ban would otherwise change nothing silently
     if (std::none_of(in.rules.rules.begin(), in.rules.rules.end(), [&](const Rule& r) { return r.name == b; }))

@@ -199,8 +199,10 @@ std::optional<ValidationResult> parseValidation(const std::string& body) {
 
 // What `generate` is given to make this variant (the build loads the files once and
 // prepares from them; the validator regenerates the capture build from these).
-GenerateOptions generateOptionsOf(const Manifest& m, const Variant& v) {
+GenerateOptions generateOptionsOf(const Manifest& m, const Variant& v, const BuildOptions& opts) {
   GenerateOptions o;
+  if (auto w = opts.workloads.find(v.name); w != opts.workloads.end()) o.workload = w->second;
+  o.gltf = opts.gltf;
   o.rigPath = v.rig->path;
   o.fragmentPath = v.pass->fragment;
   o.rulesPaths = m.rules;
@@ -219,7 +221,7 @@ GenerateOptions generateOptionsOf(const Manifest& m, const Variant& v) {
 
 // ---- one variant ------------------------------------------------------------------------
 
-void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v, const Workload* workload, BuiltVariant& out) {
+void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v, const BuildOptions& opts, BuiltVariant& out) {
   const Rig& base = s.rigs.at(v.rig->path);
   SourceLoc paramsAt{m.file, 0, 0};
   for (const auto& a : m.axes)
@@ -228,8 +230,7 @@ void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v,
       break;
     }
   Rig rig = v.params.empty() ? base : rigWithParameters(base, v.params, paramsAt);
-  GenerateOptions o = generateOptionsOf(m, v);
-  if (workload) o.workload = *workload;
+  GenerateOptions o = generateOptionsOf(m, v, opts);
   if (m.emits("hlsl")) o.hlsl = m.hlsl;
   if (m.emits("msl")) o.msl = m.msl;
   LoadedInputs in = prepareInputs(std::move(rig), s.rules, s.fragments.at(v.pass->fragment), o, s.profile);
@@ -264,7 +265,7 @@ void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts
     out.ok = out.cached = true;
   } else {
     try {
-      generateVariant(m, s, v, workload, out);
+      generateVariant(m, s, v, opts, out);
       out.ok = true;
       if (store.enabled()) store.put(out.key, generatedBody(out));
     } catch (const InputError& e) {
@@ -286,10 +287,7 @@ void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts
     }
   }
   try {
-    GenerateOptions o = generateOptionsOf(m, v);  // priced and read as it was generated
-    if (workload) o.workload = *workload;
-    o.gltf = opts.gltf;
-    out.validation = opts.validator->validate(v, o);
+    out.validation = opts.validator->validate(v, generateOptionsOf(m, v, opts));  // as it was generated
   } catch (const InputError& e) {
     out.validation = ValidationResult{};
     out.validation->errors.push_back(e.diagnostic());

@@ -11,6 +11,7 @@
 #include <fstream>
 
 #include "pipeline/generate.h"
+#include "pipeline/stages.h"
 #include "search/device_profile.h"
 #include "search/ip_oracle.h"
 
@@ -121,6 +122,31 @@ TEST(DawnProfile, TheMeasuredH200ProfileReadsFewLocations) {
     ASSERT_TRUE(plan);
     EXPECT_EQ(plan->cost, r.plan.cost) << vertices;
   }
+}
+
+// The workload reaches the prices on every path that prepares inputs: `build` loads a profile
+// once and prepares each variant from it (prepareInputs), as generate does after loading. A
+// profile that prices indexed uniform loads per joint a warp reads must make the palette three
+// times dearer on a mesh with three joints per warp than on one with one.
+TEST(DawnProfile, PreparedInputsArePricedForTheirWorkload) {
+  const DeviceProfile profile = parseDeviceProfile(
+      "device: d\nweights:\n  indexed_uniform_loads: 1\nscaled_by:\n  indexed_uniform_loads: joints_per_warp\n",
+      "per-joint.yaml");
+  const Rig rig = loadRigStage(kDawn + "face.rig.yaml");
+  const RuleSet rules = loadRulesStage({kDawn + "rules.yaml"});
+  const FragmentInterface fragment = loadFragmentStage(kDawn + "face.frag", TargetEnv::Vulkan1_0);
+  auto paletteCost = [&](double jointsPerWarp) {
+    GenerateOptions o;
+    o.workload.jointsPerWarp = jointsPerWarp;
+    const LoadedInputs in = prepareInputs(rig, rules, fragment, o, profile);
+    int64_t cost = -1;
+    for (const Action& a : in.problem.actions)
+      if (a.terms[kTermIndexedUniformLoads] > 0 && a.name == "skin_matrix_blend") cost = a.cost;
+    return cost;
+  };
+  const int64_t one = paletteCost(1), three = paletteCost(3);
+  ASSERT_GT(one, 0) << "skin_matrix_blend reads the palette at a per-vertex index";
+  EXPECT_EQ(three, 3 * one);
 }
 
 }  // namespace
