@@ -498,24 +498,29 @@ LeaveOneRigOut checkHeldOut(const std::vector<CalibrationSample>& heldOut, const
   return summarise(predictRigs(heldOut, "", profile));
 }
 
-std::string formatLeaveOneRigOut(const LeaveOneRigOut& loo) {
-  if (loo.rows.empty()) return "";
-  std::string s = "\nleave-one-rig-out: each rig's plans predicted by the profile fitted without that rig\n\n"
-                  "| held-out rig | mesh | plans | Spearman | chosen / fastest | RMS relative error |\n|---|---|---:|---:|---:|---:|\n";
-  for (const auto& h : loo.rows)
+namespace {
+
+// One table of held-out predictions (rig, mesh, plans and the figures), then its summary.
+std::string heldOutTable(const LeaveOneRigOut& t, const char* what, const char* meaning, const char* rigColumn) {
+  if (t.rows.empty()) return "";
+  std::string s = fmt::format("\n{}: {}\n\n| {} | mesh | plans | Spearman | chosen / fastest | RMS relative error |\n"
+                              "|---|---|---:|---:|---:|---:|\n",
+                              what, meaning, rigColumn);
+  for (const auto& h : t.rows)
     s += fmt::format("| {} | {} | {} | {:.3f} | {:.3f} | {:.1f} % |\n", h.rig, h.mesh, h.plans, h.spearman, h.chosenOverFastest,
                      100 * h.rmsRelativeError);
-  return s + heldOutSummary(loo) + "\n";
+  return s + heldOutSummary(t, what) + "\n";
+}
+
+}  // namespace
+
+std::string formatLeaveOneRigOut(const LeaveOneRigOut& loo) {
+  return heldOutTable(loo, "leave-one-rig-out", "each rig's plans predicted by the profile fitted without that rig",
+                      "held-out rig");
 }
 
 std::string formatHeldOutCheck(const LeaveOneRigOut& check) {
-  if (check.rows.empty()) return "";
-  std::string s = "\nheld-out check: rigs and requests no fit saw, their plans predicted by the profile\n\n"
-                  "| rig | mesh | plans | Spearman | chosen / fastest | RMS relative error |\n|---|---|---:|---:|---:|---:|\n";
-  for (const auto& h : check.rows)
-    s += fmt::format("| {} | {} | {} | {:.3f} | {:.3f} | {:.1f} % |\n", h.rig, h.mesh, h.plans, h.spearman, h.chosenOverFastest,
-                     100 * h.rmsRelativeError);
-  return s + heldOutSummary(check, "held-out check") + "\n";
+  return heldOutTable(check, "held-out check", "rigs and requests no fit saw, their plans predicted by the profile", "rig");
 }
 
 std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, const std::map<std::string, double>& meshVertices) {

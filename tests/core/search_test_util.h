@@ -78,10 +78,11 @@ constexpr int64_t kNone = -1;  // exhaustiveOptimum: no feasible plan
 
 // Exhaustive: every subset of actions, its delete-free closure from init; feasible if the
 // goals are covered and the resource items read by the actions that fire (and by the goals
-// the rig provides) fit every limit. Cost: the fired actions, each distinct item read (paid
-// once: a device profile's inputs), and the fixed cost. The cheapest feasible subset, or
-// kNone. Written from the definition, sharing nothing with the engines but the Problem.
-inline int64_t exhaustiveOptimum(const Problem& p) {
+// the rig provides) fit every limit. `cost(fired, items)` prices a feasible subset (fired:
+// per action; items: each distinct input read once); the cheapest, or kNone. Written from the
+// definition, sharing nothing with the engines but the Problem.
+template <class Cost>
+int64_t exhaustiveMinimum(const Problem& p, Cost&& cost) {
   const size_t n = p.actions.size();
   if (n > 20) throw std::logic_error("instance too large for the exhaustive solver");
   int64_t best = kNone;
@@ -99,26 +100,35 @@ inline int64_t exhaustiveOptimum(const Problem& p) {
       }
     }
     if (!std::all_of(p.goals.begin(), p.goals.end(), [&](int g) { return have[g]; })) continue;
-    int64_t cost = p.fixedCost;
     std::set<int> items;
-    for (size_t a = 0; a < n; ++a) {
-      if (!fired[a]) continue;
-      cost += p.actions[a].cost;
-      for (int q : p.actions[a].pre)
-        if (p.facts[q].resource >= 0) items.insert(p.facts[q].resource);
-    }
+    for (size_t a = 0; a < n; ++a)
+      if (fired[a])
+        for (int q : p.actions[a].pre)
+          if (p.facts[q].resource >= 0) items.insert(p.facts[q].resource);
     for (int g : p.goals)
       if (p.facts[g].resource >= 0) items.insert(p.facts[g].resource);
     std::vector<int64_t> use(p.limits.size(), 0);
-    for (int i : items) {
-      cost += p.resources[i].cost;
+    for (int i : items)
       if (static_cast<size_t>(p.resources[i].limit) < use.size()) use[p.resources[i].limit] += p.resources[i].amount;
-    }
     bool fits = true;
     for (size_t l = 0; l < use.size(); ++l) fits = fits && use[l] <= p.limits[l].max;
-    if (fits && (best == kNone || cost < best)) best = cost;
+    if (!fits) continue;
+    const int64_t c = cost(fired, items);
+    if (best == kNone || c < best) best = c;
   }
   return best;
+}
+
+// The additive cost: the fired actions, each distinct item read (paid once: a device
+// profile's inputs), and the fixed cost.
+inline int64_t exhaustiveOptimum(const Problem& p) {
+  return exhaustiveMinimum(p, [&](const std::vector<bool>& fired, const std::set<int>& items) {
+    int64_t cost = p.fixedCost;
+    for (size_t a = 0; a < fired.size(); ++a)
+      if (fired[a]) cost += p.actions[a].cost;
+    for (int i : items) cost += p.resources[i].cost;
+    return cost;
+  });
 }
 
 }  // namespace sg

@@ -43,55 +43,25 @@ std::vector<TermWeights> randomComponents(uint64_t seed) {
   return out;
 }
 
-// From the definition: every subset of actions, its delete-free closure from init; feasible
-// if the goals are covered and the items read fit the limits. Its amounts: the fired
-// actions' terms, each distinct item's terms once, the fixed terms; its cost: the largest
-// component's weighted sum. Shares nothing with the engines but the Problem's data.
+// From the definition: the cheapest feasible subset (exhaustiveMinimum), its amounts the fired
+// actions' terms, each distinct item's terms once and the fixed terms, its cost the largest
+// component's weighted sum.
 int64_t exhaustiveLargest(const Problem& p) {
-  const size_t n = p.actions.size();
-  if (n > 20) throw std::logic_error("instance too large for the exhaustive solver");
-  int64_t best = kNone;
-  for (uint32_t s = 0; s < (1u << n); ++s) {
-    std::vector<bool> have(p.facts.size(), false), fired(n, false);
-    for (int f : p.init) have[f] = true;
-    for (bool changed = true; changed;) {
-      changed = false;
-      for (size_t a = 0; a < n; ++a) {
-        const Action& act = p.actions[a];
-        if (!(s >> a & 1u) || fired[a]) continue;
-        if (!std::all_of(act.pre.begin(), act.pre.end(), [&](int q) { return have[q]; })) continue;
-        fired[a] = true;
-        have[act.add] = changed = true;
-      }
-    }
-    if (!std::all_of(p.goals.begin(), p.goals.end(), [&](int g) { return have[g]; })) continue;
+  return exhaustiveMinimum(p, [&](const std::vector<bool>& fired, const std::set<int>& items) {
     TermAmounts amounts = p.fixedTerms;
-    std::set<int> items;
-    for (size_t a = 0; a < n; ++a) {
-      if (!fired[a]) continue;
-      for (size_t t = 0; t < kTermCount; ++t) amounts[t] += p.actions[a].terms[t];
-      for (int q : p.actions[a].pre)
-        if (p.facts[q].resource >= 0) items.insert(p.facts[q].resource);
-    }
-    for (int g : p.goals)
-      if (p.facts[g].resource >= 0) items.insert(p.facts[g].resource);
-    std::vector<int64_t> use(p.limits.size(), 0);
-    for (int i : items) {
+    for (size_t a = 0; a < fired.size(); ++a)
+      if (fired[a])
+        for (size_t t = 0; t < kTermCount; ++t) amounts[t] += p.actions[a].terms[t];
+    for (int i : items)
       for (size_t t = 0; t < kTermCount; ++t) amounts[t] += p.resources[i].terms[t];
-      if (static_cast<size_t>(p.resources[i].limit) < use.size()) use[p.resources[i].limit] += p.resources[i].amount;
-    }
-    bool fits = true;
-    for (size_t l = 0; l < use.size(); ++l) fits = fits && use[l] <= p.limits[l].max;
-    if (!fits) continue;
     int64_t cost = 0;
     for (const TermWeights& w : p.componentWeights) {
       int64_t c = 0;
       for (size_t t = 0; t < kTermCount; ++t) c += w[t] * amounts[t];
       cost = std::max(cost, c);
     }
-    if (best == kNone || cost < best) best = cost;
-  }
-  return best;
+    return cost;
+  });
 }
 
 std::optional<Plan> solveWith(const Problem& p, const std::string& engine, SearchStats* st = nullptr) {
