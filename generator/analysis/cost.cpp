@@ -406,22 +406,51 @@ SpirvAccesses measureAccesses(const std::vector<uint32_t>& words) {
   std::set<uint32_t> constants, bufferBlocks;
   std::map<uint32_t, uint32_t> binding, pointerClass, pointee;  // id -> Binding; pointer type -> class, pointee
   std::map<uint32_t, uint32_t> variableType;                    // variable -> its pointer type
+  std::map<uint32_t, uint32_t> constantValue;                   // 32-bit integer constants
+  std::map<uint32_t, int64_t> typeBytes;                        // tightly packed size of a type
   struct Chain {
     uint32_t base;
     bool dynamic;
     std::vector<uint32_t> indices;
   };
-  std::set<std::vector<uint32_t>> loaded;
+  // Per element (variable and index values up to the last computed index): the distinct
+  // loads under it (their full paths) and the bytes each reads, whether the element is
+  // uniform (else a buffer) and its binding.
+  struct Element {
+    bool buffer = false;
+    uint32_t binding = 0;
+    std::map<std::vector<uint32_t>, int64_t> loads;
+  };
+  std::map<std::vector<uint32_t>, Element> elements;
   std::map<uint32_t, Chain> chains;  // access chain result -> its base and whether an index is computed
   for (size_t i = 5; i < words.size();) {
     const uint32_t len = words[i] >> 16;
     if (len == 0 || i + len > words.size()) break;
     const auto op = static_cast<spv::Op>(words[i] & 0xffffu);
     const uint32_t* w = &words[i];
+    auto bytesOf = [&](uint32_t t) { return typeBytes.count(t) ? typeBytes[t] : int64_t{4}; };
     switch (op) {
-      case spv::OpConstant: case spv::OpConstantComposite: case spv::OpConstantNull: case spv::OpSpecConstant:
+      case spv::OpConstant:
+        if (len >= 4) constantValue[w[2]] = w[3];
+        [[fallthrough]];
+      case spv::OpConstantComposite: case spv::OpConstantNull: case spv::OpSpecConstant:
         if (len >= 3) constants.insert(w[2]);
         break;
+      case spv::OpTypeInt: case spv::OpTypeFloat:
+        if (len >= 3) typeBytes[w[1]] = w[2] / 8;
+        break;
+      case spv::OpTypeVector: case spv::OpTypeMatrix:
+        if (len >= 4) typeBytes[w[1]] = bytesOf(w[2]) * w[3];
+        break;
+      case spv::OpTypeArray:
+        if (len >= 4) typeBytes[w[1]] = bytesOf(w[2]) * (constantValue.count(w[3]) ? constantValue[w[3]] : 1);
+        break;
+      case spv::OpTypeStruct: {
+        int64_t b = 0;
+        for (uint32_t k = 2; k < len; ++k) b += bytesOf(w[k]);
+        typeBytes[w[1]] = b;
+        break;
+      }
       case spv::OpDecorate:
         if (len >= 4 && w[2] == spv::DecorationBinding) binding[w[1]] = w[3];
         if (len >= 3 && w[2] == spv::DecorationBufferBlock) bufferBlocks.insert(w[1]);
@@ -454,28 +483,43 @@ SpirvAccesses measureAccesses(const std::vector<uint32_t>& words) {
         }
         auto var = variableType.find(ptr);
         if (var == variableType.end()) break;
-        // One fetch per element: loads of the same element (same variable and index values up
-        // to the last computed index; constant indices after it pick parts of the element,
-        // such as a component of a vec4 or a column of a palette matrix) count once.
-        size_t keep = path.size();
-        for (size_t k = path.size(); k-- > 0;)
-          if (!constants.count(path[k])) {
-            keep = k + 1;
-            break;
-          }
-        path.resize(keep);
-        path.insert(path.begin(), ptr);
-        if (!loaded.insert(path).second) break;
         const uint32_t cls = pointerClass[var->second];
         const bool buffer = cls == spv::StorageClassStorageBuffer ||
                             (cls == spv::StorageClassUniform && bufferBlocks.count(pointee[var->second]));
-        if (buffer) ++out.bufferLoads[binding.count(ptr) ? binding[ptr] : 0];
-        else if (cls == spv::StorageClassUniform && dynamic) ++out.indexedUniformLoads;
+        if (!buffer && !(cls == spv::StorageClassUniform && dynamic)) break;
+        path.insert(path.begin(), ptr);
+        // The element: the path up to the last computed index; constant indices after it
+        // pick parts of the element (a component of a vec4, a column of a palette matrix).
+        std::vector<uint32_t> element = path;
+        for (size_t k = element.size(); k-- > 1;)
+          if (!constants.count(element[k])) {
+            element.resize(k + 1);
+            break;
+          }
+        Element& e = elements[element];
+        e.buffer = buffer;
+        e.binding = binding.count(ptr) ? binding[ptr] : 0;
+        e.loads.emplace(path, bytesOf(w[1]));
         break;
       }
       default: break;
     }
     i += len;
+  }
+  for (const auto& [path, e] : elements) {
+    // Bytes of the element read: the whole element when it is loaded whole, else its
+    // distinct parts; a device fetches them 16 bytes (one vec4) per load.
+    int64_t bytes = 0;
+    if (auto whole = e.loads.find(path); whole != e.loads.end()) bytes = whole->second;
+    else
+      for (const auto& [part, b] : e.loads) bytes += b;
+    const int64_t loads = std::max<int64_t>(1, (bytes + 15) / 16);
+    if (e.buffer) {
+      ++out.bufferElements[e.binding];
+      out.bufferLoads[e.binding] += loads;
+    } else {
+      out.indexedUniformLoads += loads;
+    }
   }
   return out;
 }
@@ -488,6 +532,8 @@ RuleAccesses measureRuleAccesses(const RuleSet& rules, int r, const ProbeRig& ri
   SpirvAccesses a = measureAccesses(*opt);
   for (const auto& [b, loads] : a.bufferLoads)
     if (b >= 1 && b <= probe.buffers.size()) res.bufferLoads[probe.buffers[b - 1]] += loads;
+  for (const auto& [b, n] : a.bufferElements)
+    if (b >= 1 && b <= probe.buffers.size()) res.bufferElements[probe.buffers[b - 1]] += n;
   res.indexedUniformLoads = a.indexedUniformLoads;
   res.ok = true;
   return res;
@@ -514,11 +560,17 @@ void measureAccessTerms(Problem& p, const RuleSet& rules, const Rig& rig) {
       throw e;
     }
     act.terms[kTermBufferLoads] = act.terms[kTermBufferBytes] = 0;
-    for (const auto& [fact, loads] : a.bufferLoads) {
+    for (const auto& [fact, elements] : a.bufferElements) {
       const int f = p.findFact(fact);
       if (f < 0 || p.facts[static_cast<size_t>(f)].source != Fact::Source::Buffer) continue;
-      act.terms[kTermBufferLoads] += loads;
-      act.terms[kTermBufferBytes] += loads * p.buffers[static_cast<size_t>(p.facts[static_cast<size_t>(f)].rigIndex)].strideBytes;
+      const Fact& bf = p.facts[static_cast<size_t>(f)];
+      const BufferSource& b = p.buffers[static_cast<size_t>(bf.rigIndex)];
+      // The probe reads the semantic's own type; the program reads the buffer's layout:
+      // tightly packed floats take one scalar load per component (glsl_emitter's accessor).
+      auto loads = a.bufferLoads.find(fact);
+      act.terms[kTermBufferLoads] += b.element == Type::Float ? elements * componentCount(bf.type)
+                                                               : (loads == a.bufferLoads.end() ? elements : loads->second);
+      act.terms[kTermBufferBytes] += elements * b.strideBytes;
     }
     act.terms[kTermIndexedUniformLoads] = a.indexedUniformLoads;
   }

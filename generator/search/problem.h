@@ -45,8 +45,8 @@ enum CostTerm {
   kTermLocations,           // vertex input locations read (an input charged once per plan)
   kTermAttributeBytes,      // bytes fetched from vertex attributes (their formats)
   kTermBufferBytes,         // bytes fetched from storage buffers (element strides)
-  kTermBufferLoads,         // storage-buffer elements loaded
-  kTermIndexedUniformLoads, // uniform loads at an index computed per vertex (palette[joint])
+  kTermBufferLoads,         // storage-buffer loads (of up to 16 bytes: analysis/cost.h)
+  kTermIndexedUniformLoads, // 16-byte uniform loads at an index computed per vertex (palette[joint])
   kTermOutputs,             // output components written (the varyings and gl_Position)
   kTermVertices,            // 1: the fixed cost of running the program for one vertex
   kTermCount
