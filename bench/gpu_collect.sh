@@ -3,9 +3,11 @@
 # forced alternative of many (rig, request) pairs, each validated on the device first, as
 # `calibrate` samples, one log per group (docs/device-profiles.md, "Held-out check"):
 #   train     the probes, the Dawn face's two layouts and a random corpus (the fit's data)
-#   world, body-depth, pbr, models   rigs and requests the fit never sees (the check's data)
+#   train-models  RiggedFigure on its own meshes (the fit's data too)
+#   world, corpus-heldout, body-depth, pbr, models   rigs and requests the fit never sees (the check's data)
 # Fits and the held-out check are made offline from the logs (shadergen calibrate --from-logs).
-# Usage: bash gpu_collect.sh [DEVICE=NVIDIA] [OUTDIR=.]; SG_BUDGET scales every group's time limit.
+# Usage: bash gpu_collect.sh [DEVICE=NVIDIA] [OUTDIR=.]; SG_BUDGET scales every group's time limit,
+# SG_GROUPS="train world ..." runs only those groups (a device call's time limit).
 set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 device=${1-NVIDIA}
@@ -20,6 +22,7 @@ data="$here/examples/heldout"
 models="$here/examples/models"
 group() {  # group NAME SECONDS ARGS...: one calibrate run, its log in OUTDIR/NAME.log
   local name=$1 limit=$2; shift 2
+  case " ${SG_GROUPS:-$name} " in *" $name "*) ;; *) return 0 ;; esac  # SG_GROUPS: run only these
   limit=$(awk -v l="$limit" -v s="${SG_BUDGET:-1}" 'BEGIN { printf "%d", l * s }')
   local t0=$SECONDS
   timeout -s INT "$limit" "$sg" calibrate "${t[@]}" "$@" -o "${SG_PROFILE_DIR:-$outdir}/$name.yaml" > "$outdir/$name.log" 2>&1
@@ -27,10 +30,16 @@ group() {  # group NAME SECONDS ARGS...: one calibrate run, its log in OUTDIR/NA
 }
 group train 230 --corpus "${SG_CORPUS:-16}" --seed 1 --rig "$here/examples/dawn/face.rig.yaml" \
   --rig "$here/examples/dawn/face-packed.rig.yaml" -f "$here/examples/dawn/face.frag" "${dawnRules[@]}"
+# A real model's own meshes in the fit (small draws, its own vertex order); not one the check uses.
+group train-models 40 --no-probes --rig "$models/RiggedFigure.glb#*" -f "$here/examples/gltf/lit.frag" "${std[@]}"
 group world 110 --no-probes --rig "$data/limb16.rig.yaml" --rig "$data/limb8_palette300.rig.yaml" \
   --rig "$data/face52.rig.yaml" --rig "$data/octahedral.rig.yaml" --rig "$data/qtangent.rig.yaml" -f "$data/world.frag" "${std[@]}"
+# Random rigs and requests of another seed: the check's random held-out set.
+group corpus-heldout 100 --no-probes --corpus "${SG_HELDOUT_CORPUS:-6}" --seed 2 -f "$here/examples/dawn/face.frag" "${dawnRules[@]}"
 group body-depth 30 --no-probes --rig "$here/examples/dawn/body.rig.yaml" -f "$here/examples/dawn/depth.frag" "${dawnRules[@]}"
 group pbr 70 --no-probes --rig "$data/pbr_character.rig.yaml" --rig "$data/limb8_palette300.rig.yaml" \
   -f "$data/standard_normalmap.frag" "${std[@]}"
+# The Fox has no normals (and bench draws no textures of its own): an unlit request.
+group models-fox 30 --no-probes --rig "$models/Fox.glb#*" -f "$here/examples/gltf/solid.frag" "${std[@]}"
 group models 90 --no-probes --rig "$models/CesiumMan.glb#*" --rig "$models/RobotExpressive.glb#*" \
   -f "$here/examples/gltf/lit.frag" "${std[@]}"

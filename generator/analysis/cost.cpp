@@ -515,10 +515,11 @@ SpirvAccesses measureAccesses(const std::vector<uint32_t>& words) {
       for (const auto& [part, b] : e.loads) bytes += b;
     const int64_t loads = std::max<int64_t>(1, (bytes + 15) / 16);
     if (e.buffer) {
-      ++out.bufferElements[e.binding];
-      out.bufferLoads[e.binding] += loads;
+      ++out.bufferLoads[e.binding];
+      out.bufferVec4Loads[e.binding] += loads;
     } else {
-      out.indexedUniformLoads += loads;
+      ++out.indexedUniformLoads;
+      out.indexedUniformVec4Loads += loads;
     }
   }
   return out;
@@ -532,8 +533,9 @@ RuleAccesses measureRuleAccesses(const RuleSet& rules, int r, const ProbeRig& ri
   SpirvAccesses a = measureAccesses(*opt);
   for (const auto& [b, loads] : a.bufferLoads)
     if (b >= 1 && b <= probe.buffers.size()) res.bufferLoads[probe.buffers[b - 1]] += loads;
-  for (const auto& [b, n] : a.bufferElements)
-    if (b >= 1 && b <= probe.buffers.size()) res.bufferElements[probe.buffers[b - 1]] += n;
+  for (const auto& [b, n] : a.bufferVec4Loads)
+    if (b >= 1 && b <= probe.buffers.size()) res.bufferVec4Loads[probe.buffers[b - 1]] += n;
+  res.indexedUniformVec4Loads = a.indexedUniformVec4Loads;
   res.indexedUniformLoads = a.indexedUniformLoads;
   res.ok = true;
   return res;
@@ -559,20 +561,22 @@ void measureAccessTerms(Problem& p, const RuleSet& rules, const Rig& rig) {
       e.related.assign(a.diagnostics.begin() + 1, a.diagnostics.end());
       throw e;
     }
-    act.terms[kTermBufferLoads] = act.terms[kTermBufferBytes] = 0;
-    for (const auto& [fact, elements] : a.bufferElements) {
+    act.terms[kTermBufferLoads] = act.terms[kTermBufferBytes] = act.terms[kTermBufferVec4Loads] = 0;
+    for (const auto& [fact, elements] : a.bufferLoads) {
       const int f = p.findFact(fact);
       if (f < 0 || p.facts[static_cast<size_t>(f)].source != Fact::Source::Buffer) continue;
       const Fact& bf = p.facts[static_cast<size_t>(f)];
       const BufferSource& b = p.buffers[static_cast<size_t>(bf.rigIndex)];
       // The probe reads the semantic's own type; the program reads the buffer's layout:
       // tightly packed floats take one scalar load per component (glsl_emitter's accessor).
-      auto loads = a.bufferLoads.find(fact);
-      act.terms[kTermBufferLoads] += b.element == Type::Float ? elements * componentCount(bf.type)
-                                                               : (loads == a.bufferLoads.end() ? elements : loads->second);
+      auto loads = a.bufferVec4Loads.find(fact);
+      act.terms[kTermBufferLoads] += elements;
+      act.terms[kTermBufferVec4Loads] += b.element == Type::Float ? elements * componentCount(bf.type)
+                                                                   : (loads == a.bufferVec4Loads.end() ? elements : loads->second);
       act.terms[kTermBufferBytes] += elements * b.strideBytes;
     }
     act.terms[kTermIndexedUniformLoads] = a.indexedUniformLoads;
+    act.terms[kTermIndexedUniformVec4Loads] = a.indexedUniformVec4Loads;
   }
   priceProblem(p, p.weights);
 }

@@ -48,27 +48,29 @@ AutoCost measureRuleCost(const RuleSet& rules, int rule, const ProbeRig& rig);
 // through an access chain with a computed index (palette[joint]). An element is what one
 // computed index selects (constant indices after it pick its parts); it is fetched once
 // however many of its parts are read, in loads of up to 16 bytes (a vec4): a mat4 palette
-// entry is 4 loads, a mat3x4 one 3, a vec4 or a float 1.
+// entry is 4 vec4 loads, a mat3x4 one 3, a vec4 or a float 1.
 struct SpirvAccesses {
-  std::map<uint32_t, int64_t> bufferElements;  // binding -> elements
-  std::map<uint32_t, int64_t> bufferLoads;     // binding -> 16-byte loads
-  int64_t indexedUniformLoads = 0;             // 16-byte loads
+  std::map<uint32_t, int64_t> bufferLoads;      // binding -> elements
+  std::map<uint32_t, int64_t> bufferVec4Loads;  // binding -> 16-byte loads
+  int64_t indexedUniformLoads = 0;              // elements
+  int64_t indexedUniformVec4Loads = 0;          // 16-byte loads
 };
 SpirvAccesses measureAccesses(const std::vector<uint32_t>& words);
 
 struct RuleAccesses {
   bool ok = false;
-  std::map<std::string, int64_t> bufferElements;  // per buffer semantic read: elements
-  std::map<std::string, int64_t> bufferLoads;     // per buffer semantic read: 16-byte loads of its type
-  int64_t indexedUniformLoads = 0;
+  std::map<std::string, int64_t> bufferLoads;      // per buffer semantic read: elements
+  std::map<std::string, int64_t> bufferVec4Loads;  // per buffer semantic read: 16-byte loads of its type
+  int64_t indexedUniformLoads = 0, indexedUniformVec4Loads = 0;
   std::vector<Diagnostic> diagnostics;
 };
 // Counted on the rule's probe (analysis/probe.h) optimised with loops of constant trip
 // count unrolled, so a loop over the targets counts one load per target.
 RuleAccesses measureRuleAccesses(const RuleSet& rules, int rule, const ProbeRig& rig);
 
-// Sets the buffer-load (16-byte loads; one per component for a buffer of tightly packed
-// floats), buffer-byte (elements x the buffer's element stride) and indexed uniform load terms of every action that reads a storage buffer or a uniform array, then
+// Sets the buffer-load (elements), buffer vec4-load (16-byte loads; one per component for a
+// buffer of tightly packed floats), buffer-byte (elements x the buffer's element stride) and
+// indexed uniform load terms (elements and vec4 loads) of every action that reads a storage buffer or a uniform array, then
 // reprices the problem. Throws InputError when a snippet cannot be measured.
 void measureAccessTerms(Problem& p, const RuleSet& rules, const Rig& rig);
 

@@ -206,7 +206,7 @@ Probe bufferProbe(const ProbeMesh& m, int n) {
         if (v < m.mesh.vertexCount) expectedAt(p, v, 0, c) += f;
       }
   p.inputs.storageBuffers.push_back(std::move(b));
-  p.amounts[kTermBufferLoads] = n;
+  p.amounts[kTermBufferLoads] = p.amounts[kTermBufferVec4Loads] = n;
   p.amounts[kTermBufferBytes] = 16 * n;
   return p;
 }
@@ -262,6 +262,7 @@ Probe paletteProbe(const ProbeMesh& m, int n, bool perVertex) {
     for (int c = 0; c < 4; ++c) expectedAt(p, v, 0, c) = o[c];
   }
   p.amounts[kTermIndexedUniformLoads] = perVertex ? n : 0;
+  p.amounts[kTermIndexedUniformVec4Loads] = perVertex ? 4 * n : 0;  // a mat4: 4 vec4 loads
   return p;
 }
 
@@ -525,6 +526,13 @@ std::string formatHeldOutCheck(const LeaveOneRigOut& check) {
 
 std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, const std::map<std::string, double>& meshVertices) {
   std::vector<CalibrationSample> samples;
+  // Columns are found by their header ("| mesh | rig | program | arithmetic | ... |"), so logs
+  // written before a term or the workload columns existed still read (an absent term: 0).
+  std::map<std::string, size_t> column;
+  auto at = [&](const std::vector<std::string>& cells, const std::string& name) -> const std::string* {
+    auto c = column.find(name);
+    return c == column.end() || c->second >= cells.size() ? nullptr : &cells[c->second];
+  };
   std::string line;
   while (std::getline(table, line)) {
     std::vector<std::string> cells;
@@ -533,26 +541,32 @@ std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, cons
       const size_t a = cell.find_first_not_of(' '), b = cell.find_last_not_of(' ');
       cells.push_back(a == std::string::npos ? "" : cell.substr(a, b - a + 1));
     }
-    // "| mesh | rig | program | amounts... | measured | predicted |", with the empty first cell;
-    // since issue 33 also "| joints per warp | vertices per draw |" (any mesh, "own" too).
-    const bool workload = cells.size() == 8 + size_t(kTermCount);
-    if (cells.size() != 6 + size_t(kTermCount) && !workload) continue;
-    if (!workload && !meshVertices.count(cells[1])) continue;
+    if (cells.size() > 4 && cells[1] == "mesh" && cells[2] == "rig" && cells[3] == "program") {
+      column.clear();
+      for (size_t i = 1; i < cells.size(); ++i) column[cells[i]] = i;
+      continue;
+    }
+    const std::string* measured = at(cells, "measured ns/vertex");
+    if (!measured || cells.size() < 4) continue;
+    const std::string* jpw = at(cells, "joints per warp");
+    const std::string* perDraw = at(cells, "vertices per draw");
+    if (!perDraw && !meshVertices.count(cells[1])) continue;
     CalibrationSample s;
     s.mesh = cells[1];
     try {
-      s.vertices = workload ? std::stod(cells[7 + size_t(kTermCount)]) : meshVertices.at(s.mesh);
-      if (workload) s.workload.jointsPerWarp = std::stod(cells[6 + size_t(kTermCount)]);
+      s.vertices = perDraw ? std::stod(*perDraw) : meshVertices.at(s.mesh);
+      if (jpw) s.workload.jointsPerWarp = std::stod(*jpw);
     } catch (const std::exception&) {
       continue;
     }
-    if (workload) s.workload.verticesPerDraw = s.vertices;
+    if (perDraw) s.workload.verticesPerDraw = s.vertices;
     s.rig = cells[2] == "—" ? "" : cells[2];
     s.label = cells[3];
     s.fitted = s.label.rfind("checked plan", 0) != 0;
     try {
-      for (int t = 0; t < kTermCount; ++t) s.amounts[size_t(t)] = std::stoll(cells[4 + size_t(t)]);
-      s.measuredNs = std::stod(cells[4 + size_t(kTermCount)]);
+      for (int t = 0; t < kTermCount; ++t)
+        if (const std::string* amount = at(cells, termName(t))) s.amounts[size_t(t)] = std::stoll(*amount);
+      s.measuredNs = std::stod(*measured);
     } catch (const std::exception&) {
       continue;  // a row that failed ("FAILED, not timed")
     }
@@ -687,6 +701,9 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
         if (fragmentOf.count(rig)) bo.render.gen.fragmentPath = fragmentOf.at(rig);
         bo.render.gen.deviceProfilePath = profilePath;
         bo.render.device = opts.device;
+        // The plans this device's limits allow (as bench --device and validate --device use):
+        // a palette that only fits the device's larger uniform block is a plan users get there.
+        bo.render.limits.fromDevice = true;
         bo.render.validationLayers = opts.validationLayers;
         bo.render.mesh = meshName == "small" ? "head" : meshName;
         bo.render.width = opts.width;

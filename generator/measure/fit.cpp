@@ -16,6 +16,10 @@ DeviceProfile profileForm(ProfileForm form) {
   // A uniform load at a per-vertex index is served once per distinct address a warp reads
   // (the constant cache serialises them), so its weight is per address: loads x joints per warp.
   p.scaledBy[kTermIndexedUniformLoads] = kFeatureJointsPerWarp;
+  // Counted in vec4s, a warp's palette reads grow with the square: each pass serves one
+  // address, and the more joints a warp spans the less of its palette the constant cache
+  // holds (chosen by held-out error on the H200: docs/device-profiles.md).
+  p.scaledBy[kTermIndexedUniformVec4Loads] = kFeatureJointsPerWarpSquared;
   p.workloadDefaults[kFeatureJointsPerWarp] = 1;
   if (form == ProfileForm::Roofline) {
     auto pipe = [&](const char* name, std::initializer_list<int> terms) {
@@ -25,7 +29,8 @@ DeviceProfile profileForm(ProfileForm form) {
       p.pipes.push_back(x);
     };
     pipe("fetch", {kTermLocations, kTermAttributeBytes});
-    pipe("memory", {kTermBufferLoads, kTermBufferBytes, kTermIndexedUniformLoads});
+    pipe("memory", {kTermBufferLoads, kTermBufferVec4Loads, kTermBufferBytes, kTermIndexedUniformLoads,
+                    kTermIndexedUniformVec4Loads});
     pipe("alu", {kTermArithmetic});
     pipe("output", {kTermOutputs});
   }

@@ -57,7 +57,8 @@ void parseTermWeights(const YamlCtx& c, const YAML::Node& w, const char* section
 }  // namespace
 
 const char* featureName(int feature) {
-  static const char* const names[] = {"none", "joints_per_warp", "invocations_per_vertex", "active_morph_targets"};
+  static const char* const names[] = {"none", "joints_per_warp", "invocations_per_vertex", "active_morph_targets",
+                                      "joints_per_warp_squared"};
   return feature >= 0 && feature < kFeatureCount ? names[feature] : "?";
 }
 
@@ -68,6 +69,10 @@ double DeviceProfile::feature(int f) const {
     case kFeatureJointsPerWarp: v = workload.jointsPerWarp > 0 ? workload.jointsPerWarp : -1; break;
     case kFeatureInvocationsPerVertex: v = workload.invocationsPerVertex > 0 ? workload.invocationsPerVertex : -1; break;
     case kFeatureActiveMorphTargets: v = workload.activeMorphTargets; break;
+    case kFeatureJointsPerWarpSquared: {
+      const double j = feature(kFeatureJointsPerWarp);
+      return j * j;
+    }
     default: break;
   }
   if (v >= 0) return v;

@@ -19,7 +19,15 @@
 namespace sg {
 
 // What a workload feature (search/workload.h) a term's weight may be multiplied by.
-enum WorkloadFeature { kFeatureNone = 0, kFeatureJointsPerWarp, kFeatureInvocationsPerVertex, kFeatureActiveMorphTargets, kFeatureCount };
+// joints_per_warp_squared is joints_per_warp's square (its workload value or its default).
+enum WorkloadFeature {
+  kFeatureNone = 0,
+  kFeatureJointsPerWarp,
+  kFeatureInvocationsPerVertex,
+  kFeatureActiveMorphTargets,
+  kFeatureJointsPerWarpSquared,
+  kFeatureCount
+};
 // "joints_per_warp", ...: the keys of a profile's `scaled_by:` values and `workload_defaults:`.
 const char* featureName(int feature);
 

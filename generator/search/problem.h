@@ -45,8 +45,13 @@ enum CostTerm {
   kTermLocations,           // vertex input locations read (an input charged once per plan)
   kTermAttributeBytes,      // bytes fetched from vertex attributes (their formats)
   kTermBufferBytes,         // bytes fetched from storage buffers (element strides)
-  kTermBufferLoads,         // storage-buffer loads (of up to 16 bytes: analysis/cost.h)
-  kTermIndexedUniformLoads, // 16-byte uniform loads at an index computed per vertex (palette[joint])
+  kTermBufferLoads,         // storage-buffer elements loaded
+  kTermIndexedUniformLoads, // uniform elements loaded at an index computed per vertex (palette[joint])
+  // The same loads counted as a device issues them, 16 bytes (a vec4) at most per load
+  // (analysis/cost.h): a mat4 palette entry is 4, a buffer of tightly packed floats one per
+  // component. Profiles from before they were counted weigh them 0 and mean what they meant.
+  kTermBufferVec4Loads,
+  kTermIndexedUniformVec4Loads,
   kTermOutputs,             // output components written (the varyings and gl_Position)
   kTermVertices,            // 1: the fixed cost of running the program for one vertex
   kTermCount
@@ -57,7 +62,7 @@ const char* termName(int term);
 // Search cost units per unit of each term (int64: A* stays exact). Without a profile the
 // unit is the instruction slot; a profile's unit is the femtosecond (docs/device-profiles.md).
 using TermWeights = std::array<int64_t, kTermCount>;
-constexpr TermWeights kSlotWeights = {1, 0, 0, 0, 0, 0, 0, 0};
+constexpr TermWeights kSlotWeights = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0};
 // sum of weight x amount (checked: a hostile profile cannot overflow it silently).
 int64_t weighTerms(const TermWeights& w, const TermAmounts& a);
 

@@ -183,7 +183,7 @@ namespace {
 // The memory terms of the device cost model (docs/device-profiles.md), counted on the
 // Dawn face's rules: one element fetch per target of a constant-trip loop (unrolled), one
 // palette matrix per influence, each buffer element once however many components are read,
-// and none for constant-indexed uniform arrays. A fetch is counted in loads of at most 16
+// and none for constant-indexed uniform arrays; and the same fetches in loads of at most 16
 // bytes (a vec4): a mat4 is 4, a vec3 or a uvec4 1.
 TEST(AccessTerms, CountedOnTheDawnRules) {
   RuleSet rs = loadRules({sourceDir() + "/examples/dawn/rules.yaml"});
@@ -203,8 +203,8 @@ TEST(AccessTerms, CountedOnTheDawnRules) {
   // 5 targets: a GLSL loop over the deltas buffer, morph weights indexed by the loop counter.
   // A vec3 delta is one element and one load.
   RuleAccesses morph = accesses("object_position_morphed_buffer");
-  EXPECT_EQ(morph.bufferElements, (Loads{{"morph.position_deltas", 5}}));
   EXPECT_EQ(morph.bufferLoads, (Loads{{"morph.position_deltas", 5}}));
+  EXPECT_EQ(morph.bufferVec4Loads, (Loads{{"morph.position_deltas", 5}}));
   EXPECT_EQ(morph.indexedUniformLoads, 0);  // unrolled: u_morph_weight[0..4] are constant indices
   // The attribute form reads streams and constant-indexed weights only.
   RuleAccesses attr = accesses("object_position_morphed");
@@ -213,17 +213,19 @@ TEST(AccessTerms, CountedOnTheDawnRules) {
   // 4 influences: one mat4 palette entry each (64 bytes: 4 loads), at a joint index read per vertex.
   RuleAccesses skin = accesses("skin_matrix_blend");
   EXPECT_TRUE(skin.bufferLoads.empty());
-  EXPECT_EQ(skin.indexedUniformLoads, 4 * 4);
+  EXPECT_EQ(skin.indexedUniformLoads, 4);
+  EXPECT_EQ(skin.indexedUniformVec4Loads, 4 * 4);
   // Joints and weights of 4 influences are one uvec4 and one vec4 element: 1 fetch each,
   // although every component is read separately.
   RuleAccesses buffered = accesses("skin_matrix_blend_buffered_influences");
-  EXPECT_EQ(buffered.bufferElements, (Loads{{"skin.joints_buffer", 1}, {"skin.weights_buffer", 1}}));
   EXPECT_EQ(buffered.bufferLoads, (Loads{{"skin.joints_buffer", 1}, {"skin.weights_buffer", 1}}));
-  EXPECT_EQ(buffered.indexedUniformLoads, 4 * 4);
+  EXPECT_EQ(buffered.bufferVec4Loads, (Loads{{"skin.joints_buffer", 1}, {"skin.weights_buffer", 1}}));
+  EXPECT_EQ(buffered.indexedUniformLoads, 4);
+  EXPECT_EQ(buffered.indexedUniformVec4Loads, 4 * 4);
   // The palette itself from a buffer: 4 matrices fetched from it (16 loads), no indexed uniform load.
   RuleAccesses palette = accesses("skin_matrix_blend_buffer_palette");
-  EXPECT_EQ(palette.bufferElements, (Loads{{"skin.bones_buffer", 4}}));
-  EXPECT_EQ(palette.bufferLoads, (Loads{{"skin.bones_buffer", 16}}));
+  EXPECT_EQ(palette.bufferLoads, (Loads{{"skin.bones_buffer", 4}}));
+  EXPECT_EQ(palette.bufferVec4Loads, (Loads{{"skin.bones_buffer", 16}}));
   EXPECT_EQ(palette.indexedUniformLoads, 0);
 }
 

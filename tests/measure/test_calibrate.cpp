@@ -80,7 +80,10 @@ TEST(Calibrate, EveryProbeAgreesWithItsExpectedOutputsOnLavapipeAndVariesOneTerm
 TEST(Calibrate, TheFitRecoversKnownNonNegativeWeights) {
   // Samples timed by a known linear device: 0.5 ns per location, 0.01 per slot, 2 ns fixed,
   // nothing for the other terms. The fit must give those weights and predict exactly.
-  const double truth[kTermCount] = {0.01, 0.5, 0, 0, 0, 0, 0, 2.0};
+  double truth[kTermCount] = {};
+  truth[kTermArithmetic] = 0.01;
+  truth[kTermLocations] = 0.5;
+  truth[kTermVertices] = 2.0;
   std::vector<CalibrationSample> samples;
   for (int locations = 1; locations <= 16; locations += 3)
     for (int slots : {0, 40, 200}) {
@@ -123,8 +126,13 @@ TEST(Calibrate, TwoMeshSizesSeparatePerDrawFromPerVertexCosts) {
   // pixels a draw covers), beside per-vertex costs: on 2,000 vertices per draw those add
   // 0.35 + 0.075 x outputs ns per vertex, on 180,000 almost nothing. The fit must find both
   // parts, state the profile's workload, price each mesh at its own size, and read back.
-  const double perVertex[kTermCount] = {0.002, 0.45, 0, 0, 0.13, 0, 0.07, 0};
-  const double perDraw[kTermCount] = {0, 0, 0, 0, 0, 0, 150, 700};
+  double perVertex[kTermCount] = {}, perDraw[kTermCount] = {};
+  perVertex[kTermArithmetic] = 0.002;
+  perVertex[kTermLocations] = 0.45;
+  perVertex[kTermBufferLoads] = 0.13;
+  perVertex[kTermOutputs] = 0.07;
+  perDraw[kTermOutputs] = 150;
+  perDraw[kTermVertices] = 700;
   std::vector<CalibrationSample> samples;
   for (double vertices : {180000.0, 2000.0})
     for (int locations = 1; locations <= 16; locations += 5)
