@@ -211,9 +211,10 @@ Probe bufferProbe(const ProbeMesh& m, int n) {
   return p;
 }
 
-// n <= 4 loads of a mat4 palette (128 entries, std140) at indices read per vertex (the
-// mesh's skin joints, a uint attribute: load i reads palette[joint[i]], as a skin does), or
-// at as many distinct indices taken from the uniform block; each times the position.
+// n loads of a mat4 palette (128 entries, std140) at indices read per vertex (the mesh's skin
+// joints, a uint attribute: load i reads palette[joint[i % 4] + 7 (i / 4)], as a skin with n
+// influences does: each group of four spans as many joints per warp as the skin), or at as many
+// distinct indices taken from the uniform block; each times the position.
 // The per-vertex indices diverge within a warp as much as the skin's nearest bones do: on
 // the 2,009-vertex head a warp spans several bones, at Dawn scale mostly one. (Hashed
 // indices, every vertex of a warp a different joint, took 29.6 ns per vertex for four
@@ -249,14 +250,14 @@ Probe paletteProbe(const ProbeMesh& m, int n, bool perVertex) {
   std::memcpy(p.inputs.uniformData.data() + kEntries * 64, &base, 4);
   p.body = "  o0 = vec4(joint) * 0.001;\n";
   for (int i = 0; i < n; ++i)
-    p.body += perVertex ? fmt::format("  o0 += u.palette[joint[{}] & {}u] * a0;\n", i, kEntries - 1)
+    p.body += perVertex ? fmt::format("  o0 += u.palette[(joint[{}] + {}u) & {}u] * a0;\n", i % 4, 7 * (i / 4), kEntries - 1)
                         : fmt::format("  o0 += u.palette[(u.base + {}u) & {}u] * a0;\n", i, kEntries - 1);
   const auto& pos = m.mesh.streams.at("vertex.position");
   for (size_t v = 0; v < m.mesh.vertexCount; ++v) {
     const uint8_t* j = &s.data[v * 4];
     glm::dvec4 o = glm::dvec4(j[0], j[1], j[2], j[3]) * 0.001;
     for (int i = 0; i < n; ++i) {
-      const uint32_t idx = perVertex ? j[i] & (kEntries - 1) : (base + uint32_t(i)) & (kEntries - 1);
+      const uint32_t idx = perVertex ? (j[i % 4] + 7u * uint32_t(i / 4)) & (kEntries - 1) : (base + uint32_t(i)) & (kEntries - 1);
       o += palette[idx] * glm::dvec4(pos[v]);
     }
     for (int c = 0; c < 4; ++c) expectedAt(p, v, 0, c) = o[c];
@@ -286,7 +287,7 @@ std::vector<Probe> makeProbes(const ProbeMesh& m) {
   probes.push_back(fetchProbe(m, 16, kUnorm8x4));  // 16 locations at 76 bytes (4 float32x4: 64)
   for (int n : {0, 16, 64, 256}) probes.push_back(chainProbe(m, n));
   for (int n : {1, 4, 8, 16}) probes.push_back(bufferProbe(m, n));
-  for (int n : {1, 2, 4})
+  for (int n : {1, 2, 4, 8, 16})
     for (bool perVertex : {true, false}) probes.push_back(paletteProbe(m, n, perVertex));
   for (int n : {1, 4, 8, 15}) probes.push_back(outputProbe(m, n));
   return probes;
