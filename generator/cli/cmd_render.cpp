@@ -51,7 +51,14 @@ struct RenderCommand {
     checkWholeModelAnimation(parts, ro.animation);
     std::vector<ModelPart> programs;
     std::vector<std::string> failed =
-        forEachPart(parts, [&](const GltfPart& part) { programs.push_back(modelPart(ro, part)); });
+        forEachPart(parts, [&](const GltfPart& part) {
+          RenderOptions o = ro;
+          if (!o.gen.deviceProfilePath.empty()) {  // each part priced for its own mesh, as generate prices it
+            o.gen.rigPath = part.ref;
+            measureWorkloadOf(o.gen, "");
+          }
+          programs.push_back(modelPart(o, part));
+        });
     failIfPartsFailed(ro.gen.rigPath, parts.size(), failed);
     for (const auto& p : programs)
       for (const auto& n : p.notes) std::cerr << fmt::format("{}: warning: {}: {}\n", ro.gen.rigPath, p.name, n);

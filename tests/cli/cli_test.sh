@@ -486,6 +486,18 @@ device_profile)
   head_total=$(awk '$1 == "total" && NF == 2 {print $2}' last.out)
   awk -v a="$dawn_total" -v b="$head_total" 'BEGIN {exit !(b > a + 0.1)}' && ok "a small draw pays more per vertex ($dawn_total -> $head_total ns)" ||
     fail "per-vertex prediction $dawn_total at 180000, $head_total at 2010"
+  # render MODEL.glb#* under a profile prices each primitive for its own mesh, as MODEL.glb#m/p
+  # does (CesiumMan has one primitive; its palette loads are priced per joint a warp reads).
+  CESIUM=$SRC/../shared/models/CesiumMan/CesiumMan.glb
+  if [ -f "$CESIUM" ]; then
+    RC=(-f "$SRC/tests/gltf/data/lit.frag" -r "$SRC/rules/standard.yaml" --device-profile "$SRC/devices/nvidia-h200-roofline.yaml"
+        --no-validation-layers --size 16x16)
+    expect 0 "render MODEL.glb#0/0 under a profile" -- "$SG" render --rig "$CESIUM#0/0" "${RC[@]}" -o cesium1.png
+    one=$(grep -o "plan cost [0-9]*" last.out)
+    expect 0 "render MODEL.glb#* under a profile" -- "$SG" render --rig "$CESIUM#*" "${RC[@]}" -o cesium2.png
+    all=$(grep -o "plan cost [0-9]*" last.out)
+    [ -n "$one" ] && [ "$one" = "$all" ] && ok "render #* prices the part as #0/0 does ($one)" || fail "#0/0: '$one', #*: '$all'"
+  fi
   # A rig storing its frame both ways: every command that generates says which form it reads.
   V=$SRC/tests/validate/data
   FORMS=(--rig "$V/octahedral_or_float.rig.yaml" -f "$V/world.frag" -r "$SRC/rules/standard.yaml" --mesh limb
