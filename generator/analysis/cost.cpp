@@ -6,6 +6,7 @@
 #include <glslang/SPIRV/GLSL.std.450.h>
 #include <glslang/SPIRV/spirv.hpp>
 
+#include <algorithm>
 #include <functional>
 #include <map>
 #include <optional>
