@@ -25,7 +25,7 @@ group() {  # group NAME SECONDS ARGS...: one calibrate run, its log in OUTDIR/NA
   case " ${SG_GROUPS:-$name} " in *" $name "*) ;; *) return 0 ;; esac  # SG_GROUPS: run only these
   limit=$(awk -v l="$limit" -v s="${SG_BUDGET:-1}" 'BEGIN { printf "%d", l * s }')
   local t0=$SECONDS
-  timeout -s INT "$limit" "$sg" calibrate "${t[@]}" "$@" -o "${SG_PROFILE_DIR:-$outdir}/$name.yaml" > "$outdir/$name.log" 2>&1
+  timeout -s INT -k 60 "$limit" "$sg" calibrate "${t[@]}" "$@" -o "${SG_PROFILE_DIR:-$outdir}/$name.yaml" > "$outdir/$name.log" 2>&1
   echo "== $name: exit $?, $((SECONDS - t0)) s (limit $limit)"
 }
 group train 230 --corpus "${SG_CORPUS:-16}" --seed 1 --rig "$here/examples/dawn/face.rig.yaml" \

@@ -2,6 +2,8 @@
 // (docs/device-profiles.md).
 #include <fmt/format.h>
 
+#include <atomic>
+#include <csignal>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -114,7 +116,16 @@ struct CalibrateCommand {
       for (const auto& r : co.plans.rulesPaths) inputs.push_back({r, "a rules file"});
       refuseClobbering({output}, inputs);
     }
+    // SIGINT (`timeout -s INT`, Ctrl-C) stops the timing and keeps what was timed; a second one
+    // ends the process as usual.
+    static std::atomic<bool> interrupted{false};
+    co.stop = &interrupted;
+    std::signal(SIGINT, [](int) {
+      interrupted.store(true);
+      std::signal(SIGINT, SIG_DFL);
+    });
     CalibrationReport rep = calibrateDevice(co);
+    std::signal(SIGINT, SIG_DFL);
     std::cout << formatCalibration(rep);
     size_t failed = 0;
     for (const auto& s : rep.samples) failed += !s.validated;

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <stdexcept>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -609,13 +610,16 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   rep.clock = hostClock ? "process CPU time over submit-to-fence, rasterizer discarded (a CPU device)" : "GPU timestamps";
   double GpuBenchRow::*const clock = hostClock ? &GpuBenchRow::rasterOffCpuNsPerVertex : &GpuBenchRow::rasterOnNsPerVertex;
 
+  const auto stopped = [&] { return opts.stop && opts.stop->load(); };
   for (const auto& meshName : opts.meshes) {
+    if (stopped()) break;
     ProbeMesh m = probeMesh(meshName);
     std::vector<Probe> probes = opts.probes ? makeProbes(m) : std::vector<Probe>{};
     // The probes' per-vertex palette indices are this mesh's skin: its workload is theirs.
     const Workload probeWorkload =
         measureWorkload(m.mesh, m.indices, true, -1, fmt::format("probe mesh '{}' ({} vertices)", meshName, m.mesh.vertexCount));
     for (auto& p : probes) {
+      if (stopped()) break;
       CalibrationSample s;
       s.label = p.label;
       s.mesh = meshName;
@@ -696,6 +700,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   auto benchRigs = [&](const std::string& profilePath, bool fitted, const std::string& prefix) {
     for (const auto& rig : rigs)
       for (const auto& meshName : rigMeshes(rig, opts.meshes)) {
+        if (stopped()) return;
         GpuBenchOptions bo;
         bo.render.gen = opts.plans;
         bo.render.gen.rigPath = rig;
@@ -763,11 +768,13 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   for (const auto& s : rep.samples)
     if (s.mesh == opts.meshes.front()) workload = s.vertices;
   rep.nearBestPower = rigs.empty() ? 0 : opts.nearBestPower;
+  if (stopped() && std::none_of(rep.samples.begin(), rep.samples.end(), [](const CalibrationSample& s) { return s.validated; }))
+    throw std::runtime_error("calibration: interrupted before anything was timed: nothing to fit");
   rep.profile = fitDeviceProfile(rep.samples, rep.device + " (" + rep.driver + ")", workload, opts.nearBestPower, opts.form);
   // The check: each rig's plans under the fitted profile. The plans a profile chooses are
   // where its errors cost time, so each refit adds them to the fit; the last check's plans
   // are never fitted.
-  for (uint32_t round = 0; opts.check && !rigs.empty(); ++round) {
+  for (uint32_t round = 0; opts.check && !rigs.empty() && !stopped(); ++round) {
     const std::string fitted = temporaryProfile(fmt::format("fit{}", round + 1), deviceProfileYaml(rep));
     remove.paths.push_back(fitted);
     rep.checks.clear();
@@ -783,6 +790,10 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
       fitMeshes.push_back(kOwnMesh);
   rep.fits = evaluateFit(rep.samples, rep.profile, fitMeshes);
   rep.heldOut = leaveOneRigOut(rep.samples, rep.profile.device, workload, rep.nearBestPower, opts.form);
+  if (stopped())
+    rep.notes.push_back(fmt::format("interrupted: {} samples were timed and are fitted; the probes, rigs and checks after "
+                                    "the interruption were not timed",
+                                    rep.samples.size()));
   return rep;
 }
 

@@ -16,6 +16,7 @@
 // chooses are where its errors cost time); the plans under the last profile are the check,
 // timed and compared with its predictions, samples no fit saw.
 #pragma once
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <istream>
@@ -64,6 +65,10 @@ struct CalibrationOptions {
   // wrong order costs time (docs/device-profiles.md, "Where the fit looks"). 0: all alike.
   double nearBestPower = 4;
   ProfileForm form = ProfileForm::Additive;  // the model fitted (measure/fit.h)
+  // Set (by the CLI's SIGINT handler: a device call's time limit) to time nothing more: the
+  // probe or rig being timed finishes, the rest are skipped, and what was timed is fitted and
+  // reported, with a note saying so.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 struct CalibrationSample {

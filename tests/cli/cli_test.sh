@@ -486,6 +486,22 @@ device_profile)
   head_total=$(awk '$1 == "total" && NF == 2 {print $2}' last.out)
   awk -v a="$dawn_total" -v b="$head_total" 'BEGIN {exit !(b > a + 0.1)}' && ok "a small draw pays more per vertex ($dawn_total -> $head_total ns)" ||
     fail "per-vertex prediction $dawn_total at 180000, $head_total at 2010"
+  # SIGINT stops calibrate's timing and keeps what was timed (a fitted profile and a note), or,
+  # before anything was timed, fails saying so: never a death by the signal (exit 130).
+  "$SG" calibrate "${DAWN[@]}" --meshes head --draws 2 --frames 2 --rounds 1 --no-validation-layers -o int.yaml \
+    >int.out 2>int.err &
+  pid=$!
+  sleep 4
+  kill -INT "$pid"
+  wait "$pid"
+  rc=$?
+  if [ "$rc" -eq 0 ] && grep -q "^note: interrupted: [0-9]* samples were timed" int.out && [ -s int.yaml ]; then
+    ok "calibrate, interrupted: fits what it timed"
+  elif [ "$rc" -ne 0 ] && grep -q "interrupted before anything was timed" int.err; then
+    ok "calibrate, interrupted before any timing: says so"
+  else
+    fail "calibrate after SIGINT: exit $rc; $(tail -3 int.out) $(cat int.err)"
+  fi
   # render MODEL.glb#* under a profile prices each primitive for its own mesh, as MODEL.glb#m/p
   # does (CesiumMan has one primitive; its palette loads are priced per joint a warp reads).
   CESIUM=$SRC/../shared/models/CesiumMan/CesiumMan.glb

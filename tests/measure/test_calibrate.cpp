@@ -1,6 +1,7 @@
 // Device calibration (docs/device-profiles.md): every probe computes what it claims on a
 // real device (lavapipe), its amounts are what it was built to vary, the fit recovers known
 // weights, and the written profile reads back. No timing is asserted.
+#include <atomic>
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -59,6 +60,13 @@ TEST(Calibrate, EveryProbeAgreesWithItsExpectedOutputsOnLavapipeAndVariesOneTerm
   ASSERT_TRUE(pv && pu);
   EXPECT_EQ(pv->amounts[kTermIndexedUniformLoads], 4);
   EXPECT_EQ(pu->amounts[kTermIndexedUniformLoads], 0);
+  EXPECT_EQ(pv->amounts[kTermIndexedUniformVec4Loads], 16);  // a mat4 entry: 4 vec4 loads
+  EXPECT_EQ(pu->amounts[kTermIndexedUniformVec4Loads], 0);
+  // 16 loads: joints 0..3 of the skin, then shifted by 7 per group of four (validated above).
+  const CalibrationSample* pv16 = find(r, "palette loads 16 at a per-vertex index");
+  ASSERT_TRUE(pv16);
+  EXPECT_EQ(pv16->amounts[kTermIndexedUniformLoads], 16);
+  EXPECT_EQ(pv16->amounts[kTermIndexedUniformVec4Loads], 64);
   EXPECT_EQ(pv->amounts[kTermLocations], pu->amounts[kTermLocations]);
   const CalibrationSample* b16 = find(r, "storage-buffer loads 16");
   ASSERT_TRUE(b16);
@@ -74,6 +82,24 @@ TEST(Calibrate, EveryProbeAgreesWithItsExpectedOutputsOnLavapipeAndVariesOneTerm
     EXPECT_GE(back.nanoseconds[size_t(t)], 0) << termName(t);
     EXPECT_NEAR(back.nanoseconds[size_t(t)], r.profile.nanoseconds[size_t(t)], 1e-5 * (1 + r.profile.nanoseconds[size_t(t)]))
         << termName(t);
+  }
+}
+
+// Interrupted (the CLI's SIGINT handler sets the flag) before anything was timed: nothing is
+// timed and the error says why there is nothing to fit.
+TEST(Calibrate, AnInterruptionBeforeAnyTimingSaysSo) {
+  std::atomic<bool> stop{true};
+  CalibrationOptions o;
+  o.meshes = {"small"};
+  o.drawsPerFrame = 1;
+  o.frames = 1;
+  o.rounds = 1;
+  o.stop = &stop;
+  try {
+    calibrateDevice(o);
+    ADD_FAILURE() << "an interrupted calibration with nothing timed fitted a profile";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("interrupted before anything was timed"), std::string::npos) << e.what();
   }
 }
 
