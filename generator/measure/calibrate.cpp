@@ -600,7 +600,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   CalibrationReport rep;
   rep.device = harness.deviceName();
   rep.driver = renderer.driver();
-  const bool hostClock = rep.device.find("llvmpipe") != std::string::npos;
+  const bool hostClock = isCpuDevice(rep.device);
   // A CPU device (lavapipe) runs work outside the timestamps' reach (deferred binning,
   // rasterizer threads), and its wall time counts whatever else the machine runs: the
   // process's CPU time over submit-to-fence counts the work itself. Its programs draw with

@@ -61,14 +61,21 @@ struct GpuBenchReport {
   // plan cost with time per vertex, and Spearman (rank) correlation; NaN if < 3 rows.
   double pearsonOn = 0, spearmanOn = 0, pearsonOff = 0, spearmanOff = 0;
   double pearsonOffWall = 0, spearmanOffWall = 0;  // the same against host time, raster off
-  // With a device profile: Spearman of predicted against measured time (raster on,
-  // timestamps), and the generated program's time over the fastest generated one's.
+  // With a device profile: Spearman of predicted against measured time, and the generated
+  // program's time over the fastest generated one's, by `predictionClock`: raster on,
+  // timestamps on a GPU; on a CPU device the clock calibrate fits there (isCpuDevice).
   double spearmanPredictedOn = NAN;
   double generatedOverFastestOn = NAN;
+  std::string predictionClock;
   std::vector<Diagnostic> notes;  // loading's (which stored form is read, what budgets removed)
 };
 
 GpuBenchReport runGpuBench(const GpuBenchOptions& opts);
+
+// A CPU device (lavapipe): its timestamp queries miss work it defers (on the 2,009-vertex head
+// they read 55 ns per vertex where submit-to-fence took 1,000), so bench and calibrate time it
+// by the host: this process's CPU time with the rasterizer discarded, else wall time.
+bool isCpuDevice(const std::string& deviceName);
 
 // Predicted against measured time by one clock (`clock`: &GpuBenchRow::rasterOnNsPerVertex,
 // ...), over the rows with a plan cost that passed validation and were timed by it: how many,
