@@ -159,6 +159,27 @@ TEST(GpuBench, FloorsReadThePositionInEitherLayoutAndArePredicted) {
   }
 }
 
+// On a CPU device (lavapipe, the tests' device) the prediction check uses the clock calibrate
+// fits there, this process's CPU time with the rasterizer discarded, not lavapipe's timestamps
+// (which miss deferred work): the generated program over the fastest passing plan by that clock.
+TEST(GpuBench, ACpuDeviceIsCheckedByTheClockItsProfileWasFittedOn) {
+  sg::GpuBenchOptions b = quickBench(sourcePath("examples/dawn/rules.yaml"));
+  b.render.gen.deviceProfilePath = sourcePath("devices/llvmpipe-2core.yaml");
+  sg::GpuBenchReport rep = sg::runGpuBench(b);
+  ASSERT_TRUE(sg::isCpuDevice(rep.device)) << rep.device;
+  EXPECT_EQ(rep.predictionClock, "raster off, process CPU time (a CPU device)");
+  ASSERT_FALSE(rep.rows.empty());
+  ASSERT_EQ(rep.rows.front().label, "generated");
+  double fastest = INFINITY;
+  for (const auto& row : rep.rows)
+    if (row.hasCost && row.validation == "pass") {
+      ASSERT_GT(row.rasterOffCpuNsPerVertex, 0) << row.label;
+      fastest = std::min(fastest, row.rasterOffCpuNsPerVertex);
+    }
+  EXPECT_DOUBLE_EQ(rep.generatedOverFastestOn, rep.rows.front().rasterOffCpuNsPerVertex / fastest);
+  EXPECT_NE(sg::formatGpuBench(rep).find("predicted vs measured (raster off, process CPU time (a CPU device);"), std::string::npos);
+}
+
 TEST(GpuBench, HandPortOfListing33ComputesWhatTheGeneratedShaderComputes) {
   sg::GenerateOptions g;
   g.rigPath = sourcePath("examples/dawn/face.rig.yaml");
