@@ -424,12 +424,12 @@ SpirvAccesses measureAccesses(const std::vector<uint32_t>& words) {
   };
   std::map<std::vector<uint32_t>, Element> elements;
   std::map<uint32_t, Chain> chains;  // access chain result -> its base and whether an index is computed
+  auto bytesOf = [&](uint32_t t) { return typeBytes.count(t) ? typeBytes[t] : int64_t{4}; };
   for (size_t i = 5; i < words.size();) {
     const uint32_t len = words[i] >> 16;
     if (len == 0 || i + len > words.size()) break;
     const auto op = static_cast<spv::Op>(words[i] & 0xffffu);
     const uint32_t* w = &words[i];
-    auto bytesOf = [&](uint32_t t) { return typeBytes.count(t) ? typeBytes[t] : int64_t{4}; };
     switch (op) {
       case spv::OpConstant:
         if (len >= 4) constantValue[w[2]] = w[3];

@@ -70,8 +70,8 @@ RuleAccesses measureRuleAccesses(const RuleSet& rules, int rule, const ProbeRig&
 
 // Sets the buffer-load (elements), buffer vec4-load (16-byte loads; one per component for a
 // buffer of tightly packed floats), buffer-byte (elements x the buffer's element stride) and
-// indexed uniform load terms (elements and vec4 loads) of every action that reads a storage buffer or a uniform array, then
-// reprices the problem. Throws InputError when a snippet cannot be measured.
+// indexed uniform load terms (elements and vec4 loads) of every action that reads a storage
+// buffer or a uniform array, then reprices the problem. Throws InputError when a snippet cannot be measured.
 void measureAccessTerms(Problem& p, const RuleSet& rules, const Rig& rig);
 
 // Replaces every `cost: auto` by the measured cost for `rig` (rules whose `when` is false

@@ -159,6 +159,13 @@ void measureWorkloadOf(GenerateOptions& o, const std::string& mesh) {
   o.workload = rigWorkload(o.rigPath, o.rigParams, mesh);
 }
 
+GenerateOptions partOptions(const GenerateOptions& base, const std::string& partRef) {
+  GenerateOptions o = base;
+  o.rigPath = partRef;
+  if (!o.deviceProfilePath.empty()) measureWorkloadOf(o, "");
+  return o;
+}
+
 namespace {
 
 struct GenerateCommand {
@@ -289,11 +296,9 @@ struct GenerateCommand {
     std::vector<std::string> inputsRead;
     std::vector<nlohmann::ordered_json> entries(parts.size());
     std::vector<std::string> failed = forEachPart(parts, [&](const GltfPart& part) {
-      GenerateOptions o = base;
-      o.rigPath = part.ref;
+      GenerateOptions o = partOptions(base, part.ref);
       std::string stem = (std::filesystem::path(output) / part.name).string();
       o.outputName = stem + ".vert";
-      if (!o.deviceProfilePath.empty()) measureWorkloadOf(o, "");
       GenerateResult r = generate(o);
       std::vector<PendingFile> out = outputsOf(r, kinds, stem, false);
       nlohmann::ordered_json& e = entries[static_cast<size_t>(&part - parts.data())];

@@ -53,10 +53,7 @@ struct RenderCommand {
     std::vector<std::string> failed =
         forEachPart(parts, [&](const GltfPart& part) {
           RenderOptions o = ro;
-          if (!o.gen.deviceProfilePath.empty()) {  // each part priced for its own mesh, as generate prices it
-            o.gen.rigPath = part.ref;
-            measureWorkloadOf(o.gen, "");
-          }
+          o.gen = partOptions(ro.gen, part.ref);
           programs.push_back(modelPart(o, part));
         });
     failIfPartsFailed(ro.gen.rigPath, parts.size(), failed);

@@ -206,9 +206,7 @@ struct ValidateCommand {
       io.primitive = part.primitive;
       io.read = vo.gen.gltf;
       GltfImport model = importGltf(parseGltfRef(part.ref).file, io);
-      GenerateOptions gen = vo.gen;
-      gen.rigPath = part.ref;
-      if (!gen.deviceProfilePath.empty()) measureWorkloadOf(gen, "");  // as generate prices each part
+      GenerateOptions gen = partOptions(vo.gen, part.ref);
       GltfSceneInfo info;
       done[i] = validatePrimitive(v, model, gen, so, part.name, info);
       if (header.empty()) {

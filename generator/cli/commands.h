@@ -59,6 +59,9 @@ CLI::Validator finiteNumber(bool positive);
 // The workload a generation is priced for (measure/workload.h): a glTF rig's own mesh, or
 // for a YAML rig the procedural mesh `mesh` ("" = unknown). Sets o.workload.
 void measureWorkloadOf(GenerateOptions& o, const std::string& mesh);
+// One primitive of a whole model (MODEL.glb#*) as its own rig: `base` with rigPath = partRef,
+// priced for that primitive's own mesh under a device profile, as MODEL.glb#m/p is.
+GenerateOptions partOptions(const GenerateOptions& base, const std::string& partRef);
 
 void registerCommands(CLI::App& app, CliState& state);
 void registerGenerate(CLI::App& app, CliState& state);
