@@ -149,5 +149,33 @@ TEST(DawnProfile, PreparedInputsArePricedForTheirWorkload) {
   EXPECT_EQ(three, 3 * one);
 }
 
+// The vec4 loads of the palette (4 per mat4 entry, 16 for the face's 4 influences) priced by
+// joints_per_warp_squared: 9 times dearer at three joints per warp than at one, and where the
+// mesh is unknown, the square of the stated joints_per_warp default.
+TEST(DawnProfile, PaletteVec4LoadsArePricedByTheSquareOfJointsPerWarp) {
+  const DeviceProfile profile = parseDeviceProfile(
+      "device: d\nweights:\n  indexed_uniform_vec4_loads: 1\nscaled_by:\n  indexed_uniform_vec4_loads: joints_per_warp_squared\n"
+      "workload_defaults:\n  joints_per_warp: 2\n",
+      "squared.yaml");
+  const Rig rig = loadRigStage(kDawn + "face.rig.yaml");
+  const RuleSet rules = loadRulesStage({kDawn + "rules.yaml"});
+  const FragmentInterface fragment = loadFragmentStage(kDawn + "face.frag", TargetEnv::Vulkan1_0);
+  auto paletteCost = [&](double jointsPerWarp) {
+    GenerateOptions o;
+    o.workload.jointsPerWarp = jointsPerWarp;
+    const LoadedInputs in = prepareInputs(rig, rules, fragment, o, profile);
+    for (const Action& a : in.problem.actions)
+      if (a.name == "skin_matrix_blend") {
+        EXPECT_EQ(a.terms[kTermIndexedUniformVec4Loads], 16);
+        return a.cost;
+      }
+    return int64_t{-1};
+  };
+  const int64_t one = paletteCost(1);
+  EXPECT_EQ(one, 16 * kFemtosecondsPerNanosecond);
+  EXPECT_EQ(paletteCost(3), 9 * one);
+  EXPECT_EQ(paletteCost(0), 4 * one);  // unknown: the default, 2, squared
+}
+
 }  // namespace
 }  // namespace sg
