@@ -1,17 +1,27 @@
-// Helpers shared by the search tests: the plan validity check.
+// Helpers shared by the search tests: the plan validity check, a search by engine name.
 #pragma once
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <set>
 #include <stdexcept>
 #include <vector>
 
 #include "search/plan.h"
 #include "search/problem.h"
+#include "search/search.h"
 
 namespace sg {
+
+// The plan the named engine finds (default heuristic), with its statistics when asked.
+inline std::optional<Plan> solveWith(const Problem& p, const std::string& engine, SearchStats* st = nullptr) {
+  SearchOptions o;
+  o.engine = engine;
+  return findPlan(p, o, st);
+}
 
 // Validates a plan: each action applicable in order from init, goals reached, cost is
 // the sum of the actions' costs (and the costs of the inputs read, once each), no action repeated, and every action's product is new

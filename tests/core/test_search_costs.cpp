@@ -33,12 +33,6 @@ void bindAttributeLimit(Problem& p, std::mt19937& rng) {
   p.limits[0].max = std::max<int64_t>(0, use[0] - static_cast<int64_t>(rng() % 2));
 }
 
-std::optional<Plan> solveWith(const Problem& p, const std::string& engine, SearchStats* st = nullptr) {
-  SearchOptions o;
-  o.engine = engine;
-  return findPlan(p, o, st);
-}
-
 TEST(SearchCostsProperty, RandomProfilesMatchExhaustiveSolver) {
   int moved = 0, limited = 0;
   for (uint64_t seed = 1; seed <= 300; ++seed) {

@@ -38,13 +38,6 @@ void addBindingLimits(Problem& p, std::mt19937& rng) {
   for (size_t l = 0; l < use.size(); ++l) p.limits[l].max = std::max<int64_t>(0, use[l] - static_cast<int64_t>(rng() % 2));
 }
 
-std::optional<Plan> solveWith(const Problem& p, const std::string& engine, const std::string& heuristic = "lmcut") {
-  SearchOptions o;
-  o.engine = engine;
-  o.heuristic = heuristic;
-  return findPlan(p, o);
-}
-
 // Small random libraries (8-20 rules) with binding limits: regression (every heuristic),
 // forward (falls back to the IP when its plan breaks a limit) and the IP all find the
 // exhaustive optimum, or all agree that no plan fits.

@@ -64,12 +64,6 @@ int64_t exhaustiveLargest(const Problem& p) {
   });
 }
 
-std::optional<Plan> solveWith(const Problem& p, const std::string& engine, SearchStats* st = nullptr) {
-  SearchOptions o;
-  o.engine = engine;
-  return findPlan(p, o, st);
-}
-
 TEST(SearchRooflineProperty, RandomRooflinesMatchExhaustiveSolver) {
   int limited = 0, differs = 0;
   for (uint64_t seed = 1; seed <= 200; ++seed) {
