@@ -16,10 +16,9 @@ DeviceProfile profileForm(ProfileForm form) {
   // A uniform load at a per-vertex index is served once per distinct address a warp reads
   // (the constant cache serialises them), so its weight is per address: loads x joints per warp.
   p.scaledBy[kTermIndexedUniformLoads] = kFeatureJointsPerWarp;
-  // Counted in vec4s, a warp's palette reads grow with the square: each pass serves one
-  // address, and the more joints a warp spans the less of its palette the constant cache
-  // holds (chosen by held-out error on the H200: docs/device-profiles.md).
-  p.scaledBy[kTermIndexedUniformVec4Loads] = kFeatureJointsPerWarpSquared;
+  // Counted in vec4s too: the H200's palette probes cost about 0.04 ns per vec4 per joint a
+  // warp reads, at 2.6 and at 12.2 joints per warp alike (docs/device-profiles.md).
+  p.scaledBy[kTermIndexedUniformVec4Loads] = kFeatureJointsPerWarp;
   p.workloadDefaults[kFeatureJointsPerWarp] = 1;
   if (form == ProfileForm::Roofline) {
     auto pipe = [&](const char* name, std::initializer_list<int> terms) {
@@ -29,8 +28,11 @@ DeviceProfile profileForm(ProfileForm form) {
       p.pipes.push_back(x);
     };
     pipe("fetch", {kTermLocations, kTermAttributeBytes});
-    pipe("memory", {kTermBufferLoads, kTermBufferVec4Loads, kTermBufferBytes, kTermIndexedUniformLoads,
-                    kTermIndexedUniformVec4Loads});
+    pipe("memory", {kTermBufferLoads, kTermBufferVec4Loads, kTermBufferBytes});
+    // Uniform loads at a per-vertex index go through the constant cache, a unit of its own:
+    // in one pipe with storage-buffer loads, a palette's cost hid under the fetch it adds to,
+    // and the 300-bone palette was chosen at 1.56x the fastest (docs/device-profiles.md).
+    pipe("constant", {kTermIndexedUniformLoads, kTermIndexedUniformVec4Loads});
     pipe("alu", {kTermArithmetic});
     pipe("output", {kTermOutputs});
   }

@@ -4,10 +4,12 @@
 //   additive  ns = sum_t (w_t + d_t / V) x_t                      (every profile before issue 33)
 //   roofline  ns = sum_t (w_t + d_t / V) x_t  +  max_p sum_{t in p} w_pt x_t
 // where x_t is the amount of term t, scaled by a workload feature where the form says so
-// (indexed uniform loads by the joints a warp reads), and V the vertices per draw. In the
-// roofline form the additive part holds the per-vertex fixed cost and the per-draw weights;
-// the pipes hold the rest (fetch: locations and attribute bytes; memory: storage-buffer and
-// indexed uniform loads; alu: arithmetic; output: outputs), which the device overlaps.
+// (uniform loads at a per-vertex index, elements and vec4s, by the joints a warp reads), and
+// V the vertices per draw. In the roofline form the additive part holds the per-vertex fixed
+// cost and the per-draw weights;
+// the pipes hold the rest (fetch: locations and attribute bytes; memory: storage-buffer loads;
+// constant: uniform loads at a per-vertex index; alu: arithmetic; output: outputs), which the
+// device overlaps.
 #pragma once
 #include <string>
 #include <vector>
