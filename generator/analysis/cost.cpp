@@ -579,7 +579,43 @@ void measureAccessTerms(Problem& p, const RuleSet& rules, const Rig& rig) {
     act.terms[kTermIndexedUniformLoads] = a.indexedUniformLoads;
     act.terms[kTermIndexedUniformVec4Loads] = a.indexedUniformVec4Loads;
   }
+  shareIndexedUniformLoads(p);
   priceProblem(p, p.weights);
+}
+
+void shareIndexedUniformLoads(Problem& p) {
+  // Per uniform array: whether every rule reading it reads no other uniform array and loads
+  // it at a per-vertex index, and the most loads one of them makes.
+  struct Readers {
+    bool shareable = true;
+    TermAmounts most{};
+    std::vector<size_t> actions;
+  };
+  std::map<int, Readers> arrays;  // by fact
+  for (size_t i = 0; i < p.actions.size(); ++i) {
+    const Action& act = p.actions[i];
+    std::vector<int> read;
+    for (int q : act.pre) {
+      const Fact& f = p.facts[static_cast<size_t>(q)];
+      if (f.source == Fact::Source::Uniform && f.arraySize > 0) read.push_back(q);
+    }
+    for (int q : read) {
+      Readers& r = arrays[q];
+      r.actions.push_back(i);
+      r.shareable = r.shareable && read.size() == 1 && act.terms[kTermIndexedUniformLoads] > 0 &&
+                    p.facts[static_cast<size_t>(q)].resource >= 0;
+      for (int t : {kTermIndexedUniformLoads, kTermIndexedUniformVec4Loads})
+        r.most[t] = std::max(r.most[t], act.terms[t]);
+    }
+  }
+  for (auto& [fact, r] : arrays) {
+    if (!r.shareable) continue;
+    ResourceItem& item = p.resources[static_cast<size_t>(p.facts[static_cast<size_t>(fact)].resource)];
+    for (int t : {kTermIndexedUniformLoads, kTermIndexedUniformVec4Loads}) {
+      item.terms[t] = r.most[t];
+      for (size_t a : r.actions) p.actions[a].terms[t] = 0;
+    }
+  }
 }
 
 void resolveAutoCosts(RuleSet& rules, const Rig& rig) {

@@ -74,6 +74,18 @@ RuleAccesses measureRuleAccesses(const RuleSet& rules, int rule, const ProbeRig&
 // buffer or a uniform array, then reprices the problem. Throws InputError when a snippet cannot be measured.
 void measureAccessTerms(Problem& p, const RuleSet& rules, const Rig& rig);
 
+// Palette elements that several rules of a plan read at the same per-vertex index (the skin
+// matrix and a linear blend of the position, each indexing the palette by the joints) are
+// loaded once: the device's compiler reuses a uniform load of the same address (on the H200 a
+// plan reading a 300-bone palette twice takes 8-20 % more than reading it once, where the
+// palette's loads alone are 80 % of it). So a uniform array that every
+// reader loads at a per-vertex index, and reads beside no other uniform array, carries its
+// indexed-load terms on its resource item, paid once per plan, at the most any reader makes;
+// its readers carry none. Readers that index it by different inputs (joints from a buffer, from
+// attributes) share it too: a plan mixing them is under-counted, and never the cheapest (it
+// reads both forms of the joints). Called by measureAccessTerms.
+void shareIndexedUniformLoads(Problem& p);
+
 // Replaces every `cost: auto` by the measured cost for `rig` (rules whose `when` is false
 // for the rig are left alone: they are not instantiated). Throws InputError when a snippet
 // cannot be measured (its compile errors, located at the rule's YAML lines).

@@ -231,3 +231,38 @@ TEST(AccessTerms, CountedOnTheDawnRules) {
 
 }  // namespace
 }  // namespace sg
+
+// A palette read at the per-vertex joints by the skin matrix and by a linear blend of the
+// position is loaded once (the device's compiler reuses the loads): a plan with both pays
+// 4 influences x 4 vec4 loads of a mat4 entry, as a plan with one of them does, not twice.
+namespace sg {
+namespace {
+TEST(AccessTerms, APaletteReadByTwoRulesIsLoadedOnce) {
+  GenerateOptions o;
+  o.rigPath = sourceDir() + "/examples/dawn/face.rig.yaml";
+  o.fragmentPath = sourceDir() + "/examples/dawn/face.frag";
+  o.rulesPaths = {sourceDir() + "/examples/dawn/rules.yaml"};
+  o.deviceProfilePath = sourceDir() + "/devices/nvidia-h200-roofline.yaml";
+  LoadedInputs in = loadInputs(o);
+  const Problem& p = in.problem;
+  auto action = [&](const std::string& rule) {
+    for (size_t i = 0; i < p.actions.size(); ++i)
+      if (p.actions[i].name == rule) return static_cast<int>(i);
+    ADD_FAILURE() << "no action " << rule;
+    return 0;
+  };
+  const int skin = action("skin_matrix_blend"), blend = action("world_position_linear_blend"),
+            buffered = action("skin_matrix_blend_buffered_influences"), bufferPalette = action("skin_matrix_blend_buffer_palette");
+  auto vec4Loads = [&](std::vector<int> actions) { return planAmounts(p, actions)[kTermIndexedUniformVec4Loads]; };
+  auto elements = [&](std::vector<int> actions) { return planAmounts(p, actions)[kTermIndexedUniformLoads]; };
+  EXPECT_EQ(vec4Loads({skin}), 16);
+  EXPECT_EQ(vec4Loads({blend}), 16);
+  EXPECT_EQ(vec4Loads({skin, blend}), 16);
+  EXPECT_EQ(elements({skin, blend}), 4);
+  EXPECT_EQ(vec4Loads({buffered}), 16);  // influences from a buffer, the palette still uniform
+  // The palette from a storage buffer: no uniform load at all.
+  EXPECT_EQ(vec4Loads({bufferPalette}), 0);
+  EXPECT_EQ(planAmounts(p, {bufferPalette})[kTermBufferVec4Loads], 16);
+}
+}  // namespace
+}  // namespace sg

@@ -128,6 +128,15 @@ TEST(DawnProfile, TheMeasuredH200ProfileReadsFewLocations) {
 // once and prepares each variant from it (prepareInputs), as generate does after loading. A
 // profile that prices indexed uniform loads per joint a warp reads must make the palette three
 // times dearer on a mesh with three joints per warp than on one with one.
+// The resource item of the face's palette (skin.bones in the uniform block), which carries the
+// loads its readers make at a per-vertex index (analysis/cost.h shareIndexedUniformLoads).
+const ResourceItem& paletteItem(const Problem& p) {
+  const int f = p.findFact("skin.bones");
+  EXPECT_GE(f, 0);
+  EXPECT_GE(p.facts[static_cast<size_t>(f)].resource, 0);
+  return p.resources[static_cast<size_t>(p.facts[static_cast<size_t>(f)].resource)];
+}
+
 TEST(DawnProfile, PreparedInputsArePricedForTheirWorkload) {
   const DeviceProfile profile = parseDeviceProfile(
       "device: d\nweights:\n  indexed_uniform_loads: 1\nscaled_by:\n  indexed_uniform_loads: joints_per_warp\n",
@@ -139,10 +148,7 @@ TEST(DawnProfile, PreparedInputsArePricedForTheirWorkload) {
     GenerateOptions o;
     o.workload.jointsPerWarp = jointsPerWarp;
     const LoadedInputs in = prepareInputs(rig, rules, fragment, o, profile);
-    int64_t cost = -1;
-    for (const Action& a : in.problem.actions)
-      if (a.terms[kTermIndexedUniformLoads] > 0 && a.name == "skin_matrix_blend") cost = a.cost;
-    return cost;
+    return paletteItem(in.problem).cost;  // the palette's loads, paid once by whichever rules read it
   };
   const int64_t one = paletteCost(1), three = paletteCost(3);
   ASSERT_GT(one, 0) << "skin_matrix_blend reads the palette at a per-vertex index";
@@ -164,12 +170,9 @@ TEST(DawnProfile, PaletteVec4LoadsArePricedByTheSquareOfJointsPerWarp) {
     GenerateOptions o;
     o.workload.jointsPerWarp = jointsPerWarp;
     const LoadedInputs in = prepareInputs(rig, rules, fragment, o, profile);
-    for (const Action& a : in.problem.actions)
-      if (a.name == "skin_matrix_blend") {
-        EXPECT_EQ(a.terms[kTermIndexedUniformVec4Loads], 16);
-        return a.cost;
-      }
-    return int64_t{-1};
+    const ResourceItem& palette = paletteItem(in.problem);
+    EXPECT_EQ(palette.terms[kTermIndexedUniformVec4Loads], 16);
+    return palette.cost;
   };
   const int64_t one = paletteCost(1);
   EXPECT_EQ(one, 16 * kFemtosecondsPerNanosecond);
