@@ -36,7 +36,10 @@ struct CalibrateCommand {
       std::string first;
       std::getline(in, first);
       if (device && device->empty() && first.rfind("device: ", 0) == 0) {
-        const size_t driver = first.find(" (driver: "), end = first.find(')', driver);
+        // "device: NAME (driver: DRIVER); clock: ...": a driver may hold parentheses of its own.
+        const size_t driver = first.find(" (driver: ");
+        size_t end = first.find("); clock: ", driver);
+        if (end == std::string::npos) end = first.rfind(')');
         *device = driver == std::string::npos ? first.substr(8)
                                               : first.substr(8, driver - 8) + " (" + first.substr(driver + 10, end - driver - 10) + ")";
       }

@@ -129,12 +129,8 @@ struct ValidateCommand {
       so.morphWeight = morphWeight;
       so.read = vo.gen.gltf;
       so.allInstances = true;
-      GltfRef ref = parseGltfRef(vo.gen.rigPath);
-      GltfImportOptions io;
-      io.mesh = ref.mesh;
-      io.primitive = ref.primitive;
-      io.read = vo.gen.gltf;
-      GltfImport model = importGltf(ref.file, io);
+      const GltfRef ref = parseGltfRef(vo.gen.rigPath);
+      GltfImport model = importGltfRef(vo.gen.rigPath, vo.gen.gltf);
       Validator v(vo);
       GltfSceneInfo info;
       std::vector<ValidatedPart> parts{validatePrimitive(v, model, vo.gen, so,
@@ -201,11 +197,7 @@ struct ValidateCommand {
       done[i].name = part.name;
       done[i].rig = part.ref;
       done[i].error = "not run: see the diagnostics";
-      GltfImportOptions io;
-      io.mesh = part.mesh;
-      io.primitive = part.primitive;
-      io.read = vo.gen.gltf;
-      GltfImport model = importGltf(parseGltfRef(part.ref).file, io);
+      GltfImport model = importGltfRef(part.ref, vo.gen.gltf);
       GenerateOptions gen = partOptions(vo.gen, part.ref);
       GltfSceneInfo info;
       done[i] = validatePrimitive(v, model, gen, so, part.name, info);

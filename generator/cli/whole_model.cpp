@@ -21,12 +21,9 @@ std::optional<std::vector<GltfPart>> wholeModelParts(const std::string& rigPath)
 
 void checkWholeModelAnimation(const std::vector<GltfPart>& parts, const std::string& animation) {
   if (animation.empty() || parts.empty()) return;
-  GltfImportOptions o;
-  o.mesh = parts.front().mesh;
-  o.primitive = parts.front().primitive;
   std::optional<GltfImport> first;
   try {
-    first = importGltf(parseGltfRef(parts.front().ref).file, o);
+    first = importGltfRef(parts.front().ref);
   } catch (const InputError&) {
     return;  // that primitive's own failure is reported with the others
   }

@@ -118,10 +118,7 @@ Workload rigWorkload(const std::string& rigPath, const std::map<std::string, int
     if (!mesh.empty())
       throw InputError(SourceLoc{}, fmt::format("--mesh {}: a glTF rig ({}) is measured on its own mesh", mesh, rigPath));
     const GltfRef ref = parseGltfRef(rigPath);
-    GltfImportOptions io;
-    io.mesh = ref.mesh;
-    io.primitive = ref.primitive;
-    const GltfImport model = importGltf(ref.file, io);
+    const GltfImport model = importGltfRef(rigPath);
     const GltfModelData& d = model.data;
     GltfSceneOptions so;
     so.times = {0.0};

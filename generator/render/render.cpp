@@ -68,11 +68,7 @@ ModelPart modelPart(const RenderOptions& opts, const GltfPart& part) {
   p.scene = renderScene(p.gen.in.rig, o);
   // Other instances: every node of the scene that draws this mesh, with its own transform,
   // skin and morph weights (gltfInstances), under the one program.
-  GltfImportOptions io;
-  io.mesh = part.mesh;
-  io.primitive = part.primitive;
-  io.read = opts.gen.gltf;
-  GltfImport model = importGltf(parseGltfRef(part.ref).file, io);
+  GltfImport model = importGltfRef(part.ref, opts.gen.gltf);
   GltfSceneOptions so;
   so.times = {opts.time};
   so.animation = opts.animation;
@@ -139,21 +135,17 @@ std::vector<uint32_t> triangleList(const std::vector<uint32_t>& indices, int mod
 
 RenderScene renderScene(const Rig& rig, const RenderOptions& opts) {
   if (isGltfPath(opts.gen.rigPath)) {
-    GltfRef ref = parseGltfRef(opts.gen.rigPath);
-    GltfImportOptions io;
-    io.mesh = ref.mesh;
-    io.primitive = ref.primitive;
-    io.read = opts.gen.gltf;
-    GltfImport model = importGltf(ref.file, io);
+    const std::string file = parseGltfRef(opts.gen.rigPath).file;
+    GltfImport model = importGltfRef(opts.gen.rigPath, opts.gen.gltf);
     GltfSceneOptions so;
     so.times = {opts.time};
     so.animation = opts.animation;
     so.morphWeight = opts.gltfMorphWeight;
-    if (!model.data.indicesError.empty()) throw InputError(SourceLoc{ref.file, 0, 0}, model.data.indicesError);
+    if (!model.data.indicesError.empty()) throw InputError(SourceLoc{file, 0, 0}, model.data.indicesError);
     ValidationScene vs = gltfScene(model, so);
     RenderScene s;
     s.mesh = quantizeForRig(rig, vs.mesh);
-    s.indices = triangleList(model.data.indices, model.data.mode, s.mesh.vertexCount, ref.file);
+    s.indices = triangleList(model.data.indices, model.data.mode, s.mesh.vertexCount, file);
     s.shape = vs.shape;
     s.pose = vs.poses.front();
     frameCamera(s.mesh, s.shape, opts.camera, float(opts.width) / float(opts.height), s.pose);

@@ -936,14 +936,18 @@ GltfImport importGltfText(const std::string& json, const std::string& fileName, 
   return loadAndImport(fileName, opts, &json, baseDir);
 }
 
-Rig loadRig(const std::string& path, const GltfReadOptions& read) {
-  if (!isGltfPath(path)) return loadRigFile(path);
-  GltfRef ref = parseGltfRef(path);
+GltfImport importGltfRef(const std::string& refText, const GltfReadOptions& read) {
+  const GltfRef ref = parseGltfRef(refText);
   GltfImportOptions o;
   o.read = read;
   o.mesh = ref.mesh;
   o.primitive = ref.primitive;
-  return importGltf(ref.file, o).rig;
+  return importGltf(ref.file, o);
+}
+
+Rig loadRig(const std::string& path, const GltfReadOptions& read) {
+  if (!isGltfPath(path)) return loadRigFile(path);
+  return importGltfRef(path, read).rig;
 }
 
 std::string rigToYaml(const Rig& rig, const std::vector<std::string>& header) {

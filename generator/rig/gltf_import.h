@@ -209,7 +209,9 @@ size_t loadGltfModel(const std::string& file, tinygltf::Model& model);
 GltfImport importGltfModel(const tinygltf::Model& model, size_t inputBytes, const std::string& file,
                            const GltfImportOptions& opts = {});
 
-// Any rig path: "rig.yaml" (loadRigFile) or "model.glb[#m/p]" (importGltf with `read`).
+// One primitive of a model by its reference, "model.glb[#m/p]" (importGltf with `read`).
+GltfImport importGltfRef(const std::string& ref, const GltfReadOptions& read = {});
+// Any rig path: "rig.yaml" (loadRigFile) or "model.glb[#m/p]" (importGltfRef).
 Rig loadRig(const std::string& path, const GltfReadOptions& read = {});
 
 // The rig as YAML that loadRigText reads back to the same rig. `header` lines become

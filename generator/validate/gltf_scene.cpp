@@ -337,12 +337,7 @@ ValidationScene gltfScene(const GltfImport& model, const GltfSceneOptions& opts,
 }
 
 ValidationScene gltfScene(const std::string& modelRef, const GltfSceneOptions& opts, GltfSceneInfo* info) {
-  GltfRef ref = parseGltfRef(modelRef);
-  GltfImportOptions o;
-  o.mesh = ref.mesh;
-  o.primitive = ref.primitive;
-  o.read = opts.read;
-  return gltfScene(importGltf(ref.file, o), opts, info);
+  return gltfScene(importGltfRef(modelRef, opts.read), opts, info);
 }
 
 }  // namespace sg

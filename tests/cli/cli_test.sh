@@ -502,6 +502,18 @@ device_profile)
   else
     fail "calibrate after SIGINT: exit $rc; $(tail -3 int.out) $(cat int.err)"
   fi
+  # Offline refit from a recorded log: the device (a driver name holding parentheses of its own)
+  # and the fit are read back, the profile loads, and --evaluate checks held-out logs by name.
+  LP=$SRC/bench/data/lavapipe-heldout
+  expect 0 "calibrate --from-log (no device)" -- "$SG" calibrate --from-log "$LP/train.log" --check-log "$LP/pbr.log" \
+    --form additive --near-best-weight 0 -o refit.yaml
+  grep -qx 'device: "llvmpipe (LLVM 15.0.6, 256 bits) (llvmpipe Mesa 22.3.6 (LLVM 15.0.6))"' refit.yaml &&
+    ok "the log's device and driver, whole" || fail "device line: $(grep '^device' refit.yaml)"
+  grep -q "^held-out check over 4 (rig, mesh) pairs" last.out && ok "the held-out check of the pbr log's four pairs" ||
+    fail "$(grep held-out last.out)"
+  expect 0 "generate under the refitted profile" -- "$SG" generate "${DAWN[@]}" --device-profile refit.yaml -o refit --emit glsl
+  expect 0 "calibrate --evaluate" -- "$SG" calibrate --evaluate refit.yaml --check-log "$LP/world.log"
+  grep -q "^| limb8_palette300.rig.yaml | head | 6 |" last.out && ok "--evaluate lists each held-out pair" || fail "$(tail -5 last.out)"
   # render MODEL.glb#* under a profile prices each primitive for its own mesh, as MODEL.glb#m/p
   # does (CesiumMan has one primitive; its palette loads are priced per joint a warp reads).
   CESIUM=$SRC/../shared/models/CesiumMan/CesiumMan.glb
