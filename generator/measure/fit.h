@@ -6,10 +6,9 @@
 // where x_t is the amount of term t, scaled by a workload feature where the form says so
 // (uniform loads at a per-vertex index, elements and vec4s, by the joints a warp reads), and
 // V the vertices per draw. In the roofline form the additive part holds the per-vertex fixed
-// cost and the per-draw weights;
-// the pipes hold the rest (fetch: locations and attribute bytes; memory: storage-buffer loads;
-// constant: uniform loads at a per-vertex index; alu: arithmetic; output: outputs), which the
-// device overlaps.
+// cost and the per-draw weights; the pipes hold the rest (fetch: locations and attribute bytes;
+// memory: storage-buffer loads; constant: uniform loads at a per-vertex index; alu: arithmetic;
+// output: outputs), which the device overlaps.
 #pragma once
 #include <string>
 #include <vector>

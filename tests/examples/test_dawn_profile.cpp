@@ -124,33 +124,32 @@ TEST(DawnProfile, TheMeasuredH200ProfileReadsFewLocations) {
   }
 }
 
+// The face's palette (skin.bones in the uniform block) priced by `profile` for a mesh of
+// `jointsPerWarp` (0: unknown), inputs prepared as `build` prepares each variant: its resource
+// item carries the loads its readers make at a per-vertex index (shareIndexedUniformLoads).
+ResourceItem facePaletteItem(const DeviceProfile& profile, double jointsPerWarp) {
+  static const Rig rig = loadRigStage(kDawn + "face.rig.yaml");
+  static const RuleSet rules = loadRulesStage({kDawn + "rules.yaml"});
+  static const FragmentInterface fragment = loadFragmentStage(kDawn + "face.frag", TargetEnv::Vulkan1_0);
+  GenerateOptions o;
+  o.workload.jointsPerWarp = jointsPerWarp;
+  const LoadedInputs in = prepareInputs(rig, rules, fragment, o, profile);
+  const int f = in.problem.findFact("skin.bones");
+  EXPECT_GE(f, 0);
+  const int item = f < 0 ? -1 : in.problem.facts[static_cast<size_t>(f)].resource;
+  EXPECT_GE(item, 0);
+  return item < 0 ? ResourceItem{} : in.problem.resources[static_cast<size_t>(item)];
+}
+
 // The workload reaches the prices on every path that prepares inputs: `build` loads a profile
 // once and prepares each variant from it (prepareInputs), as generate does after loading. A
 // profile that prices indexed uniform loads per joint a warp reads must make the palette three
 // times dearer on a mesh with three joints per warp than on one with one.
-// The resource item of the face's palette (skin.bones in the uniform block), which carries the
-// loads its readers make at a per-vertex index (analysis/cost.h shareIndexedUniformLoads).
-const ResourceItem& paletteItem(const Problem& p) {
-  const int f = p.findFact("skin.bones");
-  EXPECT_GE(f, 0);
-  EXPECT_GE(p.facts[static_cast<size_t>(f)].resource, 0);
-  return p.resources[static_cast<size_t>(p.facts[static_cast<size_t>(f)].resource)];
-}
-
 TEST(DawnProfile, PreparedInputsArePricedForTheirWorkload) {
   const DeviceProfile profile = parseDeviceProfile(
       "device: d\nweights:\n  indexed_uniform_loads: 1\nscaled_by:\n  indexed_uniform_loads: joints_per_warp\n",
       "per-joint.yaml");
-  const Rig rig = loadRigStage(kDawn + "face.rig.yaml");
-  const RuleSet rules = loadRulesStage({kDawn + "rules.yaml"});
-  const FragmentInterface fragment = loadFragmentStage(kDawn + "face.frag", TargetEnv::Vulkan1_0);
-  auto paletteCost = [&](double jointsPerWarp) {
-    GenerateOptions o;
-    o.workload.jointsPerWarp = jointsPerWarp;
-    const LoadedInputs in = prepareInputs(rig, rules, fragment, o, profile);
-    return paletteItem(in.problem).cost;  // the palette's loads, paid once by whichever rules read it
-  };
-  const int64_t one = paletteCost(1), three = paletteCost(3);
+  const int64_t one = facePaletteItem(profile, 1).cost, three = facePaletteItem(profile, 3).cost;
   ASSERT_GT(one, 0) << "skin_matrix_blend reads the palette at a per-vertex index";
   EXPECT_EQ(three, 3 * one);
 }
@@ -163,21 +162,11 @@ TEST(DawnProfile, PaletteVec4LoadsArePricedByTheSquareOfJointsPerWarp) {
       "device: d\nweights:\n  indexed_uniform_vec4_loads: 1\nscaled_by:\n  indexed_uniform_vec4_loads: joints_per_warp_squared\n"
       "workload_defaults:\n  joints_per_warp: 2\n",
       "squared.yaml");
-  const Rig rig = loadRigStage(kDawn + "face.rig.yaml");
-  const RuleSet rules = loadRulesStage({kDawn + "rules.yaml"});
-  const FragmentInterface fragment = loadFragmentStage(kDawn + "face.frag", TargetEnv::Vulkan1_0);
-  auto paletteCost = [&](double jointsPerWarp) {
-    GenerateOptions o;
-    o.workload.jointsPerWarp = jointsPerWarp;
-    const LoadedInputs in = prepareInputs(rig, rules, fragment, o, profile);
-    const ResourceItem& palette = paletteItem(in.problem);
-    EXPECT_EQ(palette.terms[kTermIndexedUniformVec4Loads], 16);
-    return palette.cost;
-  };
-  const int64_t one = paletteCost(1);
+  EXPECT_EQ(facePaletteItem(profile, 1).terms[kTermIndexedUniformVec4Loads], 16);
+  const int64_t one = facePaletteItem(profile, 1).cost;
   EXPECT_EQ(one, 16 * kFemtosecondsPerNanosecond);
-  EXPECT_EQ(paletteCost(3), 9 * one);
-  EXPECT_EQ(paletteCost(0), 4 * one);  // unknown: the default, 2, squared
+  EXPECT_EQ(facePaletteItem(profile, 3).cost, 9 * one);
+  EXPECT_EQ(facePaletteItem(profile, 0).cost, 4 * one);  // unknown: the default, 2, squared
 }
 
 }  // namespace

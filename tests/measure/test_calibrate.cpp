@@ -14,6 +14,7 @@
 
 #include "measure/calibrate.h"
 #include "measure/gpu_bench.h"
+#include "measure_test_util.h"
 
 namespace sg {
 namespace {
@@ -25,11 +26,7 @@ const CalibrationSample* find(const CalibrationReport& r, const std::string& lab
 }
 
 TEST(Calibrate, EveryProbeAgreesWithItsExpectedOutputsOnLavapipeAndVariesOneTerm) {
-  CalibrationOptions o;
-  o.meshes = {"small"};
-  o.drawsPerFrame = 1;
-  o.frames = 1;
-  o.rounds = 1;
+  CalibrationOptions o = testing::quickCalibration();
   CalibrationReport r = calibrateDevice(o);
   ASSERT_GE(r.samples.size(), 20u);
   for (const auto& s : r.samples) {
@@ -89,11 +86,7 @@ TEST(Calibrate, EveryProbeAgreesWithItsExpectedOutputsOnLavapipeAndVariesOneTerm
 // timed and the error says why there is nothing to fit.
 TEST(Calibrate, AnInterruptionBeforeAnyTimingSaysSo) {
   std::atomic<bool> stop{true};
-  CalibrationOptions o;
-  o.meshes = {"small"};
-  o.drawsPerFrame = 1;
-  o.frames = 1;
-  o.rounds = 1;
+  CalibrationOptions o = testing::quickCalibration();
   o.stop = &stop;
   try {
     calibrateDevice(o);
@@ -342,11 +335,7 @@ TEST(Calibrate, SpearmanTreatsTimesWithinTheSpreadAsTies) {
 // default does not, so a plan reading it from the uniform block at a per-vertex index is timed.
 namespace sg {
 TEST(Calibrate, TimesThePlansTheDevicesLimitsAllow) {
-  CalibrationOptions o;
-  o.meshes = {"small"};
-  o.drawsPerFrame = 1;
-  o.frames = 1;
-  o.rounds = 1;
+  CalibrationOptions o = testing::quickCalibration();
   o.probes = false;
   o.check = false;
   o.validationLayers = false;

@@ -10,6 +10,7 @@
 
 #include "measure/calibrate.h"
 #include "measure/corpus.h"
+#include "measure_test_util.h"
 
 namespace sg {
 namespace {
@@ -97,11 +98,7 @@ TEST(HeldOut, TheProfileRecordsTheSummary) {
 // calibrate --corpus: the random rigs' plans are timed on the device (lavapipe), each
 // validated first, and every rig is held out in turn.
 TEST(HeldOut, CalibrateTimesTheCorpusAndHoldsEachRigOut) {
-  CalibrationOptions o;
-  o.meshes = {"small"};
-  o.drawsPerFrame = 1;
-  o.frames = 1;
-  o.rounds = 1;
+  CalibrationOptions o = testing::quickCalibration();
   o.probes = false;
   o.check = false;
   o.corpus = 2;  // the fewest that can be held out in turn
