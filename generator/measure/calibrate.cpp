@@ -221,10 +221,15 @@ Probe bufferProbe(const ProbeMesh& m, int n) {
 // indices, every vertex of a warp a different joint, took 29.6 ns per vertex for four
 // loads on the H200 at Dawn scale, 15x their uniform-index twin: a case no skinned mesh
 // has, which made the fit overprice a plan's palette loads.)
-Probe paletteProbe(const ProbeMesh& m, int n, bool perVertex) {
-  Probe p = baseProbe(m, fmt::format("palette loads {} at a {} index", n, perVertex ? "per-vertex" : "uniform"), 1);
+// In a storage buffer (`inBuffer`), the same loads are gathers through the memory pipe.
+Probe paletteProbe(const ProbeMesh& m, int n, bool perVertex, bool inBuffer = false) {
+  Probe p = baseProbe(m, fmt::format("{}palette loads {} at a {} index", inBuffer ? "buffer " : "", n, perVertex ? "per-vertex" : "uniform"), 1);
   constexpr uint32_t kEntries = 128;
-  p.decl += fmt::format("layout(std140, set = 0, binding = 0) uniform Block {{ mat4 palette[{}]; uint base; }} u;\n", kEntries);
+  if (inBuffer)
+    p.decl += "layout(std140, set = 0, binding = 0) uniform Block { uint base; } u;\n"
+              "layout(std430, set = 0, binding = 1) readonly buffer Palette { mat4 palette[]; } b;\n";
+  else
+    p.decl += fmt::format("layout(std140, set = 0, binding = 0) uniform Block {{ mat4 palette[{}]; uint base; }} u;\n", kEntries);
   // Both variants read the index attribute (same locations and bytes); only the first uses it.
   p.decl += "layout(location = 1) in uvec4 joint;\n";
   const auto& joints = m.mesh.streams.at("skin.joints[0]");
@@ -249,10 +254,19 @@ Probe paletteProbe(const ProbeMesh& m, int n, bool perVertex) {
         std::memcpy(p.inputs.uniformData.data() + size_t(e) * 64 + size_t(c) * 16 + size_t(r) * 4, &f, 4);
       }
   std::memcpy(p.inputs.uniformData.data() + kEntries * 64, &base, 4);
+  if (inBuffer) {
+    rt::StorageBufferData b;
+    b.binding = 1;
+    b.data.assign(p.inputs.uniformData.begin(), p.inputs.uniformData.begin() + kEntries * 64);
+    p.inputs.storageBuffers.push_back(std::move(b));
+    p.inputs.uniformData.assign(16, 0);
+    std::memcpy(p.inputs.uniformData.data(), &base, 4);
+  }
+  const char* array = inBuffer ? "b.palette" : "u.palette";
   p.body = "  o0 = vec4(joint) * 0.001;\n";
   for (int i = 0; i < n; ++i)
-    p.body += perVertex ? fmt::format("  o0 += u.palette[(joint[{}] + {}u) & {}u] * a0;\n", i % 4, 7 * (i / 4), kEntries - 1)
-                        : fmt::format("  o0 += u.palette[(u.base + {}u) & {}u] * a0;\n", i, kEntries - 1);
+    p.body += perVertex ? fmt::format("  o0 += {}[(joint[{}] + {}u) & {}u] * a0;\n", array, i % 4, 7 * (i / 4), kEntries - 1)
+                        : fmt::format("  o0 += {}[(u.base + {}u) & {}u] * a0;\n", array, i, kEntries - 1);
   const auto& pos = m.mesh.streams.at("vertex.position");
   for (size_t v = 0; v < m.mesh.vertexCount; ++v) {
     const uint8_t* j = &s.data[v * 4];
@@ -263,8 +277,15 @@ Probe paletteProbe(const ProbeMesh& m, int n, bool perVertex) {
     }
     for (int c = 0; c < 4; ++c) expectedAt(p, v, 0, c) = o[c];
   }
-  p.amounts[kTermIndexedUniformLoads] = perVertex ? n : 0;
-  p.amounts[kTermIndexedUniformVec4Loads] = perVertex ? 4 * n : 0;  // a mat4: 4 vec4 loads
+  if (inBuffer) {  // every load counts as a buffer load; the per-vertex ones are gathers too
+    p.amounts[kTermBufferLoads] = n;
+    p.amounts[kTermBufferVec4Loads] = 4 * n;  // a mat4: 4 vec4 loads
+    p.amounts[kTermBufferBytes] = 64 * n;
+    p.amounts[kTermIndexedBufferVec4Loads] = perVertex ? 4 * n : 0;
+  } else {
+    p.amounts[kTermIndexedUniformLoads] = perVertex ? n : 0;
+    p.amounts[kTermIndexedUniformVec4Loads] = perVertex ? 4 * n : 0;
+  }
   return p;
 }
 
@@ -290,6 +311,8 @@ std::vector<Probe> makeProbes(const ProbeMesh& m) {
   for (int n : {1, 4, 8, 16}) probes.push_back(bufferProbe(m, n));
   for (int n : {1, 2, 4, 8, 16})
     for (bool perVertex : {true, false}) probes.push_back(paletteProbe(m, n, perVertex));
+  for (int n : {4, 16})
+    for (bool perVertex : {true, false}) probes.push_back(paletteProbe(m, n, perVertex, true));
   for (int n : {1, 4, 8, 15}) probes.push_back(outputProbe(m, n));
   return probes;
 }

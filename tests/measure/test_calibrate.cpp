@@ -65,6 +65,17 @@ TEST(Calibrate, EveryProbeAgreesWithItsExpectedOutputsOnLavapipeAndVariesOneTerm
   EXPECT_EQ(pv16->amounts[kTermIndexedUniformLoads], 16);
   EXPECT_EQ(pv16->amounts[kTermIndexedUniformVec4Loads], 64);
   EXPECT_EQ(pv->amounts[kTermLocations], pu->amounts[kTermLocations]);
+  // The palette in a storage buffer: buffer loads either way, gathers only at a per-vertex index.
+  const CalibrationSample* bv = find(r, "buffer palette loads 16 at a per-vertex index");
+  const CalibrationSample* bu = find(r, "buffer palette loads 16 at a uniform index");
+  ASSERT_TRUE(bv && bu);
+  for (const CalibrationSample* x : {bv, bu}) {
+    EXPECT_EQ(x->amounts[kTermBufferLoads], 16) << x->label;
+    EXPECT_EQ(x->amounts[kTermBufferVec4Loads], 64) << x->label;
+    EXPECT_EQ(x->amounts[kTermIndexedUniformLoads], 0) << x->label;
+  }
+  EXPECT_EQ(bv->amounts[kTermIndexedBufferVec4Loads], 64);
+  EXPECT_EQ(bu->amounts[kTermIndexedBufferVec4Loads], 0);
   const CalibrationSample* b16 = find(r, "storage-buffer loads 16");
   ASSERT_TRUE(b16);
   EXPECT_EQ(b16->amounts[kTermBufferLoads], 16);
