@@ -238,8 +238,9 @@ struct GenerateCommand {
   }
 
   void printPlan(const GenerateResult& r, const GenerateOptions& o) const {
-    std::cout << fmt::format("plan for rig '{}' ({} rules, {} expanded, {} heuristic):\n", r.in.rig.name,
-                             r.plan.actions.size(), r.stats.expanded, o.heuristic);
+    const std::string how = r.stats.heuristic.empty() ? "integer program"
+                                                       : fmt::format("{} expanded, {} heuristic", r.stats.expanded, r.stats.heuristic);
+    std::cout << fmt::format("plan for rig '{}' ({} rules, {}):\n", r.in.rig.name, r.plan.actions.size(), how);
     std::cout << describePlan(r.in.problem, r.plan);
     if (r.in.profile) std::cout << describePlanCost(r.plan, r.in.problem, *r.in.profile);
     for (const DeviceProfile& d : r.in.portable) std::cout << describePlanCost(r.plan, r.in.problem, d);

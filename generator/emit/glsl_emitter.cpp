@@ -175,6 +175,7 @@ class Emitter {
         {"fragment", baseName(fragmentName)},
         {"cost", std::to_string(plan_.cost)},
         {"heuristic", opts_.heuristic},
+        {"search", opts_.search},
         {"sources", sourcesList()},
         {"inputs", inputs},
         {"uniforms", uniforms},

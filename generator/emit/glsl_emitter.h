@@ -18,6 +18,8 @@ namespace sg {
 struct EmitOptions {
   bool capture = false;  // add transform-feedback qualifiers (validation builds only)
   std::string heuristic = "lmcut";
+  // The search that found the plan, as the header names it ("lmcut A*", "integer program").
+  std::string search = "lmcut A*";
   std::string version;  // shadergen version printed in the header
 };
 

@@ -391,6 +391,9 @@ GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const
   EmitOptions eo;
   eo.capture = opts.capture;
   eo.heuristic = opts.heuristic;
+  // The engine that found it: a roofline or portable profile on a cyclic graph, or --search ip,
+  // is solved by the integer program, which the header must not call A*.
+  eo.search = res.stats.heuristic.empty() ? "integer program" : res.stats.heuristic + " A*";
   eo.version = shadergenVersion();
   res.glsl = emitStage(in, res.plan, templates, eo);
   CompiledVertexShader compiled = compileStage(in, res.plan, res.glsl, opts.outputName, opts.targetEnv);

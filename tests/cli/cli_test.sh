@@ -303,6 +303,13 @@ search)
     expect 0 "--search $engine" -- "$SG" generate "${DAWN[@]}" -o "s/$engine" --search "$engine" --stats
     grep -q "^search ($engine" last.out && grep -q 'total cost 97$' last.out && ok "--search $engine: cost 97" ||
       fail "--search $engine printed: $(head -3 last.out)"
+    # The shader's header and the plan line name the search that found it: no A* for the IP.
+    case $engine in ip) what='integer program' ;; *) what='lmcut A\*' ;; esac
+    grep -q "Plan cost 97 ($what)\.$" s/$engine*.vert && ok "--search $engine: the header names it" ||
+      fail "--search $engine header: $(grep -h 'Plan cost' s/$engine*)"
+    case $engine in ip) grep -q "^plan for rig .*(21 rules, integer program):" last.out ;;
+                    *) grep -q "^plan for rig .*(21 rules, [0-9]* expanded, lmcut heuristic):" last.out ;; esac &&
+      ok "--search $engine: the plan line names it" || fail "--search $engine plan line: $(grep '^plan for' last.out)"
   done
   expect 2 "unknown --search" -- "$SG" generate "${DAWN[@]}" -o x --search sideways
   expect 2 "negative --search-time-limit" -- "$SG" generate "${DAWN[@]}" -o x --search-time-limit -1
