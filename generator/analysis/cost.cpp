@@ -563,7 +563,6 @@ void measureAccessTerms(Problem& p, const RuleSet& rules, const Rig& rig) {
       throw e;
     }
     act.terms[kTermBufferLoads] = act.terms[kTermBufferBytes] = act.terms[kTermBufferVec4Loads] = 0;
-    act.terms[kTermIndexedBufferVec4Loads] = 0;
     for (const auto& [fact, elements] : a.bufferLoads) {
       const int f = p.findFact(fact);
       if (f < 0 || p.facts[static_cast<size_t>(f)].source != Fact::Source::Buffer) continue;
@@ -572,12 +571,9 @@ void measureAccessTerms(Problem& p, const RuleSet& rules, const Rig& rig) {
       // The probe reads the semantic's own type; the program reads the buffer's layout:
       // tightly packed floats take one scalar load per component (glsl_emitter's accessor).
       auto loads = a.bufferVec4Loads.find(fact);
-      const int64_t vec4s = b.element == Type::Float ? elements * componentCount(bf.type)
-                                                     : (loads == a.bufferVec4Loads.end() ? elements : loads->second);
       act.terms[kTermBufferLoads] += elements;
-      act.terms[kTermBufferVec4Loads] += vec4s;
-      // An array buffer holds a rig uniform array (the palette): read at a per-vertex index.
-      if (b.kind == BufferSource::Kind::Array) act.terms[kTermIndexedBufferVec4Loads] += vec4s;
+      act.terms[kTermBufferVec4Loads] += b.element == Type::Float ? elements * componentCount(bf.type)
+                                                                   : (loads == a.bufferVec4Loads.end() ? elements : loads->second);
       act.terms[kTermBufferBytes] += elements * b.strideBytes;
     }
     act.terms[kTermIndexedUniformLoads] = a.indexedUniformLoads;

@@ -277,11 +277,10 @@ Probe paletteProbe(const ProbeMesh& m, int n, bool perVertex, bool inBuffer = fa
     }
     for (int c = 0; c < 4; ++c) expectedAt(p, v, 0, c) = o[c];
   }
-  if (inBuffer) {  // every load counts as a buffer load; the per-vertex ones are gathers too
+  if (inBuffer) {  // storage-buffer loads, as the search counts a buffer palette's
     p.amounts[kTermBufferLoads] = n;
     p.amounts[kTermBufferVec4Loads] = 4 * n;  // a mat4: 4 vec4 loads
     p.amounts[kTermBufferBytes] = 64 * n;
-    p.amounts[kTermIndexedBufferVec4Loads] = perVertex ? 4 * n : 0;
   } else {
     p.amounts[kTermIndexedUniformLoads] = perVertex ? n : 0;
     p.amounts[kTermIndexedUniformVec4Loads] = perVertex ? 4 * n : 0;
@@ -311,10 +310,10 @@ std::vector<Probe> makeProbes(const ProbeMesh& m) {
   for (int n : {1, 4, 8, 16}) probes.push_back(bufferProbe(m, n));
   for (int n : {1, 2, 4, 8, 16})
     for (bool perVertex : {true, false}) probes.push_back(paletteProbe(m, n, perVertex));
-  // A palette in a storage buffer at the skin's joints only: at a uniform index its loads are
-  // broadcasts, cheaper per vec4 than any per-vertex stream (on the H200, 64 vec4s took 3.2 ns
-  // against 4.6 for 16 streamed), a case no plan has that drove the fit to price elements
-  // and not vec4s (docs/device-profiles.md).
+  // A palette in a storage buffer (a plan form the buffer rules offer), at the skin's joints
+  // only: at a uniform index its loads are broadcasts, cheaper per vec4 than any per-vertex
+  // stream (on the H200, 64 vec4s took 3.2 ns against 4.6 for 16 streamed), a case no plan has
+  // that drove the fit to price elements and not vec4s (docs/device-profiles.md).
   for (int n : {4, 16}) probes.push_back(paletteProbe(m, n, true, true));
   for (int n : {1, 4, 8, 15}) probes.push_back(outputProbe(m, n));
   return probes;

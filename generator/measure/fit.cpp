@@ -19,8 +19,6 @@ DeviceProfile profileForm(ProfileForm form) {
   // Counted in vec4s too: the H200's palette probes cost about 0.04 ns per vec4 per joint a
   // warp reads, at 2.6 and at 12.2 joints per warp alike (docs/device-profiles.md).
   p.scaledBy[kTermIndexedUniformVec4Loads] = kFeatureJointsPerWarp;
-  // A palette in a storage buffer: the gather's extra cost is per distinct element a warp reads.
-  p.scaledBy[kTermIndexedBufferVec4Loads] = kFeatureJointsPerWarp;
   p.workloadDefaults[kFeatureJointsPerWarp] = 1;
   if (form == ProfileForm::Roofline) {
     auto pipe = [&](const char* name, std::initializer_list<int> terms) {
@@ -30,7 +28,7 @@ DeviceProfile profileForm(ProfileForm form) {
       p.pipes.push_back(x);
     };
     pipe("fetch", {kTermLocations, kTermAttributeBytes});
-    pipe("memory", {kTermBufferLoads, kTermBufferVec4Loads, kTermBufferBytes, kTermIndexedBufferVec4Loads});
+    pipe("memory", {kTermBufferLoads, kTermBufferVec4Loads, kTermBufferBytes});
     // Uniform loads at a per-vertex index go through the constant cache, a unit of its own:
     // in one pipe with storage-buffer loads, a palette's cost hid under the fetch it adds to,
     // and the 300-bone palette was chosen at 1.56x the fastest (docs/device-profiles.md).

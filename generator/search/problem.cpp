@@ -35,7 +35,6 @@ const char* termName(int term) {
   static const char* const names[kTermCount] = {"arithmetic",   "locations",  "attribute_bytes",
                                                 "buffer_bytes", "buffer_loads", "indexed_uniform_loads",
                                                 "buffer_vec4_loads", "indexed_uniform_vec4_loads",
-                                                "indexed_buffer_vec4_loads",
                                                 "outputs",      "vertices"};
   return term >= 0 && term < kTermCount ? names[term] : "?";
 }

@@ -52,11 +52,6 @@ enum CostTerm {
   // component. Profiles from before they were counted weigh them 0 and mean what they meant.
   kTermBufferVec4Loads,
   kTermIndexedUniformVec4Loads,
-  // The vec4 loads of buffer_vec4_loads that read an array buffer (a palette in a storage
-  // buffer) at an index computed per vertex: a gather, whose cost grows with the distinct
-  // elements a warp reads, where a per-vertex stream's loads are contiguous. Counted in
-  // buffer_vec4_loads too; profiles from before it weigh it 0 and mean what they meant.
-  kTermIndexedBufferVec4Loads,
   kTermOutputs,             // output components written (the varyings and gl_Position)
   kTermVertices,            // 1: the fixed cost of running the program for one vertex
   kTermCount
@@ -67,7 +62,7 @@ const char* termName(int term);
 // Search cost units per unit of each term (int64: A* stays exact). Without a profile the
 // unit is the instruction slot; a profile's unit is the femtosecond (docs/device-profiles.md).
 using TermWeights = std::array<int64_t, kTermCount>;
-constexpr TermWeights kSlotWeights = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+constexpr TermWeights kSlotWeights = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0};
 // sum of weight x amount (checked: a hostile profile cannot overflow it silently).
 int64_t weighTerms(const TermWeights& w, const TermAmounts& a);
 
