@@ -250,15 +250,23 @@ std::string describePlanCost(const Plan& plan, const Problem& p, const DevicePro
   std::string out = fmt::format("  predicted per vertex on '{}'{}{}:\n", profile.device,
                                 profile.file.empty() ? "" : fmt::format(" ({})", profile.file),
                                 profile.hasDrawWeights() ? fmt::format(" at {:g} vertices per draw", profile.verticesPerDraw) : "");
-  out += fmt::format("    {:<22} {:>8} {:>10} {:>9}\n", "term", "amount", "ns/unit", "ns");
-  for (size_t t = 0; t < kTermCount; ++t)
-    out += fmt::format("    {:<22} {:>8} {:>10.6f} {:>9.3f}\n", termName(static_cast<int>(t)), c.amounts[t],
+  out += fmt::format("    {:<26} {:>8} {:>10} {:>9}\n", "term", "amount", "ns/unit", "ns");
+  for (size_t t = 0; t < kTermCount; ++t) {
+    out += fmt::format("    {:<26} {:>8} {:>10.6f} {:>9.3f}", termName(static_cast<int>(t)), c.amounts[t],
                        static_cast<double>(w[t]) / kFemtosecondsPerNanosecond, c.nanoseconds[t]);
+    // A roofline's term is priced in its pipes: what it adds to each (summed in the pipe's line).
+    for (const DeviceProfile::Pipe& pipe : profile.pipes)
+      if (pipe.nanoseconds[t] > 0) {
+        const double perUnit = pipe.nanoseconds[t] * profile.feature(profile.scaledBy[t]);
+        out += fmt::format("  + {:.6f} x {} = {:.3f} in {}", perUnit, c.amounts[t], perUnit * double(c.amounts[t]), pipe.name);
+      }
+    out += "\n";
+  }
   for (size_t k = 0; k < c.pipeNanoseconds.size(); ++k)
-    out += fmt::format("    {:<22} {:>8} {:>10} {:>9.3f}{}\n", "pipe " + profile.pipes[k].name, "", "", c.pipeNanoseconds[k],
+    out += fmt::format("    {:<26} {:>8} {:>10} {:>9.3f}{}\n", "pipe " + profile.pipes[k].name, "", "", c.pipeNanoseconds[k],
                        static_cast<int>(k) == c.slowestPipe ? "  (slowest: counted)" : "");
   if (profile.workload.known()) out += fmt::format("    workload: {}\n", describeWorkload(profile.workload));
-  out += fmt::format("    {:<22} {:>8} {:>10} {:>9.3f}\n", "total", "", "", c.totalNanoseconds);
+  out += fmt::format("    {:<26} {:>8} {:>10} {:>9.3f}\n", "total", "", "", c.totalNanoseconds);
   return out;
 }
 

@@ -217,3 +217,41 @@ TEST(SearchRoofline, APortablePlanMinimisesTheWorstRegret) {
 
 }  // namespace
 }  // namespace sg
+
+namespace sg {
+namespace {
+
+// The prediction of a roofline profile shows each term's price in its pipe, and those prices
+// add up to the pipe's line: a reader can see why a pipe is the slowest.
+TEST(SearchRoofline, ThePredictionShowsEachTermInItsPipe) {
+  Problem p;
+  p.facts = {Fact{"in"}, Fact{"out"}};
+  p.init = {0};
+  p.goals = {1};
+  Action a{"fetch_and_load", 0, {0}, 1};
+  a.terms[kTermLocations] = 3;
+  a.terms[kTermBufferLoads] = 2;
+  p.actions = {a};
+  DeviceProfile prof;
+  prof.device = "test";
+  prof.nanoseconds[kTermVertices] = 1;
+  p.fixedTerms[kTermVertices] = 1;
+  DeviceProfile::Pipe fetch, memory;
+  fetch.name = "fetch";
+  fetch.nanoseconds[kTermLocations] = 0.5;
+  memory.name = "memory";
+  memory.nanoseconds[kTermBufferLoads] = 0.25;
+  prof.pipes = {fetch, memory};
+  applyDeviceProfile(p, prof);
+  auto plan = solveWith(p, "auto");
+  ASSERT_TRUE(plan);
+  const std::string text = describePlanCost(*plan, p, prof);
+  EXPECT_NE(text.find("+ 0.500000 x 3 = 1.500 in fetch"), std::string::npos) << text;
+  EXPECT_NE(text.find("+ 0.250000 x 2 = 0.500 in memory"), std::string::npos) << text;
+  EXPECT_NE(text.find("pipe fetch"), std::string::npos) << text;
+  // 1 ns fixed + the slowest pipe (fetch, 1.5 ns); the memory pipe's 0.5 ns overlaps.
+  EXPECT_DOUBLE_EQ(predictPlanCost(*plan, p, prof).totalNanoseconds, 2.5);
+}
+
+}  // namespace
+}  // namespace sg
