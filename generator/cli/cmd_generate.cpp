@@ -237,7 +237,7 @@ struct GenerateCommand {
     files.push_back({dpath, makeDepfile(targets, inputsRead)});
   }
 
-  void printPlan(const GenerateResult& r, const GenerateOptions& o) const {
+  void printPlan(const GenerateResult& r) const {
     const std::string how = r.stats.heuristic.empty() ? "integer program"
                                                        : fmt::format("{} expanded, {} heuristic", r.stats.expanded, r.stats.heuristic);
     std::cout << fmt::format("plan for rig '{}' ({} rules, {}):\n", r.in.rig.name, r.plan.actions.size(), how);
@@ -280,7 +280,7 @@ struct GenerateCommand {
     if (stats) std::cout << describeStats(r.stats);
     for (const auto& n : r.in.notes) std::cerr << formatDiagnostic(n) << "\n";
     if (!quiet) {
-      printPlan(r, o);
+      printPlan(r);
       for (const auto& f : files) std::cout << "wrote " << f.path << "\n";
     }
     return 0;
@@ -313,7 +313,7 @@ struct GenerateCommand {
       if (stats) std::cout << part.name << ": " << describeStats(r.stats);
       if (!quiet) {
         std::cout << part.name << ": ";
-        printPlan(r, o);
+        printPlan(r);
       }
       files.insert(files.end(), out.begin(), out.end());
     });
