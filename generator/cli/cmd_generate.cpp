@@ -238,9 +238,9 @@ struct GenerateCommand {
   }
 
   void printPlan(const GenerateResult& r) const {
-    const std::string how = r.stats.heuristic.empty() ? "integer program"
-                                                       : fmt::format("{} expanded, {} heuristic", r.stats.expanded, r.stats.heuristic);
-    std::cout << fmt::format("plan for rig '{}' ({} rules, {}):\n", r.in.rig.name, r.plan.actions.size(), how);
+    const std::string expanded = r.stats.heuristic.empty() ? "" : fmt::format(", {} expanded", r.stats.expanded);
+    std::cout << fmt::format("plan for rig '{}' ({} rules, {}{}):\n", r.in.rig.name, r.plan.actions.size(),
+                             searchMethod(r.stats), expanded);
     std::cout << describePlan(r.in.problem, r.plan);
     if (r.in.profile) std::cout << describePlanCost(r.plan, r.in.problem, *r.in.profile);
     for (const DeviceProfile& d : r.in.portable) std::cout << describePlanCost(r.plan, r.in.problem, d);

@@ -245,23 +245,19 @@ Probe paletteProbe(const ProbeMesh& m, int n, bool perVertex, bool inBuffer = fa
   p.amounts[kTermAttributeBytes] += 4;
   const uint32_t base = 5;
   std::vector<glm::dmat4> palette(kEntries);
-  p.inputs.uniformData.assign(kEntries * 64 + 16, 0);
+  std::vector<uint8_t> bytes(kEntries * 64);  // mat4 entries: the same layout in std140 and std430
   for (uint32_t e = 0; e < kEntries; ++e)
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r) {
         float f = static_cast<float>(2 * unit(200 + e, uint32_t(c), uint32_t(r)) - 1);
         palette[e][c][r] = f;
-        std::memcpy(p.inputs.uniformData.data() + size_t(e) * 64 + size_t(c) * 16 + size_t(r) * 4, &f, 4);
+        std::memcpy(bytes.data() + size_t(e) * 64 + size_t(c) * 16 + size_t(r) * 4, &f, 4);
       }
-  std::memcpy(p.inputs.uniformData.data() + kEntries * 64, &base, 4);
-  if (inBuffer) {
-    rt::StorageBufferData b;
-    b.binding = 1;
-    b.data.assign(p.inputs.uniformData.begin(), p.inputs.uniformData.begin() + kEntries * 64);
-    p.inputs.storageBuffers.push_back(std::move(b));
-    p.inputs.uniformData.assign(16, 0);
-    std::memcpy(p.inputs.uniformData.data(), &base, 4);
-  }
+  if (inBuffer) p.inputs.storageBuffers.push_back(rt::StorageBufferData{1, std::move(bytes)});
+  else p.inputs.uniformData = std::move(bytes);
+  const size_t baseAt = p.inputs.uniformData.size();  // `base` follows the palette, if any
+  p.inputs.uniformData.resize(baseAt + 16, 0);
+  std::memcpy(p.inputs.uniformData.data() + baseAt, &base, 4);
   const char* array = inBuffer ? "b.palette" : "u.palette";
   p.body = "  o0 = vec4(joint) * 0.001;\n";
   for (int i = 0; i < n; ++i)

@@ -15,6 +15,7 @@
 #include "rig/gltf_import.h"
 #include "rig/rig_lod.h"
 #include "rig/vertex_encoding.h"
+#include "search/search.h"
 
 namespace sg {
 
@@ -391,9 +392,7 @@ GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const
   EmitOptions eo;
   eo.capture = opts.capture;
   eo.heuristic = opts.heuristic;
-  // The engine that found it: a roofline or portable profile on a cyclic graph, or --search ip,
-  // is solved by the integer program, which the header must not call A*.
-  eo.search = res.stats.heuristic.empty() ? "integer program" : res.stats.heuristic + " A*";
+  eo.search = searchMethod(res.stats);
   eo.version = shadergenVersion();
   res.glsl = emitStage(in, res.plan, templates, eo);
   CompiledVertexShader compiled = compileStage(in, res.plan, res.glsl, opts.outputName, opts.targetEnv);

@@ -46,6 +46,10 @@ std::optional<Plan> findPlan(const Problem& p, const SearchOptions& opts, Search
   return plan;
 }
 
+std::string searchMethod(const SearchStats& st) {
+  return st.heuristic.empty() ? "integer program" : st.heuristic + " A*";
+}
+
 std::string describeStats(const SearchStats& st) {
   std::string who = st.heuristic.empty() ? st.engine : fmt::format("{} A*, {}", st.engine, st.heuristic);
   return fmt::format(

@@ -22,6 +22,10 @@ struct SearchOptions {
 // cyclic rule graph; SearchLimitError at a limit. nullopt: the goals are unreachable.
 std::optional<Plan> findPlan(const Problem& p, const SearchOptions& opts, SearchStats* stats = nullptr);
 
+// How the plan was found, as the shader's header and generate's plan line name it: "lmcut A*",
+// or "integer program" (--search ip, or forward A*'s fallback under a roofline profile).
+std::string searchMethod(const SearchStats& st);
+
 // `generate --stats`: expansions, generated nodes, heuristic time, initial h vs cost.
 std::string describeStats(const SearchStats& st);
 

@@ -308,7 +308,7 @@ search)
     grep -q "Plan cost 97 ($what)\.$" s/$engine*.vert && ok "--search $engine: the header names it" ||
       fail "--search $engine header: $(grep -h 'Plan cost' s/$engine*)"
     case $engine in ip) grep -q "^plan for rig .*(21 rules, integer program):" last.out ;;
-                    *) grep -q "^plan for rig .*(21 rules, [0-9]* expanded, lmcut heuristic):" last.out ;; esac &&
+                    *) grep -q "^plan for rig .*(21 rules, lmcut A\*, [0-9]* expanded):" last.out ;; esac &&
       ok "--search $engine: the plan line names it" || fail "--search $engine plan line: $(grep '^plan for' last.out)"
   done
   expect 2 "unknown --search" -- "$SG" generate "${DAWN[@]}" -o x --search sideways

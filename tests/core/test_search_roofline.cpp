@@ -43,6 +43,22 @@ std::vector<TermWeights> randomComponents(uint64_t seed) {
   return out;
 }
 
+// One goal, "out" from "in", reached by the ways addWay adds: each one action paying `locations`
+// and `loads` (the fetch and memory pipes' terms).
+Problem oneGoal() {
+  Problem p;
+  p.facts = {Fact{"in"}, Fact{"out"}};
+  p.init = {0};
+  p.goals = {1};
+  return p;
+}
+void addWay(Problem& p, const char* name, int locations, int loads) {
+  Action a{name, static_cast<int>(p.actions.size()), {0}, 1};
+  a.terms[kTermLocations] = locations;
+  a.terms[kTermBufferLoads] = loads;
+  p.actions.push_back(a);
+}
+
 // From the definition: the cheapest feasible subset (exhaustiveMinimum), its amounts the fired
 // actions' terms, each distinct item's terms once and the fixed terms, its cost the largest
 // component's weighted sum.
@@ -123,16 +139,9 @@ TEST(SearchRooflineProperty, LibrariesMatchIntegerProgram) {
 // One goal, two ways: A reads 3 fetch units and 3 memory units (sum 6, largest pipe 3);
 // B reads 5 fetch units (sum 5, largest 5). A sum prefers B; overlapping pipes prefer A.
 TEST(SearchRoofline, TheLargestPipeDecidesNotTheSum) {
-  Problem p;
-  p.facts = {Fact{"in"}, Fact{"out"}};
-  p.init = {0};
-  p.goals = {1};
-  Action a{"overlapped", 0, {0}, 1};
-  a.terms[kTermLocations] = 3;
-  a.terms[kTermBufferLoads] = 3;
-  Action b{"fetch_only", 1, {0}, 1};
-  b.terms[kTermLocations] = 5;
-  p.actions = {a, b};
+  Problem p = oneGoal();
+  addWay(p, "overlapped", 3, 3);
+  addWay(p, "fetch_only", 5, 0);
   TermWeights fetch{}, memory{}, sum{};
   fetch[kTermLocations] = 1;
   memory[kTermBufferLoads] = 1;
@@ -179,19 +188,10 @@ namespace {
 // B's best (2 vs A's 10), "mixed" costs 3 on both: regrets fetch 5x (on B), load 5x (on A),
 // mixed 1.5x on both. The least worst-case regret is "mixed", though neither device prefers it.
 TEST(SearchRoofline, APortablePlanMinimisesTheWorstRegret) {
-  Problem p;
-  p.facts = {Fact{"in"}, Fact{"out"}};
-  p.init = {0};
-  p.goals = {1};
-  auto way = [&](const char* name, int locations, int loads) {
-    Action a{name, static_cast<int>(p.actions.size()), {0}, 1};
-    a.terms[kTermLocations] = locations;
-    a.terms[kTermBufferLoads] = loads;
-    p.actions.push_back(a);
-  };
-  way("fetch", 2, 10);
-  way("load", 10, 2);
-  way("mixed", 3, 3);
+  Problem p = oneGoal();
+  addWay(p, "fetch", 2, 10);
+  addWay(p, "load", 10, 2);
+  addWay(p, "mixed", 3, 3);
   DeviceProfile a, b;
   a.device = "A";
   a.nanoseconds[kTermLocations] = 1;
@@ -215,23 +215,11 @@ TEST(SearchRoofline, APortablePlanMinimisesTheWorstRegret) {
   }
 }
 
-}  // namespace
-}  // namespace sg
-
-namespace sg {
-namespace {
-
 // The prediction of a roofline profile shows each term's price in its pipe, and those prices
 // add up to the pipe's line: a reader can see why a pipe is the slowest.
 TEST(SearchRoofline, ThePredictionShowsEachTermInItsPipe) {
-  Problem p;
-  p.facts = {Fact{"in"}, Fact{"out"}};
-  p.init = {0};
-  p.goals = {1};
-  Action a{"fetch_and_load", 0, {0}, 1};
-  a.terms[kTermLocations] = 3;
-  a.terms[kTermBufferLoads] = 2;
-  p.actions = {a};
+  Problem p = oneGoal();
+  addWay(p, "fetch_and_load", 3, 2);
   DeviceProfile prof;
   prof.device = "test";
   prof.nanoseconds[kTermVertices] = 1;
