@@ -205,7 +205,11 @@ std::optional<Plan> integerProgramSearch(const Problem& p, SearchStats* stats, c
   }
   // A roofline objective (Problem::componentWeights): minimise an auxiliary T with one row
   // per component, T - (its actions' and items' sums) >= its fixed part; the x and z columns
-  // then cost nothing themselves.
+  // then cost nothing themselves. The rows are in units of a thousandth of their largest
+  // coefficient: at femtosecond or regret-per-10^9 magnitudes (10^9 and more) GLPK's MIP
+  // presolver reduced a coefficient wrongly and proved a plan optimal at 1.22x the optimum
+  // (tests/core/test_ip_oracle.cpp, ThePortableObjectiveIsSolvedExactly). The plan's cost is
+  // weighed exactly afterwards (tidyPlan).
   if (!p.componentWeights.empty()) {
     const int t = ++cols;
     glp_add_cols(P, 1);
@@ -213,15 +217,23 @@ std::optional<Plan> integerProgramSearch(const Problem& p, SearchStats* stats, c
     glp_set_col_bnds(P, t, GLP_LO, 0, 0);
     glp_set_obj_coef(P, t, 1);
     for (int c = 1; c < t; ++c) glp_set_obj_coef(P, c, 0);
+    int64_t largest = 1;
+    for (const TermWeights& w : p.componentWeights) {
+      largest = std::max(largest, weighTerms(w, p.fixedTerms));
+      for (int a : acts) largest = std::max(largest, weighTerms(w, p.actions[a].terms));
+      for (size_t r = 0; r < p.resources.size(); ++r)
+        if (zCol[r]) largest = std::max(largest, weighTerms(w, p.resources[r].terms));
+    }
+    const double unit = std::max(1.0, static_cast<double>(largest) / 1000.0);
     for (const TermWeights& w : p.componentWeights) {
       glp_add_rows(P, 1);
-      glp_set_row_bnds(P, ++rows, GLP_LO, static_cast<double>(weighTerms(w, p.fixedTerms)), 0);
+      glp_set_row_bnds(P, ++rows, GLP_LO, static_cast<double>(weighTerms(w, p.fixedTerms)) / unit, 0);
       auto put = [&](int col, const TermAmounts& terms) {
         const int64_t c = weighTerms(w, terms);
         if (!col || !c) return;
         ia.push_back(rows);
         ja.push_back(col);
-        ar.push_back(-static_cast<double>(c));
+        ar.push_back(-static_cast<double>(c) / unit);
       };
       for (size_t i = 0; i < acts.size(); ++i) put(static_cast<int>(i) + 1, p.actions[acts[i]].terms);
       for (size_t r = 0; r < p.resources.size(); ++r) put(zCol[r], p.resources[r].terms);
