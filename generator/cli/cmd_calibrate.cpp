@@ -13,6 +13,7 @@
 #include "cli/output_files.h"
 #include "cli/whole_model.h"
 #include "measure/calibrate.h"
+#include "measure/corpus.h"
 
 namespace sg {
 namespace {
@@ -27,6 +28,7 @@ struct CalibrateCommand {
   std::string form = "additive";
   std::vector<std::string> fromLogs, checkLogs;
   std::string evaluate;  // --evaluate PROFILE: the held-out check of an existing profile
+  std::string writeCorpus;  // --write-corpus DIR: the corpus's files, no device
 
   // Samples of earlier runs (the tables calibrate prints): the device line and its rows.
   static std::vector<CalibrationSample> readLogs(const std::vector<std::string>& files, std::string* device) {
@@ -72,8 +74,26 @@ struct CalibrateCommand {
     return 0;
   }
 
+  // The random rigs and requests --corpus N --seed S would time, as files to generate, bench or
+  // validate one by one (the held-out sets of docs/device-profiles.md are such seeds).
+  int writeCorpusFiles() const {
+    if (co.corpus == 0) throw CLI::ValidationError("--write-corpus", "needs --corpus N (how many random rigs)");
+    std::vector<PendingFile> files;
+    std::string listing;
+    for (const CorpusCase& c : randomCorpus(co.corpus, co.corpusSeed)) {
+      const std::filesystem::path stem = std::filesystem::path(writeCorpus) / c.name;
+      files.push_back({stem.string() + ".rig.yaml", c.rigYaml});
+      files.push_back({stem.string() + ".frag", c.fragment});
+      listing += files[files.size() - 2].path + " " + files.back().path + "\n";
+    }
+    writeFilesAtomically(files);  // all of them or none
+    std::cout << listing;
+    return 0;
+  }
+
   int run() {
     co.form = form == "roofline" ? ProfileForm::Roofline : ProfileForm::Additive;
+    if (!writeCorpus.empty()) return writeCorpusFiles();
     if (!fromLogs.empty()) return refit();
     if (!evaluate.empty()) {
       if (checkLogs.empty()) throw CLI::ValidationError("--evaluate", "needs --check-log (the samples to predict)");
@@ -174,6 +194,9 @@ void registerCalibrate(CLI::App& app, CliState& state) {
                   "(examples/dawn/rules.yaml has their vocabulary), as --rig does")
       ->check(CLI::Range(0, 1000));
   sub->add_option("--seed", cmd->co.corpusSeed, "The corpus's seed (default 1): the same seed, the same rigs");
+  sub->add_option("--write-corpus", cmd->writeCorpus,
+                  "Write the --corpus N --seed S rigs and requests to DIR (<name>.rig.yaml, <name>.frag; one line "
+                  "per case) and exit; no device is opened");
   sub->add_flag("--no-check", cmd->noCheck, "With --rig: do not time the rigs' plans under the fitted profile afterwards");
   sub->add_option("--from-log", cmd->fromLogs,
                   "Fit the samples of earlier runs' logs (their tables) instead of measuring; no device is opened")

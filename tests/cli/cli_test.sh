@@ -521,6 +521,17 @@ device_profile)
   expect 0 "generate under the refitted profile" -- "$SG" generate "${DAWN[@]}" --device-profile refit.yaml -o refit --emit glsl
   expect 0 "calibrate --evaluate" -- "$SG" calibrate --evaluate refit.yaml --check-log "$LP/world.log"
   grep -q "^| limb8_palette300.rig.yaml | head | 6 |" last.out && ok "--evaluate lists each held-out pair" || fail "$(tail -5 last.out)"
+  # --write-corpus: the random rigs and requests of a seed as files, without a device; the same
+  # seed writes the same bytes, and each case generates with the vocabulary's rules.
+  expect 0 "calibrate --write-corpus" -- "$SG" calibrate --corpus 3 --seed 5 --write-corpus corpus5
+  [ "$(wc -l < last.out)" -eq 3 ] && [ "$(ls corpus5 | wc -l)" -eq 6 ] && ok "three cases, a rig and a request each" ||
+    fail "--write-corpus wrote: $(ls corpus5 | tr '\n' ' ')"
+  "$SG" calibrate --corpus 3 --seed 5 --write-corpus corpus5b >/dev/null && diff -r corpus5 corpus5b >/dev/null &&
+    ok "the same seed, the same files" || fail "--write-corpus is not deterministic"
+  read -r crig cfrag < <(head -1 last.out)
+  expect 0 "a written case generates" -- "$SG" generate --rig "$crig" -f "$cfrag" -r "$SRC/examples/dawn/rules.yaml" \
+    --templates "$SRC/templates" -o corpus-case --emit glsl
+  expect 2 "--write-corpus without --corpus (a usage error)" -- "$SG" calibrate --write-corpus corpus6
   # render MODEL.glb#* under a profile prices each primitive for its own mesh, as MODEL.glb#m/p
   # does (CesiumMan has one primitive; its palette loads are priced per joint a warp reads).
   CESIUM=$SRC/../shared/models/CesiumMan/CesiumMan.glb
