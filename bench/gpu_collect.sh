@@ -5,6 +5,7 @@
 #   train     the probes, the Dawn face's two layouts and a random corpus (the fit's data)
 #   train-models  RiggedFigure on its own meshes (the fit's data too)
 #   world, corpus-heldout, body-depth, pbr, models   rigs and requests the fit never sees (the check's data)
+#   unseen, unseen-formats, unseen-models   rigs and models first timed after the profiles were fitted (session 12)
 # Fits and the held-out check are made offline from the logs (shadergen calibrate --from-logs).
 # Usage: bash gpu_collect.sh [DEVICE=NVIDIA] [OUTDIR=.]; SG_BUDGET scales every group's time limit,
 # SG_GROUPS="train world ..." runs only those groups (a device call's time limit), SG_HELDOUT_SEED picks
@@ -44,3 +45,12 @@ group pbr 70 --no-probes --rig "$data/pbr_character.rig.yaml" --rig "$data/limb8
 group models-fox 30 --no-probes --rig "$models/Fox.glb#*" -f "$here/examples/gltf/solid.frag" "${std[@]}"
 group models 90 --no-probes --rig "$models/CesiumMan.glb#*" --rig "$models/RobotExpressive.glb#*" \
   -f "$here/examples/gltf/lit.frag" "${std[@]}"
+# First timed after every shipped profile was fitted: the suite's other rigs (encodings offered in
+# pairs, bit-packed or separate, sparse targets), the three.js mesh, and models no run has drawn.
+group unseen 240 --no-probes --rig "$data/limb8.rig.yaml" --rig "$data/limb4_unorm8.rig.yaml" \
+  --rig "$data/face52_sparse.rig.yaml" --rig "$data/octahedral_or_float.rig.yaml" --rig "$data/qtangent_or_float.rig.yaml" \
+  --rig "$data/morph_scaled.rig.yaml" --rig "$data/bitpacked_or_separate.rig.yaml" --rig "$data/threejs-mesh.rig.yaml" \
+  -f "$data/world.frag" "${std[@]}"
+group unseen-formats 40 --no-probes --rig "$data/formats_a.rig.yaml" --rig "$data/formats_b.rig.yaml" -f "$data/formats.frag" "${std[@]}"
+group unseen-models 60 --no-probes --rig "$models/LeePerrySmith.glb#*" --rig "$models/AnimatedMorphSphere.meshopt-cc-kv.glb#*" \
+  --rig "$models/MorphStressTest.gltf#*" -f "$here/examples/gltf/lit.frag" "${std[@]}"

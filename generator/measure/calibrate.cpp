@@ -12,6 +12,7 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 #include "analysis/cost.h"
 #include "common/glsl_compile.h"
@@ -448,19 +449,25 @@ std::string heldOutSummary(const LeaveOneRigOut& loo, const char* what = "leave-
 // Each (rig, mesh) of `rig` ("" = every rig) in `samples`: its plans predicted by `profile`.
 std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& samples, const std::string& rig,
                                     const DeviceProfile& profile) {
-  std::vector<std::pair<std::string, std::string>> keys;  // (rig, mesh) in the samples' order
+  // One choice per (rig, request, mesh), in the samples' order; a rig timed under several
+  // requests names the request in its row.
+  std::vector<std::tuple<std::string, std::string, std::string>> keys;
+  std::map<std::string, std::set<std::string>> requestsOf;
   for (const auto& s : samples)
-    if (!s.rig.empty() && (rig.empty() || s.rig == rig) &&
-        std::find(keys.begin(), keys.end(), std::make_pair(s.rig, s.mesh)) == keys.end())
-      keys.emplace_back(s.rig, s.mesh);
+    if (!s.rig.empty() && (rig.empty() || s.rig == rig)) {
+      requestsOf[s.rig].insert(s.request);
+      if (std::find(keys.begin(), keys.end(), std::make_tuple(s.rig, s.request, s.mesh)) == keys.end())
+        keys.emplace_back(s.rig, s.request, s.mesh);
+    }
   std::vector<HeldOutRig> rows;
-  for (const auto& [r, mesh] : keys) {
+  for (const auto& [r, request, mesh] : keys) {
     HeldOutRig h;
-    h.rig = r;
+    h.rig = requestsOf[r].size() > 1 ? fmt::format("{} ({})", r, request) : r;
     h.mesh = mesh;
     std::set<TermAmounts> seen;  // a plan timed twice (chosen by two profiles) counts once
     for (const auto& s : samples) {
-      if (s.rig != r || s.mesh != mesh || !isPlanSample(s) || !s.validated || s.measuredNs <= 0) continue;
+      if (s.rig != r || s.request != request || s.mesh != mesh || !isPlanSample(s) || !s.validated || s.measuredNs <= 0)
+        continue;
       if (!seen.insert(s.amounts).second) continue;
       DeviceProfile at = profile;
       at.workload = s.workload;
@@ -547,7 +554,8 @@ std::string formatHeldOutCheck(const LeaveOneRigOut& check) {
   return heldOutTable(check, "held-out check", "rigs and requests no fit saw, their plans predicted by the profile", "rig");
 }
 
-std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, const std::map<std::string, double>& meshVertices) {
+std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, const std::map<std::string, double>& meshVertices,
+                                                       const std::string& request) {
   std::vector<CalibrationSample> samples;
   // Columns are found by their header ("| mesh | rig | program | arithmetic | ... |"), so logs
   // written before a term or the workload columns existed still read (an absent term: 0).
@@ -584,6 +592,7 @@ std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, cons
     }
     if (perDraw) s.workload.verticesPerDraw = s.vertices;
     s.rig = cells[2] == "—" ? "" : cells[2];
+    s.request = request;
     s.label = cells[3];
     s.fitted = s.label.rfind("checked plan", 0) != 0;
     try {

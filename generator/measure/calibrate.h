@@ -76,6 +76,10 @@ struct CalibrationSample {
   std::string mesh;
   double vertices = 0;  // per draw (the mesh's)
   std::string rig;      // the rig of a plan or floor ("" for a probe)
+  // The request its plans answer, where one rig is timed under several (samples read from
+  // several logs: the log's name; "" in a live run, which has one request per rig). Plans of
+  // different requests are different choices, compared apart.
+  std::string request;
   Workload workload;    // of the mesh and pose it was timed on (measure/workload.h); a probe's: its mesh's
   bool fitted = true;   // false: a plan of the check, which the fit did not see
   TermAmounts amounts{};
@@ -106,7 +110,7 @@ struct CalibrationCheck {
 // fitted without any of that rig's samples (fitDeviceProfile on the rest: the probes and the
 // other rigs), predicting that rig's plans on each mesh it was timed on.
 struct HeldOutRig {
-  std::string rig, mesh;
+  std::string rig, mesh;  // rig: "RIG (REQUEST)" where the rig was timed under several requests
   size_t plans = 0;                  // distinct validated plans (by their term amounts)
   std::vector<double> predicted, measured;  // ns per vertex, per plan
   double spearman = NAN;             // predicted against measured (within 0.5 %: ties)
@@ -154,8 +158,10 @@ std::vector<CalibrationFit> evaluateFit(std::vector<CalibrationSample>& samples,
 
 // The samples of formatCalibration's table read back (recorded logs, bench/data/*.log):
 // rows whose mesh is in `meshVertices` (its vertices per draw). Rows "checked plan" are not
-// fitted; a rig of "—" is a probe's.
-std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, const std::map<std::string, double>& meshVertices);
+// fitted; a rig of "—" is a probe's. A log is one calibrate run, one request per rig: `request`
+// names it (the log's file name), so the same rig in two logs is two choices.
+std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, const std::map<std::string, double>& meshVertices,
+                                                       const std::string& request = "");
 
 // The report as text (samples table, weights, fit errors), and the profile as a documented
 // YAML file that loadDeviceProfile reads back.

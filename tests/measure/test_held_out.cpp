@@ -131,7 +131,7 @@ namespace sg {
 TEST(HeldOut, TheRooflineRanksTheH200HeldOutRigsBetterThanTheSum) {
   auto read = [](const char* name) {
     std::ifstream in(std::string(SG_SOURCE_DIR) + "/bench/data/h200-heldout3/" + name);
-    return parseCalibrationSamples(in, {});
+    return parseCalibrationSamples(in, {}, name);
   };
   std::vector<CalibrationSample> train = read("train.log");
   for (auto& s : read("train-models.log")) train.push_back(s);
@@ -174,5 +174,40 @@ TEST(HeldOut, ALogWithoutTheVec4LoadColumnsStillReads) {
   EXPECT_DOUBLE_EQ(face->measuredNs, 9.7183);
   EXPECT_DOUBLE_EQ(face->workload.jointsPerWarp, 2.6196);
   EXPECT_DOUBLE_EQ(face->vertices, 180000);
+}
+}  // namespace sg
+
+// One rig timed under two requests (the 300-bone palette limb in the H200 collection's world
+// and PBR groups: a world-space and a normal-mapped request) is two choices: the check of both
+// logs together gives, for each request, the figures of that log checked alone; merged, the
+// least-predicted plan of one request would be measured against the fastest of the other.
+namespace sg {
+TEST(HeldOut, ARigUnderTwoRequestsIsTwoChoices) {
+  auto read = [](const char* name) {
+    std::ifstream in(std::string(SG_SOURCE_DIR) + "/bench/data/h200-heldout6/" + name);
+    return parseCalibrationSamples(in, {}, name);
+  };
+  const std::vector<CalibrationSample> world = read("world.log"), pbr = read("pbr.log");
+  std::vector<CalibrationSample> both = world;
+  both.insert(both.end(), pbr.begin(), pbr.end());
+  std::vector<CalibrationSample> train = read("train.log");
+  const DeviceProfile profile = fitDeviceProfile(train, "H200", 180000, 0, ProfileForm::Roofline);
+  const LeaveOneRigOut together = checkHeldOut(both, profile);
+  size_t palette = 0;
+  for (const auto& [log, alone] : {std::pair{"world.log", checkHeldOut(world, profile)}, std::pair{"pbr.log", checkHeldOut(pbr, profile)}})
+    for (const char* mesh : {"dawn", "head"}) {
+      const HeldOutRig* a = row(alone, "limb8_palette300.rig.yaml", mesh);
+      const HeldOutRig* t = row(together, std::string("limb8_palette300.rig.yaml (") + log + ")", mesh);
+      ASSERT_NE(a, nullptr) << log << " " << mesh;
+      ASSERT_NE(t, nullptr) << log << " " << mesh;
+      EXPECT_EQ(t->measured, a->measured) << log << " " << mesh;
+      EXPECT_EQ(t->predicted, a->predicted) << log << " " << mesh;
+      EXPECT_EQ(t->chosenOverFastest, a->chosenOverFastest) << log << " " << mesh;
+      ++palette;
+    }
+  EXPECT_EQ(palette, 4u);
+  // Rigs of one request keep their plain names.
+  EXPECT_NE(row(together, "limb16.rig.yaml", "head"), nullptr);
+  EXPECT_EQ(together.rows.size(), checkHeldOut(world, profile).rows.size() + checkHeldOut(pbr, profile).rows.size());
 }
 }  // namespace sg
