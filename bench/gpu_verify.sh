@@ -16,8 +16,42 @@ std=(-r "$here/rules/standard.yaml" --templates "$here/templates")
 one() {  # one LABEL ARGS...: bench, then its summary lines
   echo "== $1"; shift
   timeout 120 "$sg" bench "${b[@]}" "$@" 2>&1 | tee -a "${SG_VERIFY_TABLES:-/dev/null}" |
-    grep -E "generated|chosen|Spearman|FAIL|error" | grep -v "^| forced" | head -6
+    grep -E "generated|chosen|Spearman|FAIL|error" | grep -v "^| forced" | head -20
 }
+# SG_VERIFY_SET=unseen: instead, the rigs, random rigs and models of gpu_collect.sh's "unseen" groups
+# and random seeds 5 and 6 (SG_UNSEEN_PART=rigs|corpus|models, default all: a device call's time limit).
+if [ "${SG_VERIFY_SET:-heldout}" = unseen ]; then
+  part=${SG_UNSEEN_PART:-all}
+  models="$here/examples/models"
+  if [ "$part" = all ] || [ "$part" = rigs ]; then
+    for mesh in dawn head; do
+      for rig in limb8 limb4_unorm8 face52_sparse octahedral_or_float qtangent_or_float morph_scaled bitpacked_or_separate threejs-mesh; do
+        one "$rig on $mesh" --rig "$data/$rig.rig.yaml" -f "$data/world.frag" "${std[@]}" --device-profile "$profile" --mesh "$mesh"
+      done
+      for rig in formats_a formats_b; do
+        one "$rig on $mesh" --rig "$data/$rig.rig.yaml" -f "$data/formats.frag" "${std[@]}" --device-profile "$profile" --mesh "$mesh"
+      done
+    done
+  fi
+  if [ "$part" = all ] || [ "$part" = corpus ]; then
+    corpus=$(mktemp -d)
+    for seed in 5 6; do
+      "$sg" calibrate --corpus 6 --seed "$seed" --write-corpus "$corpus/$seed" > "$corpus/$seed.txt" || exit 1
+      for mesh in dawn head; do
+        while read -r rig frag; do
+          one "$(basename "$rig" .rig.yaml) on $mesh" --rig "$rig" -f "$frag" -r "$here/examples/dawn/rules.yaml" \
+            --templates "$here/templates" --device-profile "$profile" --mesh "$mesh"
+        done < "$corpus/$seed.txt"
+      done
+    done
+  fi
+  if [ "$part" = all ] || [ "$part" = models ]; then
+    for m in LeePerrySmith.glb AnimatedMorphSphere.meshopt-cc-kv.glb MorphStressTest.gltf; do
+      one "$m" --rig "$models/$m#*" -f "$here/examples/gltf/lit.frag" "${std[@]}" --device-profile "$profile"
+    done
+  fi
+  exit 0
+fi
 # The portable plans: this device's profile and another's (default lavapipe's; on lavapipe, pass
 # SG_PORTABLE_WITH=devices/nvidia-h200-roofline.yaml for the two-device choice).
 other=${SG_PORTABLE_WITH:-$here/devices/llvmpipe-2core.yaml}
