@@ -47,10 +47,9 @@ group models 90 --no-probes --rig "$models/CesiumMan.glb#*" --rig "$models/Robot
   -f "$here/examples/gltf/lit.frag" "${std[@]}"
 # First timed after every shipped profile was fitted: the suite's other rigs (encodings offered in
 # pairs, bit-packed or separate, sparse targets), the three.js mesh, and models no run has drawn.
-group unseen 240 --no-probes --rig "$data/limb8.rig.yaml" --rig "$data/limb4_unorm8.rig.yaml" \
-  --rig "$data/face52_sparse.rig.yaml" --rig "$data/octahedral_or_float.rig.yaml" --rig "$data/qtangent_or_float.rig.yaml" \
-  --rig "$data/morph_scaled.rig.yaml" --rig "$data/bitpacked_or_separate.rig.yaml" --rig "$data/threejs-mesh.rig.yaml" \
-  -f "$data/world.frag" "${std[@]}"
+unseen=() unseenM=()
+for r in "${unseenRigs[@]}"; do unseen+=(--rig "$data/$r.rig.yaml"); done
+for m in "${unseenModels[@]}"; do unseenM+=(--rig "$models/$m#*"); done
+group unseen 240 --no-probes "${unseen[@]}" -f "$data/world.frag" "${std[@]}"
 group unseen-formats 40 --no-probes --rig "$data/formats_a.rig.yaml" --rig "$data/formats_b.rig.yaml" -f "$data/formats.frag" "${std[@]}"
-group unseen-models 60 --no-probes --rig "$models/LeePerrySmith.glb#*" --rig "$models/AnimatedMorphSphere.meshopt-cc-kv.glb#*" \
-  --rig "$models/MorphStressTest.gltf#*" -f "$here/examples/gltf/lit.frag" "${std[@]}"
+group unseen-models 60 --no-probes "${unseenM[@]}" -f "$here/examples/gltf/lit.frag" "${std[@]}"

@@ -25,7 +25,7 @@ if [ "${SG_VERIFY_SET:-heldout}" = unseen ]; then
   models="$here/examples/models"
   if [ "$part" = all ] || [ "$part" = rigs ]; then
     for mesh in dawn head; do
-      for rig in limb8 limb4_unorm8 face52_sparse octahedral_or_float qtangent_or_float morph_scaled bitpacked_or_separate threejs-mesh; do
+      for rig in "${unseenRigs[@]}"; do
         one "$rig on $mesh" --rig "$data/$rig.rig.yaml" -f "$data/world.frag" "${std[@]}" --device-profile "$profile" --mesh "$mesh"
       done
       for rig in formats_a formats_b; do
@@ -46,7 +46,7 @@ if [ "${SG_VERIFY_SET:-heldout}" = unseen ]; then
     done
   fi
   if [ "$part" = all ] || [ "$part" = models ]; then
-    for m in LeePerrySmith.glb AnimatedMorphSphere.meshopt-cc-kv.glb MorphStressTest.gltf; do
+    for m in "${unseenModels[@]}"; do
       one "$m" --rig "$models/$m#*" -f "$here/examples/gltf/lit.frag" "${std[@]}" --device-profile "$profile"
     done
   fi
