@@ -637,7 +637,7 @@ TEST(RulesLoader, StandardLibraryAndDawnIncludes) {
   EXPECT_EQ(set.findSemantic("skin.bones")->arrayParam, "bones");
   ASSERT_TRUE(set.findVarying("SkinSilhouetteVec"));
   EXPECT_EQ(set.findVarying("SkinSilhouetteVec")->semantics.size(), 4u);
-  // A rule from skinning.yaml: its snippet lines point into skinning.yaml.
+  // A rule from skinning.yaml: its snippet lines (palette_fetch, bone_blend) point into skinning.yaml.
   const sg::Rule* blend = nullptr;
   for (const auto& r : set.rules)
     if (r.name == "skin_matrix_blend") blend = &r;

@@ -128,6 +128,10 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         RigCase{"limb2", "limb2.rig.yaml", "world.frag", "limb", {"skin_matrix_blend"}, kLinearBlends},
         RigCase{"limb8", "limb8.rig.yaml", "world.frag", "limb", {"skin_matrix_blend"}, kLinearBlends},
+        // Five influences (a last group of one) and uniform scale: every linear blend, the
+        // normal's too, through vector_blend's partial-group path.
+        RigCase{"limb5_uniform", "limb5_uniform.rig.yaml", "world.frag", "limb", {"skin_matrix_blend"},
+                {"world_position_linear_blend", "world_normal_linear_blend", "world_tangent_linear_blend"}},
         RigCase{"limb4_unorm8", "limb4_unorm8.rig.yaml", "world.frag", "limb", {"skin_matrix_blend"}, kLinearBlends},
         // Every packed vertex format, read back on the device as the reference assumes.
         RigCase{"formats_a", "formats_a.rig.yaml", "formats.frag", "limb", {"skin_matrix_blend"}, kLinearBlends},
