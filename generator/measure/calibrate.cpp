@@ -622,6 +622,7 @@ std::vector<std::string> rigMeshes(const std::string& rig, const std::vector<std
 
 CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   if (opts.meshes.empty()) throw std::invalid_argument("calibration: no mesh");
+  timeCpuDevicesSingleThreaded();
   rt::HarnessOptions ho;
   ho.deviceName = opts.device;
   ho.validation = opts.validationLayers;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <numeric>
 #include <regex>
@@ -229,6 +230,8 @@ constexpr double kRunToRunSpread = 0.005;
 
 bool isCpuDevice(const std::string& deviceName) { return deviceName.find("llvmpipe") != std::string::npos; }
 
+void timeCpuDevicesSingleThreaded() { setenv("LP_NUM_THREADS", "0", /*overwrite=*/0); }
+
 PredictionCheck checkPredictions(const std::vector<GpuBenchRow>& rows, double GpuBenchRow::*clock) {
   PredictionCheck c;
   std::vector<double> predicted, measured;
@@ -249,6 +252,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   const TargetEnv env = opts.render.gen.targetEnv;
   // Every program is validated on the device that times it, which is opened first: a named
   // device's own limits constrain the search.
+  timeCpuDevicesSingleThreaded();
   ValidateOptions vo;
   vo.device = opts.render.device;
   vo.validationLayers = opts.render.validationLayers;

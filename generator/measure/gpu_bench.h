@@ -77,6 +77,13 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts);
 // by the host: this process's CPU time with the rasterizer discarded, else wall time.
 bool isCpuDevice(const std::string& deviceName);
 
+// Before a device is opened for timing: lavapipe runs single-threaded (LP_NUM_THREADS=0) unless
+// the environment already says otherwise. With its rasterizer threads on a 2-core machine, one
+// program's process CPU time moved 64-86 ns per vertex between three runs and ratios within a run
+// by up to 17 %; single-threaded, 60-62 and 2 % (bench/data/lavapipe-linear-blend). Other
+// drivers ignore the variable.
+void timeCpuDevicesSingleThreaded();
+
 // Predicted against measured time by one clock (`clock`: &GpuBenchRow::rasterOnNsPerVertex,
 // ...), over the rows with a plan cost that passed validation and were timed by it: how many,
 // their Spearman within the run-to-run spread (rows with a prediction), and the generated

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 
 #include "common/input_file.h"
@@ -221,3 +222,17 @@ TEST(GpuBench, HandPortOfListing33ComputesWhatTheGeneratedShaderComputes) {
 }
 
 }  // namespace
+
+// Timing on lavapipe turns its rasterizer threads off, unless the user chose a thread count.
+TEST(GpuBenchCpuDevice, TimesLavapipeSingleThreadedUnlessTheEnvironmentSaysOtherwise) {
+  const char* before = std::getenv("LP_NUM_THREADS");
+  const std::string saved = before ? before : "";
+  unsetenv("LP_NUM_THREADS");
+  sg::timeCpuDevicesSingleThreaded();
+  ASSERT_NE(std::getenv("LP_NUM_THREADS"), nullptr);
+  EXPECT_STREQ(std::getenv("LP_NUM_THREADS"), "0");
+  setenv("LP_NUM_THREADS", "3", 1);
+  sg::timeCpuDevicesSingleThreaded();
+  EXPECT_STREQ(std::getenv("LP_NUM_THREADS"), "3");
+  if (before) setenv("LP_NUM_THREADS", saved.c_str(), 1); else unsetenv("LP_NUM_THREADS");
+}
