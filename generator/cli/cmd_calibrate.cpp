@@ -147,18 +147,21 @@ struct CalibrateCommand {
     // a second or more later ends the process at once. Not sooner: GNU timeout sends its signal
     // to the command and again to its process group, and ending on that copy lost every run
     // (two of three interrupted lavapipe runs wrote nothing, an H200 training run too).
+    // The first signal's time is claimed by one compare-exchange, so two copies handled at once
+    // on two threads agree on which came first.
     static std::atomic<bool> interrupted{false};
     static std::atomic<long long> firstInterruptNs{0};
     co.stop = &interrupted;
     std::signal(SIGINT, [](int) {
       timespec now{};
-      clock_gettime(CLOCK_MONOTONIC, &now);  // async-signal-safe, as are the atomics and _exit
-      const long long ns = static_cast<long long>(now.tv_sec) * 1000000000LL + now.tv_nsec;
-      if (!interrupted.exchange(true)) {
-        firstInterruptNs.store(ns);
+      clock_gettime(CLOCK_MONOTONIC, &now);  // async-signal-safe, as are lock-free atomics and _exit
+      const long long ns = static_cast<long long>(now.tv_sec) * 1000000000LL + now.tv_nsec + 1;  // never 0
+      long long first = 0;
+      if (firstInterruptNs.compare_exchange_strong(first, ns)) {
+        interrupted.store(true);
         return;
       }
-      if (ns - firstInterruptNs.load() > 1000000000LL) _exit(130);
+      if (ns - first > 1000000000LL) _exit(130);
     });
     CalibrationReport rep = calibrateDevice(co);
     std::signal(SIGINT, SIG_DFL);

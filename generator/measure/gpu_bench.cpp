@@ -250,9 +250,9 @@ PredictionCheck checkPredictions(const std::vector<GpuBenchRow>& rows, double Gp
 
 GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   const TargetEnv env = opts.render.gen.targetEnv;
+  timeCpuDevicesSingleThreaded();
   // Every program is validated on the device that times it, which is opened first: a named
   // device's own limits constrain the search.
-  timeCpuDevicesSingleThreaded();
   ValidateOptions vo;
   vo.device = opts.render.device;
   vo.validationLayers = opts.render.validationLayers;
