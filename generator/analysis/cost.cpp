@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <glslang/SPIRV/GLSL.std.450.h>
 #include <glslang/SPIRV/spirv.hpp>
+#include <spirv-tools/libspirv.h>
 
 #include <algorithm>
 #include <functional>
@@ -355,13 +356,14 @@ CostBreakdown measureSpirv(const std::vector<uint32_t>& words) {
 
 namespace {
 
-// The rule's probe compiled and optimised (loops with a constant trip count unrolled when
-// `unroll`); nullopt with the reasons in `diags` (located in the rules file).
+// The rule's probe compiled and optimised (when `unroll`: counts at their bound and loops
+// with a constant trip count unrolled); nullopt with the reasons in `diags` (located in the
+// rules file).
 std::optional<std::vector<uint32_t>> optimisedProbe(const RuleSet& rules, int r, const ProbeRig& rig, bool unroll,
                                                     SnippetProbe& probe, std::vector<Diagnostic>& diags) {
   const Rule& rule = rules.rules[static_cast<size_t>(r)];
   try {
-    probe = buildSnippetProbe(rules, r, rig);
+    probe = buildSnippetProbe(rules, r, rig, unroll);
   } catch (const InputError& e) {
     diags.push_back(e.diagnostic());
     return std::nullopt;
@@ -402,7 +404,64 @@ AutoCost measureRuleCost(const RuleSet& rules, int r, const ProbeRig& rig) {
   return res;
 }
 
+namespace {
+
+// Ids whose value may differ between the vertices of one draw: loaded from a vertex input
+// (an attribute, gl_VertexIndex), or computed from, or loaded at an index computed from, such
+// a value. A uniform-array read at any other computed index (u_weight[u_active[k]]) reads one
+// address for a whole warp, as a constant index does. SPIRV-Tools' parser tells id operands
+// from literals; stores into function variables and phis are followed to a fixed point.
+std::set<uint32_t> perVertexIds(const std::vector<uint32_t>& words) {
+  struct Parsed {
+    spv::Op op;
+    uint32_t result;
+    std::vector<uint32_t> ids;  // id operands (not types, not literals)
+  };
+  struct Acc {
+    std::vector<Parsed> insts;
+    std::set<uint32_t> inputs;  // variables of the Input storage class
+  } acc;
+  auto onInst = [](void* user, const spv_parsed_instruction_t* in) -> spv_result_t {
+    auto* a = static_cast<Acc*>(user);
+    Parsed p{static_cast<spv::Op>(in->opcode), in->result_id, {}};
+    for (uint16_t k = 0; k < in->num_operands; ++k)
+      if (in->operands[k].type == SPV_OPERAND_TYPE_ID) p.ids.push_back(in->words[in->operands[k].offset]);
+    if (p.op == spv::OpVariable && in->num_words >= 4 && in->words[3] == spv::StorageClassInput) a->inputs.insert(in->result_id);
+    a->insts.push_back(std::move(p));
+    return SPV_SUCCESS;
+  };
+  spv_context ctx = spvContextCreate(SPV_ENV_VULKAN_1_0);
+  const spv_result_t ok = spvBinaryParse(ctx, &acc, words.data(), words.size(), nullptr, onInst, nullptr);
+  spvContextDestroy(ctx);
+  std::set<uint32_t> varying(acc.inputs.begin(), acc.inputs.end());
+  if (ok != SPV_SUCCESS) return varying;
+  std::map<uint32_t, uint32_t> root;  // access chain -> the variable it starts from
+  for (const auto& p : acc.insts)
+    if ((p.op == spv::OpAccessChain || p.op == spv::OpInBoundsAccessChain) && !p.ids.empty())
+      root[p.result] = root.count(p.ids[0]) ? root[p.ids[0]] : p.ids[0];
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (const auto& p : acc.insts) {
+      if (p.op == spv::OpStore) {  // a function variable holding a per-vertex value
+        if (p.ids.size() >= 2 && varying.count(p.ids[1])) {
+          const uint32_t var = root.count(p.ids[0]) ? root[p.ids[0]] : p.ids[0];
+          changed = varying.insert(var).second || changed;
+        }
+        continue;
+      }
+      if (p.result == 0 || varying.count(p.result)) continue;
+      bool v = false;
+      for (uint32_t id : p.ids) v = v || varying.count(id) || (root.count(id) && varying.count(root[id]));
+      if (v) changed = varying.insert(p.result).second || changed;
+    }
+  }
+  return varying;
+}
+
+}  // namespace
+
 SpirvAccesses measureAccesses(const std::vector<uint32_t>& words) {
+  const std::set<uint32_t> perVertex = perVertexIds(words);
   SpirvAccesses out;
   std::set<uint32_t> constants, bufferBlocks;
   std::map<uint32_t, uint32_t> binding, pointerClass, pointee;  // id -> Binding; pointer type -> class, pointee
@@ -468,7 +527,7 @@ SpirvAccesses measureAccesses(const std::vector<uint32_t>& words) {
       case spv::OpAccessChain: case spv::OpInBoundsAccessChain:
         if (len >= 4) {
           bool dynamic = false;
-          for (uint32_t k = 4; k < len; ++k) dynamic = dynamic || !constants.count(w[k]);
+          for (uint32_t k = 4; k < len; ++k) dynamic = dynamic || perVertex.count(w[k]);
           chains[w[2]] = Chain{w[3], dynamic, std::vector<uint32_t>(w + 4, w + len)};
         }
         break;

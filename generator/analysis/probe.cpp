@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <fstream>
 
 #include "common/input_file.h"
@@ -59,6 +60,7 @@ ProbeRig makeDefault(const RuleSet& rules, const std::string& name, std::map<std
 ProbeRig probeRigFromRig(const Rig& rig, const RuleSet& rules) {
   ProbeRig pr;
   static_cast<RigShape&>(pr) = shapeOfRig(rig, rules);
+  for (const auto& u : rig.uniforms) pr.uniforms.insert(u.semantic);
   for (const auto& a : rig.attributes) {
     int targets = a.perMorphTarget ? rig.morphTargets() : 1;
     for (int t = 0; t < targets; ++t)
@@ -87,7 +89,7 @@ std::vector<ProbeRig> defaultProbeRigs(const RuleSet& rules) {
 
 ExprEnv probeEnv(const ProbeRig& rig) { return shapeEnv(rig); }
 
-SnippetProbe buildSnippetProbe(const RuleSet& rules, int r, const ProbeRig& rig) {
+SnippetProbe buildSnippetProbe(const RuleSet& rules, int r, const ProbeRig& rig, bool forAccesses) {
   const Rule& rule = rules.rules[static_cast<size_t>(r)];
   const std::string outName = "t_" + mangle(rule.produces);
   // Streams read the attribute (and swizzle) as the emitted shader does; the rest are uniforms.
@@ -108,8 +110,9 @@ SnippetProbe buildSnippetProbe(const RuleSet& rules, int r, const ProbeRig& rig)
   std::string& s = probe.unit.text;
   s += "#version 450\n";
   s += fmt::format("// Probe of rule '{}' instantiated for {}.\n", rule.name, rig.name);
-  std::map<std::string, Type> inputs;  // vertex inputs read (attribute streams)
+  std::map<std::string, Type> inputs;  // vertex inputs read (attribute streams; per-vertex values forAccesses)
   std::string members;                  // uniform block members
+  std::string constants;                // counts at their bound (forAccesses)
   std::string buffers;                  // storage buffers and their accessors, as the emitter reads them
   int binding = 1;
   for (const auto& fact : inst.needs) {
@@ -128,8 +131,18 @@ SnippetProbe buildSnippetProbe(const RuleSet& rules, int r, const ProbeRig& rig)
       inputs.emplace(st->second.input, st->second.type);
       continue;
     }
+    if (forAccesses && !d->bound.empty()) {
+      const int64_t most = std::max<int64_t>(0, d->bound.eval(probeEnv(rig)));
+      constants += fmt::format("const {} p_{} = {}{};\n", glslName(d->type), mangle(fact), most,
+                               scalarKind(d->type) == ScalarKind::UInt ? "u" : "");
+      continue;
+    }
     std::string array;
     if (auto it = rig.arrays.find(d->name); it != rig.arrays.end()) array = fmt::format("[{}]", it->second);
+    if (forAccesses && array.empty() && !rig.uniforms.count(fact)) {
+      inputs.emplace("p_" + mangle(fact), d->type);
+      continue;
+    }
     members += fmt::format("  {} p_{}{};\n", glslName(d->type), mangle(fact), array);
   }
   int location = 0;
@@ -138,6 +151,7 @@ SnippetProbe buildSnippetProbe(const RuleSet& rules, int r, const ProbeRig& rig)
     location += isMatrix(type) ? 4 : 1;
   }
   if (!members.empty()) s += "layout(set = 0, binding = 0, std140) uniform ProbeInputs {\n" + members + "};\n";
+  s += constants;
   s += buffers;
   s += fmt::format("layout(location = 0) {}out {} sg_probe_out;\n", isIntegerType(product->type) ? "flat " : "",
                    glslName(product->type));

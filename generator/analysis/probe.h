@@ -30,6 +30,9 @@ struct ProbeRig : RigShape {
     std::string swizzle;  // "" = whole attribute
   };
   std::map<std::string, Stream> streams;
+  // Semantics the rig provides in its uniform block: the same for every vertex of a draw.
+  // Every other value a rule reads varies per vertex (an attribute, or another rule's product).
+  std::set<std::string> uniforms;
   bool isDefault = false;
 };
 
@@ -56,7 +59,12 @@ struct SnippetProbe {
 
 // Builds the probe shader for rules.rules[rule]. Throws InputError (located in the rules
 // file) for template errors, unknown semantics and semantics used but not in `needs`.
-SnippetProbe buildSnippetProbe(const RuleSet& rules, int rule, const ProbeRig& rig);
+// `forAccesses` (the probe analysis/cost.h counts memory accesses on): a semantic with a
+// `bound:` (a per-draw count) is the constant of its bound, so a loop it limits has a constant
+// trip count and its loads count per iteration at the most it can run; and a value that varies
+// per vertex (neither a rig uniform nor a uniform array) is a vertex input, not a uniform, so an
+// index computed from it is told from one that is the same for the whole draw.
+SnippetProbe buildSnippetProbe(const RuleSet& rules, int rule, const ProbeRig& rig, bool forAccesses = false);
 
 // Compiles the probe with glslang; diagnostics point at the rule's YAML lines (columns
 // refined with refineSnippetColumns). Errors glslang reports after the snippet (a missing

@@ -32,6 +32,10 @@ struct SemanticDecl {
   // of these families (packed per element, in order) or of one uniform array; snippets
   // read it as a function, ${name}(i).
   std::vector<std::string> bufferOf;
+  // `bound:` (docs/rules-format.md): a per-draw count whose largest value is this expression
+  // over the rig's parameters (morph.active_count <= max_active_targets). The cost analysis
+  // counts the loads of a loop it bounds once per iteration at that value. Null = none.
+  Expr bound;
   std::string doc;
   SourceLoc loc;
   // What the value is (docs/validation.md, "Definitions"): a formula over other semantics,

@@ -138,11 +138,12 @@ void loadSemantics(RuleSet& set, const YamlCtx& y, const YAML::Node& sems, const
       typeName = body.Scalar();
     } else {
       y.expectMap(body, "a semantic declaration");
-      y.checkKeys(body, {"type", "count", "array", "doc", "definition", "kind", "range", "buffer_of"});
+      y.checkKeys(body, {"type", "count", "array", "doc", "definition", "kind", "range", "buffer_of", "bound"});
       if (!body["type"]) y.fail(body, fmt::format("semantic '{}' has no 'type'", d.name));
       typeName = y.scalar(body["type"], "'type'");
       if (body["count"]) d.count = Expr::parse(y.scalar(body["count"], "'count'"), exprLoc(body["count"], y.file));
       if (body["array"]) d.arrayParam = y.scalar(body["array"], "'array'");
+      if (body["bound"]) d.bound = Expr::parse(y.scalar(body["bound"], "'bound'"), exprLoc(body["bound"], y.file));
       if (body["doc"]) d.doc = y.scalar(body["doc"], "'doc'");
       if (YAML::Node b = body["buffer_of"]) {
         if (b.IsScalar()) d.bufferOf.push_back(b.Scalar());
@@ -157,6 +158,9 @@ void loadSemantics(RuleSet& set, const YamlCtx& y, const YAML::Node& sems, const
     auto t = parseType(typeName);
     if (!t) y.fail(body.IsMap() ? body["type"] : body, fmt::format("unknown type '{}' for semantic '{}'", typeName, d.name));
     d.type = *t;
+    if (!d.bound.empty() && (scalarKind(d.type) == ScalarKind::Float || componentCount(d.type) != 1 || !d.arrayParam.empty()))
+      y.fail(body["bound"], fmt::format("semantic '{}': 'bound' is for a count (a uint or int scalar), not a {}{}", d.name,
+                                        glslName(d.type), d.arrayParam.empty() ? "" : " array"));
     set.semantics.push_back(std::move(d));
   }
 }

@@ -11,6 +11,7 @@
 #include "analysis/cost.h"
 #include "analysis/explain.h"
 #include "analysis/probe.h"
+#include "common/glsl_compile.h"
 #include "analysis_test_util.h"
 #include "pipeline/generate.h"
 
@@ -180,6 +181,18 @@ TEST(AutoCost, UnmeasurableSnippetIsALocatedError) {
 namespace sg {
 namespace {
 
+// The access terms of one rule of `rs`, measured on `pr`.
+RuleAccesses accessesOf(const RuleSet& rs, const std::string& rule, const ProbeRig& pr) {
+  for (size_t i = 0; i < rs.rules.size(); ++i)
+    if (rs.rules[i].name == rule) {
+      RuleAccesses a = measureRuleAccesses(rs, static_cast<int>(i), pr);
+      EXPECT_TRUE(a.ok) << rule << (a.diagnostics.empty() ? "" : ": " + formatDiagnostic(a.diagnostics.front()));
+      return a;
+    }
+  ADD_FAILURE() << "no rule " << rule;
+  return RuleAccesses{};
+}
+
 // The memory terms of the device cost model (docs/device-profiles.md), counted on the
 // Dawn face's rules: one element fetch per target of a constant-trip loop (unrolled), one
 // palette matrix per influence, each buffer element once however many components are read,
@@ -189,16 +202,7 @@ TEST(AccessTerms, CountedOnTheDawnRules) {
   RuleSet rs = loadRules({sourceDir() + "/examples/dawn/rules.yaml"});
   Rig rig = loadRigFile(sourceDir() + "/examples/dawn/face.rig.yaml");
   ProbeRig pr = probeRigFromRig(rig, rs);
-  auto accesses = [&](const std::string& rule) {
-    for (size_t i = 0; i < rs.rules.size(); ++i)
-      if (rs.rules[i].name == rule) {
-        RuleAccesses a = measureRuleAccesses(rs, static_cast<int>(i), pr);
-        EXPECT_TRUE(a.ok) << rule << (a.diagnostics.empty() ? "" : ": " + formatDiagnostic(a.diagnostics.front()));
-        return a;
-      }
-    ADD_FAILURE() << "no rule " << rule;
-    return RuleAccesses{};
-  };
+  auto accesses = [&](const std::string& rule) { return accessesOf(rs, rule, pr); };
   using Loads = std::map<std::string, int64_t>;
   // 5 targets: a GLSL loop over the deltas buffer, morph weights indexed by the loop counter.
   // A vec3 delta is one element and one load.
@@ -263,6 +267,84 @@ TEST(AccessTerms, APaletteReadByTwoRulesIsLoadedOnce) {
   // The palette from a storage buffer: no uniform load at all.
   EXPECT_EQ(vec4Loads({bufferPalette}), 0);
   EXPECT_EQ(planAmounts(p, {bufferPalette})[kTermBufferVec4Loads], 16);
+}
+}  // namespace
+}  // namespace sg
+
+// The sparse-morph loop runs min(morph.active_count, max_active_targets) times, a count the
+// vocabulary bounds (`bound: max_active_targets`): its loads count once per iteration at that
+// bound, as a constant-trip loop's do. Its uniform reads are indexed by the active list, the
+// same for every vertex of a draw: one address per warp, as a constant index reads, so they
+// are not per-vertex indexed loads.
+namespace sg {
+namespace {
+TEST(AccessTerms, ABoundedLoopCountsEveryIterationAndWarpUniformIndicesAreNotPerVertex) {
+  RuleSet rs = loadRules({sourceDir() + "/rules/standard.yaml"});
+  Rig rig = loadRigFile(sourceDir() + "/tests/validate/data/face52_sparse.rig.yaml");
+  ProbeRig pr = probeRigFromRig(rig, rs);
+  ASSERT_EQ(pr.params.at("max_active_targets"), 6);
+  auto accesses = [&](const std::string& rule, const ProbeRig& at) { return accessesOf(rs, rule, at); };
+  using Loads = std::map<std::string, int64_t>;
+  // 6 active targets at most: 6 delta elements, one per iteration.
+  RuleAccesses sparse = accesses("object_position_morphed_sparse", pr);
+  EXPECT_EQ(sparse.bufferLoads, (Loads{{"morph.position_deltas", 6}}));
+  EXPECT_EQ(sparse.indexedUniformLoads, 0);  // morph.weights[active[k]]: one address per warp
+  EXPECT_EQ(sparse.indexedUniformVec4Loads, 0);
+  RuleAccesses normals = accesses("normal_occlusion_morphed_sparse", pr);
+  EXPECT_EQ(normals.bufferLoads, (Loads{{"morph.normal_occlusion_deltas", 6}}));
+  // The bound follows the rig's parameter.
+  ProbeRig two = pr;
+  two.params["max_active_targets"] = 2;
+  EXPECT_EQ(accesses("object_position_morphed_sparse", two).bufferLoads, (Loads{{"morph.position_deltas", 2}}));
+  // The palette at the per-vertex joints stays a per-vertex indexed load (4 influences), also
+  // where the joints are another rule's product (unpacked from a bit-packed attribute): the
+  // probe reads such a value as a vertex input, not as a uniform.
+  EXPECT_EQ(accesses("skin_matrix_blend", pr).indexedUniformLoads, 4);
+  Rig packed = loadRigFile(sourceDir() + "/tests/validate/data/bitpacked.rig.yaml");
+  ASSERT_EQ(probeRigFromRig(packed, rs).streams.count("skin.joints[0]"), 0u);
+  EXPECT_EQ(accesses("skin_matrix_blend", probeRigFromRig(packed, rs)).indexedUniformLoads, 4);
+}
+
+// measureAccesses on hand-written programs: a uniform array read at an index from a vertex
+// input, or from a storage buffer read at gl_VertexIndex, or through a local variable holding
+// one, is per-vertex; at an index computed from uniforms alone it is not.
+TEST(AccessTerms, PerVertexIndicesAreFollowedThroughLoadsLocalsAndArithmetic) {
+  auto count = [](const std::string& body) {
+    const std::string text = "#version 450\n"
+                             "layout(location = 0) in uvec4 joint;\n"
+                             "layout(std140, binding = 0) uniform U { mat4 palette[64]; uvec4 base; } u;\n"
+                             "layout(std430, binding = 1) readonly buffer B { uvec4 j[]; } b;\n"
+                             "layout(location = 0) out vec4 o;\n"
+                             "void main() {\n" + body + "}\n";
+    CompileResult c = compileGlsl(GlslUnit{Stage::Vertex, text, "accesses.vert", {}}, TargetEnv::Vulkan1_0);
+    EXPECT_TRUE(c.ok) << (c.diagnostics.empty() ? "" : formatDiagnostic(c.diagnostics.front()));
+    return c.ok ? measureAccesses(optimizeSpirv(c.spirv, TargetEnv::Vulkan1_0)).indexedUniformLoads : -1;
+  };
+  EXPECT_EQ(count("  o = u.palette[joint.x][0];\n"), 1);
+  EXPECT_EQ(count("  o = u.palette[b.j[gl_VertexIndex].y][1];\n"), 1);
+  EXPECT_EQ(count("  o = u.palette[(joint.z + u.base.x) & 63u][2];\n"), 1);
+  EXPECT_EQ(count("  uint k = u.base.y;\n  if (joint.w > 3u) k = joint.w;\n  o = u.palette[k & 63u][3];\n"), 1);
+  EXPECT_EQ(count("  o = u.palette[u.base.x & 63u][0];\n"), 0);
+  EXPECT_EQ(count("  o = u.palette[(u.base.x * 3u + u.base.y) & 63u][0] + u.palette[b.j[u.base.z].x & 63u][1];\n"), 0);
+  EXPECT_EQ(count("  vec4 s = vec4(0.0);\n  for (uint k = 0u; k < u.base.w; ++k) s += u.palette[k & 63u][0];\n  o = s;\n"), 0);
+}
+}  // namespace
+}  // namespace sg
+
+// `bound:` names the most a count can be; anything but an integer scalar is refused where it
+// is written.
+namespace sg {
+namespace {
+TEST(AccessTerms, ABoundOnANonCountIsALocatedError) {
+  auto dir = scratchDir("bound_error");
+  const std::string text = "semantics:\n  a.n: { type: uint, bound: max_active_targets }\n  a.f: { type: float, bound: 4 }\n";
+  const std::string path = writeFile(dir / "rules.yaml", text);
+  try {
+    loadRules({path});
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(formatDiagnostic(e.diagnostic()), path + ":3:30: error: semantic 'a.f': 'bound' is for a count (a uint or int scalar), not a float");
+  }
 }
 }  // namespace
 }  // namespace sg
