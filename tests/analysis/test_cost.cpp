@@ -296,6 +296,11 @@ TEST(AccessTerms, ABoundedLoopCountsEveryIterationAndWarpUniformIndicesAreNotPer
   ProbeRig two = pr;
   two.params["max_active_targets"] = 2;
   EXPECT_EQ(accesses("object_position_morphed_sparse", two).bufferLoads, (Loads{{"morph.position_deltas", 2}}));
+  // A rig may state up to 65,535; the probe counts at most 256 iterations (the most instances
+  // a family has), so a valid rig cannot make it unroll for minutes.
+  ProbeRig most = pr;
+  most.params["max_active_targets"] = 65535;
+  EXPECT_EQ(accesses("object_position_morphed_sparse", most).bufferLoads, (Loads{{"morph.position_deltas", 256}}));
   // The palette at the per-vertex joints stays a per-vertex indexed load (4 influences), also
   // where the joints are another rule's product (unpacked from a bit-packed attribute): the
   // probe reads such a value as a vertex input, not as a uniform.
