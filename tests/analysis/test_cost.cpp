@@ -296,11 +296,10 @@ TEST(AccessTerms, ABoundedLoopCountsEveryIterationAndWarpUniformIndicesAreNotPer
   ProbeRig two = pr;
   two.params["max_active_targets"] = 2;
   EXPECT_EQ(accesses("object_position_morphed_sparse", two).bufferLoads, (Loads{{"morph.position_deltas", 2}}));
-  // A rig may state up to 65,535; the probe counts at most 256 iterations (the most instances
-  // a family has), so a valid rig cannot make it unroll for minutes.
+  // A rig may state up to 65,535 active targets; the loop also stops at the list's size (52).
   ProbeRig most = pr;
   most.params["max_active_targets"] = 65535;
-  EXPECT_EQ(accesses("object_position_morphed_sparse", most).bufferLoads, (Loads{{"morph.position_deltas", 256}}));
+  EXPECT_EQ(accesses("object_position_morphed_sparse", most).bufferLoads, (Loads{{"morph.position_deltas", 52}}));
   // The palette at the per-vertex joints stays a per-vertex indexed load (4 influences), also
   // where the joints are another rule's product (unpacked from a bit-packed attribute): the
   // probe reads such a value as a vertex input, not as a uniform.
@@ -332,6 +331,30 @@ TEST(AccessTerms, PerVertexIndicesAreFollowedThroughLoadsLocalsAndArithmetic) {
   EXPECT_EQ(count("  o = u.palette[u.base.x & 63u][0];\n"), 0);
   EXPECT_EQ(count("  o = u.palette[(u.base.x * 3u + u.base.y) & 63u][0] + u.palette[b.j[u.base.z].x & 63u][1];\n"), 0);
   EXPECT_EQ(count("  vec4 s = vec4(0.0);\n  for (uint k = 0u; k < u.base.w; ++k) s += u.palette[k & 63u][0];\n  o = s;\n"), 0);
+}
+}  // namespace
+}  // namespace sg
+
+// A loop to a count whose bound is larger than any family (a user's rule, no other clamp) is
+// counted at most 256 times, so a large bound cannot make the probe unroll for minutes.
+namespace sg {
+namespace {
+TEST(AccessTerms, ALargeBoundIsCountedAtMost256Times) {
+  auto dir = scratchDir("bound_cap");
+  const std::string text = std::string(kVocabulary) + R"(  a.count: { type: uint, bound: 100000 }
+rules:
+  - name: looped
+    produces: out.m4
+    needs: [a.count, a.f, skin.bones]
+    cost: 1
+    glsl: |
+      ${out} = mat4(0.0);
+      for (uint k = 0u; k < ${a.count}; ++k) ${out} += ${skin.bones}[(uint(${a.f}) + k) & 3u];
+)";
+  RuleSet rs = loadRules({writeFile(dir / "rules.yaml", text)});
+  RuleAccesses a = measureRuleAccesses(rs, 0, defaultProbeRigs(rs).front());
+  ASSERT_TRUE(a.ok) << (a.diagnostics.empty() ? "" : formatDiagnostic(a.diagnostics.front()));
+  EXPECT_EQ(a.indexedUniformLoads, 256);  // a.f varies per vertex: every iteration's index does
 }
 }  // namespace
 }  // namespace sg
