@@ -356,14 +356,13 @@ CostBreakdown measureSpirv(const std::vector<uint32_t>& words) {
 
 namespace {
 
-// The rule's probe compiled and optimised (when `unroll`: counts at their bound and loops
-// with a constant trip count unrolled); nullopt with the reasons in `diags` (located in the
-// rules file).
-std::optional<std::vector<uint32_t>> optimisedProbe(const RuleSet& rules, int r, const ProbeRig& rig, bool unroll,
+// The rule's probe compiled and optimised; `forAccesses`: the access probe (probe.h), its loops
+// of constant trip count unrolled. nullopt with the reasons in `diags` (located in the rules file).
+std::optional<std::vector<uint32_t>> optimisedProbe(const RuleSet& rules, int r, const ProbeRig& rig, bool forAccesses,
                                                     SnippetProbe& probe, std::vector<Diagnostic>& diags) {
   const Rule& rule = rules.rules[static_cast<size_t>(r)];
   try {
-    probe = buildSnippetProbe(rules, r, rig, unroll);
+    probe = buildSnippetProbe(rules, r, rig, forAccesses);
   } catch (const InputError& e) {
     diags.push_back(e.diagnostic());
     return std::nullopt;
@@ -383,7 +382,7 @@ std::optional<std::vector<uint32_t>> optimisedProbe(const RuleSet& rules, int r,
     return std::nullopt;
   }
   try {
-    return optimizeSpirv(c.spirv, TargetEnv::Vulkan1_0, unroll);
+    return optimizeSpirv(c.spirv, TargetEnv::Vulkan1_0, forAccesses);
   } catch (const std::exception& e) {
     diags.push_back(Diagnostic{Severity::Error, rule.loc,
                                fmt::format("rule '{}': cannot optimise its snippet: {}", rule.name, e.what())});

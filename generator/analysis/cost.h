@@ -45,7 +45,9 @@ AutoCost measureRuleCost(const RuleSet& rules, int rule, const ProbeRig& rig);
 
 // Memory accesses per vertex of a program (the cost model's per-rule terms,
 // docs/device-profiles.md): through a storage buffer, per binding; from the uniform block
-// through an access chain with a computed index (palette[joint]). An element is what one
+// through an access chain with an index computed per vertex (palette[joint]: from a vertex
+// input, or from a load at such an index; an index the same for the whole draw reads one
+// address per warp, as a constant one does, and is not counted). An element is what one
 // computed index selects (constant indices after it pick its parts); it is fetched once
 // however many of its parts are read, in loads of up to 16 bytes (a vec4): a mat4 palette
 // entry is 4 vec4 loads, a mat3x4 one 3, a vec4 or a float 1.

@@ -373,6 +373,27 @@ TEST(AccessTerms, ABoundOnANonCountIsALocatedError) {
   } catch (const InputError& e) {
     EXPECT_EQ(formatDiagnostic(e.diagnostic()), path + ":3:30: error: semantic 'a.f': 'bound' is for a count (a uint or int scalar), not a float");
   }
+  // A bound naming no rig parameter is reported at the name when a rule's accesses are measured.
+  const std::string misspelt = std::string(kVocabulary) + R"(  a.count: { type: uint, bound: mroph_targets }
+rules:
+  - name: looped
+    produces: out.m4
+    needs: [a.count, a.f, skin.bones]
+    cost: 1
+    glsl: |
+      ${out} = mat4(0.0);
+      for (uint k = 0u; k < ${a.count}; ++k) ${out} += ${skin.bones}[(uint(${a.f}) + k) & 3u];
+)";
+  const std::string misspeltPath = writeFile(dir / "misspelt.yaml", misspelt);
+  RuleSet rs = loadRules({misspeltPath});
+  RuleAccesses a = measureRuleAccesses(rs, 0, defaultProbeRigs(rs).front());
+  ASSERT_FALSE(a.ok);
+  ASSERT_FALSE(a.diagnostics.empty());
+  auto [line, col] = sg::testing::lineColOf(misspelt, "mroph_targets");
+  EXPECT_EQ(a.diagnostics.front().loc.file, misspeltPath);
+  EXPECT_EQ(a.diagnostics.front().loc.line, line);
+  EXPECT_EQ(a.diagnostics.front().loc.col, col);
+  EXPECT_NE(a.diagnostics.front().message.find("mroph_targets"), std::string::npos);
 }
 }  // namespace
 }  // namespace sg
