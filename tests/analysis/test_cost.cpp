@@ -339,10 +339,10 @@ TEST(AccessTerms, PerVertexIndicesAreFollowedThroughLoadsLocalsAndArithmetic) {
 // counted at most 256 times, so a large bound cannot make the probe unroll for minutes.
 namespace sg {
 namespace {
-TEST(AccessTerms, ALargeBoundIsCountedAtMost256Times) {
-  auto dir = scratchDir("bound_cap");
-  const std::string text = std::string(kVocabulary) + R"(  a.count: { type: uint, bound: 100000 }
-rules:
+// One rule looping to a count declared with `bound: BOUND`, reading the palette at an index
+// that varies per vertex (a.f is neither a rig uniform nor an array).
+std::string boundedLoopRules(const std::string& bound) {
+  return std::string(kVocabulary) + "  a.count: { type: uint, bound: " + bound + " }\n" + R"(rules:
   - name: looped
     produces: out.m4
     needs: [a.count, a.f, skin.bones]
@@ -351,6 +351,11 @@ rules:
       ${out} = mat4(0.0);
       for (uint k = 0u; k < ${a.count}; ++k) ${out} += ${skin.bones}[(uint(${a.f}) + k) & 3u];
 )";
+}
+
+TEST(AccessTerms, ALargeBoundIsCountedAtMost256Times) {
+  auto dir = scratchDir("bound_cap");
+  const std::string text = boundedLoopRules("100000");
   RuleSet rs = loadRules({writeFile(dir / "rules.yaml", text)});
   RuleAccesses a = measureRuleAccesses(rs, 0, defaultProbeRigs(rs).front());
   ASSERT_TRUE(a.ok) << (a.diagnostics.empty() ? "" : formatDiagnostic(a.diagnostics.front()));
@@ -374,16 +379,7 @@ TEST(AccessTerms, ABoundOnANonCountIsALocatedError) {
     EXPECT_EQ(formatDiagnostic(e.diagnostic()), path + ":3:30: error: semantic 'a.f': 'bound' is for a count (a uint or int scalar), not a float");
   }
   // A bound naming no rig parameter is reported at the name when a rule's accesses are measured.
-  const std::string misspelt = std::string(kVocabulary) + R"(  a.count: { type: uint, bound: mroph_targets }
-rules:
-  - name: looped
-    produces: out.m4
-    needs: [a.count, a.f, skin.bones]
-    cost: 1
-    glsl: |
-      ${out} = mat4(0.0);
-      for (uint k = 0u; k < ${a.count}; ++k) ${out} += ${skin.bones}[(uint(${a.f}) + k) & 3u];
-)";
+  const std::string misspelt = boundedLoopRules("mroph_targets");
   const std::string misspeltPath = writeFile(dir / "misspelt.yaml", misspelt);
   RuleSet rs = loadRules({misspeltPath});
   RuleAccesses a = measureRuleAccesses(rs, 0, defaultProbeRigs(rs).front());
