@@ -37,7 +37,7 @@ group train-models 40 --no-probes --rig "$models/RiggedFigure.glb#*" -f "$here/e
 group world 110 --no-probes --rig "$data/limb16.rig.yaml" --rig "$data/limb8_palette300.rig.yaml" \
   --rig "$data/face52.rig.yaml" --rig "$data/octahedral.rig.yaml" --rig "$data/qtangent.rig.yaml" -f "$data/world.frag" "${std[@]}"
 # Random rigs and requests of another seed: the check's random held-out set.
-group corpus-heldout 100 --no-probes --corpus "${SG_HELDOUT_CORPUS:-6}" --seed "${SG_HELDOUT_SEED:-2}" -f "$here/examples/dawn/face.frag" "${dawnRules[@]}"
+group corpus-heldout 130 --no-probes --corpus "${SG_HELDOUT_CORPUS:-6}" --seed "${SG_HELDOUT_SEED:-2}" -f "$here/examples/dawn/face.frag" "${dawnRules[@]}"
 group body-depth 30 --no-probes --rig "$here/examples/dawn/body.rig.yaml" -f "$here/examples/dawn/depth.frag" "${dawnRules[@]}"
 group pbr 70 --no-probes --rig "$data/pbr_character.rig.yaml" --rig "$data/limb8_palette300.rig.yaml" \
   -f "$data/standard_normalmap.frag" "${std[@]}"

@@ -164,6 +164,7 @@ GenerateResult handWrittenProgram(const std::string& text, const std::string& pa
   r.glsl.uniforms.clear();
   r.glsl.buffers.clear();
   for (const auto& in : s.inputs()) {
+    if (in.name.rfind("gl_", 0) == 0) continue;  // gl_VertexIndex: a built-in, not an attribute
     EmittedInput e;
     e.name = in.name;
     e.location = in.location;
@@ -191,6 +192,17 @@ GenerateResult handWrittenProgram(const std::string& text, const std::string& pa
       if (m.name == "u_" + rig.uniforms[u].name) r.glsl.uniforms.push_back(EmittedUniform{m.name, static_cast<int>(u)});
   }
   r.spirv.descriptors = s.descriptors();
+  // A hand port of a buffer-fed program reads the generated program's storage buffers at their
+  // bindings; they are filled as for the program it is compared with.
+  for (const auto& d : r.spirv.descriptors) {
+    if (d.kind != ShaderDescriptor::Kind::StorageBlock) continue;
+    auto b = std::find_if(like.glsl.buffers.begin(), like.glsl.buffers.end(),
+                          [&](const EmittedBuffer& e) { return d.set == 0 && int(d.binding) == e.binding; });
+    if (b == like.glsl.buffers.end())
+      throw InputError(SourceLoc{path, 0, 0}, fmt::format("storage buffer '{}' (set {}, binding {}) is not one the generated "
+                                                          "program reads", d.name, d.set, d.binding));
+    r.glsl.buffers.push_back(*b);
+  }
   return r;
 }
 

@@ -181,6 +181,16 @@ TEST(GpuBench, ACpuDeviceIsCheckedByTheClockItsProfileWasFittedOn) {
   EXPECT_NE(sg::formatGpuBench(rep).find("predicted vs measured (raster off, process CPU time (a CPU device);"), std::string::npos);
 }
 
+// What `program` writes for every vertex of the mesh, captured with the generated program's layout.
+std::vector<uint8_t> captured(sg::rt::Harness& harness, const sg::GenerateResult& program, const sg::GenerateResult& gen,
+                              const sg::rt::Mesh& mesh, const sg::rt::Pose& pose) {
+  sg::rt::RunRequest r;
+  static_cast<sg::rt::ProgramInputs&>(r) = sg::programInputs(program, mesh, pose);
+  r.spirv = program.spirv.words;
+  r.capture.strideBytes = gen.glsl.captureStride;
+  return harness.run(r).captured;
+}
+
 TEST(GpuBench, HandPortOfListing33ComputesWhatTheGeneratedShaderComputes) {
   sg::GenerateOptions g;
   g.rigPath = sourcePath("examples/dawn/face.rig.yaml");
@@ -197,14 +207,7 @@ TEST(GpuBench, HandPortOfListing33ComputesWhatTheGeneratedShaderComputes) {
   EXPECT_NE(hand.spirv.words, gen.spirv.words);
 
   sg::rt::Harness harness;
-  sg::rt::RunRequest a, b;
-  static_cast<sg::rt::ProgramInputs&>(a) = sg::programInputs(gen, mesh, pose);
-  a.spirv = gen.spirv.words;
-  a.capture.strideBytes = gen.glsl.captureStride;
-  static_cast<sg::rt::ProgramInputs&>(b) = sg::programInputs(hand, mesh, pose);
-  b.spirv = hand.spirv.words;
-  b.capture.strideBytes = gen.glsl.captureStride;
-  std::vector<uint8_t> ga = harness.run(a).captured, gb = harness.run(b).captured;
+  std::vector<uint8_t> ga = captured(harness, gen, gen, mesh, pose), gb = captured(harness, hand, gen, mesh, pose);
   ASSERT_EQ(ga.size(), gb.size());
   EXPECT_TRUE(harness.validationMessages().empty()) << harness.validationMessages().front();
   // Same values up to float rounding (the two programs order their arithmetic differently).
@@ -219,6 +222,47 @@ TEST(GpuBench, HandPortOfListing33ComputesWhatTheGeneratedShaderComputes) {
     differ += d > 1e-4;
   }
   EXPECT_EQ(differ, 0u) << "worst relative difference " << worst;
+}
+
+// A hand port of a buffer-fed program (16 influences and the palette from storage buffers, read
+// at gl_VertexIndex) is fed the generated program's buffers at their bindings and computes what it
+// computes; a storage buffer the generated program does not read is a located error.
+TEST(GpuBench, HandPortOfABufferFedProgramReadsTheGeneratedProgramsStorageBuffers) {
+  sg::GenerateOptions g;
+  g.rigPath = sourcePath("tests/validate/data/limb16.rig.yaml");
+  g.fragmentPath = sourcePath("tests/validate/data/world.frag");
+  g.rulesPaths = {sourcePath("rules/standard.yaml")};
+  g.bannedRules = {"skin_matrix_blend", "skin_matrix_blend_buffered_influences", "skin_matrix_blend_buffer_palette",
+                   "world_position_linear_blend", "world_normal_linear_blend", "world_tangent_linear_blend"};
+  sg::GenerateResult plain = sg::generate(g);  // the hand port's text: no capture qualifiers of its own
+  g.capture = true;
+  sg::GenerateResult gen = sg::generate(g);
+  ASSERT_EQ(gen.glsl.buffers.size(), 3u);  // joints, weights, palette
+  sg::ValidationScene scene = sg::proceduralScene(gen.in.rig, "limb", 3, 1);
+  sg::rt::Mesh mesh = sg::quantizeForRig(gen.in.rig, scene.mesh);
+  const sg::rt::Pose& pose = scene.poses.front();
+  sg::GenerateResult hand = sg::handWrittenProgram(sg::addCaptureQualifiers(plain.glsl.text, "hand.vert", gen.glsl),
+                                                   "hand.vert", gen, g.targetEnv);
+  ASSERT_EQ(hand.glsl.buffers.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) EXPECT_EQ(hand.glsl.buffers[i].semantic, gen.glsl.buffers[i].semantic);
+
+  sg::rt::Harness harness;
+  std::vector<uint8_t> ga = captured(harness, gen, gen, mesh, pose), gb = captured(harness, hand, gen, mesh, pose);
+  ASSERT_EQ(ga.size(), gb.size());
+  EXPECT_TRUE(harness.validationMessages().empty()) << harness.validationMessages().front();
+  EXPECT_EQ(ga, gb);
+
+  g.bannedRules.push_back("skin_matrix_blend_buffered_influences_buffer_palette");
+  g.bannedRules.erase(g.bannedRules.begin());  // the uniform palette and attribute influences: no buffers
+  sg::GenerateResult noBuffers = sg::generate(g);
+  ASSERT_TRUE(noBuffers.glsl.buffers.empty());
+  try {
+    sg::handWrittenProgram(plain.glsl.text, "hand.vert", noBuffers, g.targetEnv);
+    ADD_FAILURE() << "no error";
+  } catch (const sg::InputError& e) {
+    EXPECT_EQ(e.diagnostic().loc.file, "hand.vert");
+    EXPECT_NE(e.diagnostic().message.find("is not one the generated program reads"), std::string::npos) << e.diagnostic().message;
+  }
 }
 
 }  // namespace

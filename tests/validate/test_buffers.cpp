@@ -10,6 +10,7 @@
 #include <iostream>
 
 #include "test_util.h"
+#include "rig/rig_lod.h"
 #include "validate/gltf_scene.h"
 #include "validate/validate.h"
 
@@ -134,6 +135,36 @@ TEST(Buffers, Limb16InfluencesAttributesAndBuffers) {
                                       sourcePath("rules/standard.yaml"), "limb", false, 2, 8);
   expectAllPass(small);
   EXPECT_TRUE(has(small.runs[0].rules, "skin_matrix_blend_buffered_influences"));
+}
+
+// The palette in a storage buffer is blended column by column (bone_blend_columns), each group's
+// weights read beside its joints; the last group may hold 1, 2 or 3 influences. Each form, with
+// the joints as attributes or from a storage buffer, against the independent reference: a wrong
+// column, joint or weight of the partial group fails it.
+TEST(Buffers, BufferPaletteBlendsColumnByColumnWithPartialGroups) {
+  for (const std::string rule : {"skin_matrix_blend_buffer_palette", "skin_matrix_blend_buffered_influences_buffer_palette"})
+    for (const auto& [rig, influences] : std::vector<std::pair<std::string, int>>{
+             {"limb2.rig.yaml", 2}, {"limb5_uniform.rig.yaml", 5}, {"limb5_uniform.rig.yaml", 6},
+             {"limb5_uniform.rig.yaml", 7}, {"limb16.rig.yaml", 16}}) {
+      SCOPED_TRACE(rule + " on " + rig + " with " + std::to_string(influences) + " influences");
+      sg::ValidateOptions vo;
+      vo.gen.rigPath = dataPath(rig);
+      vo.gen.fragmentPath = dataPath("world.frag");
+      vo.gen.rulesPaths = {sourcePath("rules/standard.yaml")};
+      vo.gen.maxAttributes = 32;
+      vo.gen.rigParams = {{"influences", influences}};
+      // Every other producer of the skin matrix, and the blends that bypass it, out.
+      for (const char* r : {"skin_matrix_blend", "skin_matrix_blend_buffered_influences", "skin_matrix_blend_buffer_palette",
+                            "skin_matrix_blend_buffered_influences_buffer_palette", "world_position_linear_blend",
+                            "world_normal_linear_blend", "world_tangent_linear_blend"})
+        if (r != rule) vo.gen.bannedRules.push_back(r);
+      sg::Rig loaded = sg::loadRigFile(vo.gen.rigPath);
+      sg::ValidationScene scene = sg::proceduralScene(sg::rigWithParameters(loaded, vo.gen.rigParams, sg::SourceLoc{}), "limb", 3, 2);
+      sg::Validator v(vo);
+      sg::ValidateReport rep = v.run(scene);
+      expectAllPass(rep);
+      EXPECT_TRUE(has(rep.runs[0].rules, rule));
+    }
 }
 
 // 8 influences over 300 bones: the palette does not fit the 16 KiB uniform block.
