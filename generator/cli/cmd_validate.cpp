@@ -154,7 +154,7 @@ struct ValidateCommand {
       int n = count ? std::stoi(poses) : 1;
       if (count && (n < 1 || n > 100))  // a usage error (exit 2), like every other bad option value
         throw CLI::ValidationError("--poses", fmt::format("{}: a count is 1..100", poses));
-      scene = proceduralScene(loadRigFile(vo.gen.rigPath), mesh, seed, n);
+      scene = proceduralScene(vo.gen.rigPath, vo.gen.rigParams, mesh, seed, n);
       if (count) {
         what = fmt::format("mesh '{}' ({} vertices), {} pose(s) from seed {}\n", scene.mesh.name,
                            scene.mesh.vertexCount, scene.poses.size(), seed);

@@ -13,6 +13,7 @@
 #include <random>
 #include <set>
 
+#include "rig/rig_lod.h"
 #include "runtime/procedural.h"
 #include "validate/float_check.h"
 #include "validate/interpreter.h"
@@ -204,6 +205,13 @@ ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_
   for (int i = 0; i < poses; ++i) s.poses.push_back(rt::makeRandomPose(s.shape, seed + static_cast<uint32_t>(i), po));
   limitActiveTargets(rig, s.poses, seed);
   return s;
+}
+
+ValidationScene proceduralScene(const std::string& rigPath, const std::map<std::string, int64_t>& params,
+                                const std::string& mesh, uint32_t seed, int poses) {
+  Rig rig = loadRigFile(rigPath);
+  if (!params.empty()) rig = rigWithParameters(rig, params, SourceLoc{});
+  return proceduralScene(rig, mesh, seed, poses);
 }
 
 // The reference values of one pose, kept across the runs of one validation: the chosen plan

@@ -4,6 +4,7 @@
 #pragma once
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -102,6 +103,10 @@ struct ValidationScene {
 // A procedural scene matching the rig: "head" (default), "limb", or "dawn" (180k vertices).
 // Throws InputError if the rig asks for something the procedural meshes can't supply.
 ValidationScene proceduralScene(const Rig& rig, const std::string& mesh, uint32_t seed, int poses);
+// The same for a rig file as the program is generated for it: with the deformer parameters set
+// (--set, a variant's level of detail), so the poses hold the targets and influences it reads.
+ValidationScene proceduralScene(const std::string& rigPath, const std::map<std::string, int64_t>& params,
+                                const std::string& mesh, uint32_t seed, int poses);
 
 // For rigs with an active-target list (morph.active_targets, docs/buffers.md): keeps, per
 // pose, a seeded choice of as many non-zero morph weights as the list holds.

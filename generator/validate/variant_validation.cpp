@@ -47,10 +47,14 @@ std::string DeviceVariantValidator::identity() const {
 }
 
 std::shared_ptr<const ValidationScene> DeviceVariantValidator::sceneOf(const std::string& rigPath,
+                                                                      const std::map<std::string, int64_t>& params,
                                                                       const GltfReadOptions& read) {
+  // A level-of-detail variant (fewer targets or influences) is posed as its own rig.
+  std::string key = rigPath;
+  for (const auto& [name, value] : params) key += fmt::format("\n{}={}", name, value);
   {
     std::lock_guard<std::mutex> g(lock_);
-    if (auto it = scenes_.find(rigPath); it != scenes_.end()) return it->second;
+    if (auto it = scenes_.find(key); it != scenes_.end()) return it->second;
   }
   std::shared_ptr<ValidationScene> scene;
   if (isGltfPath(rigPath)) {  // the model's own mesh, posed by its animation
@@ -62,14 +66,14 @@ std::shared_ptr<const ValidationScene> DeviceVariantValidator::sceneOf(const std
     scene = std::make_shared<ValidationScene>(gltfScene(rigPath, so));
   } else {  // a procedural mesh in random poses, as `validate` makes for a YAML rig
     scene = std::make_shared<ValidationScene>(
-        proceduralScene(loadRigFile(rigPath), settings_.mesh, settings_.seed, settings_.poses));
+        proceduralScene(rigPath, params, settings_.mesh, settings_.seed, settings_.poses));
   }
   std::lock_guard<std::mutex> g(lock_);
-  return scenes_.emplace(rigPath, scene).first->second;
+  return scenes_.emplace(key, scene).first->second;
 }
 
 ValidationResult DeviceVariantValidator::validate(const Variant&, const GenerateOptions& gen) {
-  std::shared_ptr<const ValidationScene> scene = sceneOf(gen.rigPath, gen.gltf);
+  std::shared_ptr<const ValidationScene> scene = sceneOf(gen.rigPath, gen.rigParams, gen.gltf);
   std::unique_ptr<Validator> validator;
   {
     std::lock_guard<std::mutex> g(lock_);

@@ -24,12 +24,13 @@ class DeviceVariantValidator : public VariantValidator {
 
  private:
   ValidateOptions options(const GenerateOptions& gen) const;
-  std::shared_ptr<const ValidationScene> sceneOf(const std::string& rigPath, const GltfReadOptions& read);
+  std::shared_ptr<const ValidationScene> sceneOf(const std::string& rigPath, const std::map<std::string, int64_t>& params,
+                                                 const GltfReadOptions& read);
   ManifestValidation settings_;
   std::string device_, driver_;
   std::mutex lock_;
   std::vector<std::unique_ptr<Validator>> idle_;  // one per worker at most, each its own device
-  std::map<std::string, std::shared_ptr<const ValidationScene>> scenes_;  // by rig path
+  std::map<std::string, std::shared_ptr<const ValidationScene>> scenes_;  // by rig path and parameters
 };
 
 }  // namespace sg

@@ -425,6 +425,24 @@ EOF
   cmp -s sep/face-color-influences1.spv "out/$spvpath" && cmp -s sep/face-color-influences1.json out/face-color-influences1.json &&
     cmp -s sep/face-color-influences1.vert out/face-color-influences1.vert &&
     ok "build output == generate --set output (GLSL, SPIR-V, reflection)" || fail "build and generate differ ($spvpath)"
+  # A level-of-detail variant is validated as its own rig: the sparse 52-target face with 2 targets
+  # poses at most 2 active ones (before: "the pose has 6 targets with a non-zero weight").
+  SP=(--rig "$SRC/tests/validate/data/face52_sparse.rig.yaml" -f "$SRC/tests/validate/data/world.frag" -r "$SRC/rules/standard.yaml")
+  expect 0 "validate --set morph_targets=2 (sparse face)" -- "$SG" validate "${SP[@]}" --set morph_targets=2 --poses 2 --no-validation-layers
+  grep -q '^PASS' last.out && ok "the 2-target level of detail validates" || fail "validate printed: $(tail -3 last.out)"
+  cat >lod.yaml <<EOF
+output: lod
+rules: $SRC/rules/standard.yaml
+rigs:
+  sparse: $SRC/tests/validate/data/face52_sparse.rig.yaml
+passes:
+  world: $SRC/tests/validate/data/world.frag
+axes:
+  morph_targets: [52, 2]
+validate: { poses: 2, validation_layers: false }
+EOF
+  expect 0 "build --validate, level-of-detail variants of a sparse rig" -- "$SG" build lod.yaml
+  grep -q "validated on llvmpipe.*: 2 run" last.out && ok "both levels validated" || fail "build printed: $(tail -3 last.out)"
   # Two builds at once sharing one cache directory: both succeed, same bytes.
   "$SG" build m.yaml -o c1 --cache-dir shared -q & p1=$!
   "$SG" build m.yaml -o c2 --cache-dir shared -q & p2=$!
