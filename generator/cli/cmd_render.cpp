@@ -211,7 +211,8 @@ void registerRender(CLI::App& app, CliState& state) {
   bench->cmd = b;
   bench->args.add(*b);
   b->add_option("--hand-port", bench->bo.handPortPath, "A hand-written vertex shader with the same interface "
-                                                       "(a_<attribute>, u_<uniform>), e.g. examples/dawn/listing-3-3.vert");
+                                                       "(a_<attribute>, u_<uniform>, gl_VertexIndex, the generated program's storage buffers "
+                                                       "at their bindings), e.g. examples/dawn/listing-3-3.vert");
   b->add_option("--mesh", bench->bo.render.mesh, "Procedural mesh for a YAML rig: dawn (default, 180k vertices), head, limb "
                                                  "(a glTF rig, MODEL.glb#m/p or the whole MODEL.glb#*, draws its own mesh)")
       ->check(CLI::IsMember({"head", "limb", "dawn"}));
