@@ -231,6 +231,12 @@ TEST(AccessTerms, CountedOnTheDawnRules) {
   EXPECT_EQ(palette.bufferLoads, (Loads{{"skin.bones_buffer", 4}}));
   EXPECT_EQ(palette.bufferVec4Loads, (Loads{{"skin.bones_buffer", 16}}));
   EXPECT_EQ(palette.indexedUniformLoads, 0);
+  // Both from buffers, each bone column loaded where it is summed (bone_blend_columns): still one
+  // element per matrix and 4 vec4 loads of it, and the joints' and weights' one element each.
+  RuleAccesses both = accesses("skin_matrix_blend_buffered_influences_buffer_palette");
+  EXPECT_EQ(both.bufferLoads, (Loads{{"skin.bones_buffer", 4}, {"skin.joints_buffer", 1}, {"skin.weights_buffer", 1}}));
+  EXPECT_EQ(both.bufferVec4Loads, (Loads{{"skin.bones_buffer", 16}, {"skin.joints_buffer", 1}, {"skin.weights_buffer", 1}}));
+  EXPECT_EQ(both.indexedUniformLoads, 0);
 }
 
 }  // namespace
