@@ -132,11 +132,10 @@ SnippetProbe buildSnippetProbe(const RuleSet& rules, int r, const ProbeRig& rig,
       continue;
     }
     if (forAccesses && !d->bound.empty()) {
-      // At most as many iterations as a family has instances (instantiate.cpp allows 256): a
-      // rig may state a larger bound (max_active_targets up to 65535), and unrolling that many
-      // would take minutes for iterations no list can fill.
-      constexpr int64_t kMostIterations = 256;
-      const int64_t most = std::clamp<int64_t>(d->bound.eval(probeEnv(rig)), 0, kMostIterations);
+      // At most as many iterations as a family has instances: a rig may state a larger bound
+      // (max_active_targets up to 65535), and unrolling that many would take minutes for
+      // iterations no list can fill.
+      const int64_t most = std::clamp<int64_t>(d->bound.eval(probeEnv(rig)), 0, kMostFamilyInstances);
       constants += fmt::format("const {} p_{} = {}{};\n", glslName(d->type), mangle(fact), most,
                                scalarKind(d->type) == ScalarKind::UInt ? "u" : "");
       continue;

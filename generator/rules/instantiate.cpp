@@ -24,7 +24,8 @@ void evalFamilies(RigShape& shape, const RuleSet& rules, bool strictArrays) {
   for (const auto& d : rules.semantics) {
     if (!d.count.empty()) {
       int64_t n = d.count.eval(env);
-      if (n < 0 || n > 256) throw InputError(d.loc, fmt::format("semantic '{}' has count {} (allowed 0..256)", d.name, n));
+      if (n < 0 || n > kMostFamilyInstances)
+        throw InputError(d.loc, fmt::format("semantic '{}' has count {} (allowed 0..{})", d.name, n, kMostFamilyInstances));
       shape.families[d.name] = n;
     }
     if (!d.arrayParam.empty()) {

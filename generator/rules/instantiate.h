@@ -32,6 +32,9 @@ struct RigShape {
 // "name[i]".
 std::string indexedName(const std::string& name, int64_t i);
 
+// The most instances a semantic family may have (its `count`).
+constexpr int64_t kMostFamilyInstances = 256;
+
 // Evaluates the family counts and uniform array sizes of `rules` against shape.params.
 // A missing array parameter throws InputError when `strictArrays`, else sizes it 4.
 // Counts outside 0..256 throw InputError at the semantic's declaration.
