@@ -338,13 +338,7 @@ TEST(AccessTerms, PerVertexIndicesAreFollowedThroughLoadsLocalsAndArithmetic) {
   EXPECT_EQ(count("  o = u.palette[(u.base.x * 3u + u.base.y) & 63u][0] + u.palette[b.j[u.base.z].x & 63u][1];\n"), 0);
   EXPECT_EQ(count("  vec4 s = vec4(0.0);\n  for (uint k = 0u; k < u.base.w; ++k) s += u.palette[k & 63u][0];\n  o = s;\n"), 0);
 }
-}  // namespace
-}  // namespace sg
 
-// A loop to a count whose bound is larger than any family (a user's rule, no other clamp) is
-// counted at most 256 times, so a large bound cannot make the probe unroll for minutes.
-namespace sg {
-namespace {
 // One rule looping to a count declared with `bound: BOUND`, reading the palette at an index
 // that varies per vertex (a.f is neither a rig uniform nor an array).
 std::string boundedLoopRules(const std::string& bound) {
@@ -359,6 +353,8 @@ std::string boundedLoopRules(const std::string& bound) {
 )";
 }
 
+// A loop to a count whose bound is larger than any family (a user's rule, no other clamp) is
+// counted at most 256 times, so a large bound cannot make the probe unroll for minutes.
 TEST(AccessTerms, ALargeBoundIsCountedAtMost256Times) {
   auto dir = scratchDir("bound_cap");
   const std::string text = boundedLoopRules("100000");
@@ -367,13 +363,9 @@ TEST(AccessTerms, ALargeBoundIsCountedAtMost256Times) {
   ASSERT_TRUE(a.ok) << (a.diagnostics.empty() ? "" : formatDiagnostic(a.diagnostics.front()));
   EXPECT_EQ(a.indexedUniformLoads, 256);  // a.f varies per vertex: every iteration's index does
 }
-}  // namespace
-}  // namespace sg
 
 // `bound:` names the most a count can be; anything but an integer scalar is refused where it
 // is written.
-namespace sg {
-namespace {
 TEST(AccessTerms, ABoundOnANonCountIsALocatedError) {
   auto dir = scratchDir("bound_error");
   const std::string text = "semantics:\n  a.n: { type: uint, bound: max_active_targets }\n  a.f: { type: float, bound: 4 }\n";
