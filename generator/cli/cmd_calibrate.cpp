@@ -198,6 +198,10 @@ void registerCalibrate(CLI::App& app, CliState& state) {
   sub->add_option("--templates", cmd->co.plans.templateDir, "With --rig: directory with vertex.glsl templates");
   sub->add_option("--draws", cmd->co.drawsPerFrame, "Draws of the mesh between two timestamps (default 16)")
       ->check(CLI::Range(1, 4096));
+  sub->add_option("--min-frame-vertices", cmd->co.minVerticesPerFrame,
+                  "A smaller mesh (a model's part) is drawn more often than --draws, so that each timed frame draws at least this "
+                  "many vertices (default 16000: the 2,009-vertex head at 8 draws; 0: exactly --draws)")
+      ->check(CLI::Range(0, 100000000));
   sub->add_option("--frames", cmd->co.frames, "Timed frames; the median counts (default 9)")->check(CLI::Range(1, 1000));
   sub->add_option("--rounds", cmd->co.rounds, "Timings per program; the best counts (default 2)")->check(CLI::Range(1, 100));
   sub->add_option("--refits", cmd->co.refits, "With --rig: fits again with the plans each profile chose (default 1)")

@@ -219,6 +219,10 @@ void registerRender(CLI::App& app, CliState& state) {
   b->add_option("--size", bench->size, "Render target WIDTHxHEIGHT with rasterization on (default 256x256)");
   b->add_option("--draws", bench->bo.drawsPerFrame, "Draws of the mesh between two timestamps (default 8)")
       ->check(CLI::Range(1, 100000));
+  b->add_option("--min-frame-vertices", bench->bo.minVerticesPerFrame,
+                "A smaller mesh (a model's part) is drawn more often than --draws, so that each timed frame draws at least this "
+                "many vertices (default 16000: the 2,009-vertex head at 8 draws; 0: exactly --draws)")
+      ->check(CLI::Range(0, 100000000));
   b->add_option("--frames", bench->bo.frames, "Timed frames; the median is reported (default 7)")->check(CLI::Range(1, 1000));
   b->add_option("--rounds", bench->bo.rounds, "Passes over every program, order rotated; the best counts (default 3)")
       ->check(CLI::Range(1, 100));

@@ -681,7 +681,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           req.width = opts.width;
           req.height = opts.height;
           rt::TimingRequest t;
-          t.drawsPerFrame = opts.drawsPerFrame;
+          t.drawsPerFrame = drawsPerFrame(opts.drawsPerFrame, opts.minVerticesPerFrame, m.mesh.vertexCount);
           t.frames = opts.frames + 1;
           t.rasterize = !hostClock;
           t.captureStride = run.capture.strideBytes;
@@ -689,7 +689,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
             rt::Timing tm = renderer.time(req, t);
             const std::vector<double>& clock = hostClock ? tm.cpuNs : tm.frameNs;
             std::vector<double> frames(clock.begin() + 1, clock.end());
-            double ns = medianOf(frames) / (double(opts.drawsPerFrame) * double(tm.verticesPerDraw));
+            double ns = medianOf(frames) / (double(t.drawsPerFrame) * double(tm.verticesPerDraw));
             s.measuredNs = s.measuredNs < 0 ? ns : std::min(s.measuredNs, ns);
           }
         }
@@ -749,6 +749,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
         bo.rasterOn = !hostClock;
         bo.rasterOff = hostClock;
         bo.drawsPerFrame = opts.drawsPerFrame;
+        bo.minVerticesPerFrame = opts.minVerticesPerFrame;
         bo.frames = opts.frames;
         bo.rounds = opts.rounds;
         GpuBenchReport br;

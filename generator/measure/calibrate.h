@@ -43,6 +43,7 @@ struct CalibrationOptions {
   bool validationLayers = true;
   std::vector<std::string> meshes{"dawn", "head"};  // the first one's samples give the weights
   uint32_t drawsPerFrame = 16;
+  uint32_t minVerticesPerFrame = 16000;  // a small mesh drawn more often (GpuBenchOptions)
   uint32_t frames = 9;              // + 1 warm-up frame
   uint32_t rounds = 2;              // best round counts
   uint32_t width = 256, height = 256;  // the target of every draw (bench's default)

@@ -240,6 +240,11 @@ double spearmanWithinSpread(const std::vector<double>& x, const std::vector<doub
 // Two timings of one program on one device differ by up to this much (relative): docs/performance.md.
 constexpr double kRunToRunSpread = 0.005;
 
+uint32_t drawsPerFrame(uint32_t draws, uint32_t minVertices, size_t vertices) {
+  const uint64_t needed = vertices == 0 ? 0 : (uint64_t(minVertices) + vertices - 1) / vertices;
+  return uint32_t(std::min<uint64_t>(kMostDrawsPerFrame, std::max<uint64_t>({1, draws, needed})));
+}
+
 bool isCpuDevice(const std::string& deviceName) { return deviceName.find("llvmpipe") != std::string::npos; }
 
 void timeCpuDevicesSingleThreaded() { setenv("LP_NUM_THREADS", "0", /*overwrite=*/0); }
@@ -377,7 +382,8 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   rep.workload = gen.workload;
   rep.vertices = scene.mesh.vertexCount;
   rep.triangles = scene.indices.size() / 3;
-  rep.drawsPerFrame = opts.drawsPerFrame;
+  const uint32_t draws = drawsPerFrame(opts.drawsPerFrame, opts.minVerticesPerFrame, scene.mesh.vertexCount);
+  rep.drawsPerFrame = draws;
   rep.frames = opts.frames;
   rep.rounds = std::max<uint32_t>(1, opts.rounds);
   rep.width = opts.render.width;
@@ -392,11 +398,11 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
       Program& p = programs[(k + round) % n];
       if (p.validate && p.row.validation != "pass") continue;
       rt::TimingRequest t;
-      t.drawsPerFrame = opts.drawsPerFrame;
+      t.drawsPerFrame = draws;
       t.frames = opts.frames + 1;
       auto perVertex = [&](const std::vector<double>& ns, uint32_t vertices) {
         std::vector<double> frames(ns.begin() + 1, ns.end());  // the first warms up
-        return median(frames) / (double(opts.drawsPerFrame) * double(vertices));
+        return median(frames) / (double(draws) * double(vertices));
       };
       if (opts.rasterOn) {
         rt::DrawRequest req = drawRequest(p.render, frag, textures, scene);

@@ -25,6 +25,11 @@ struct GpuBenchOptions {
   bool alternatives = true;    // every forced alternative (as validate --cross-check)
   bool rasterOn = true, rasterOff = true;
   uint32_t drawsPerFrame = 8;
+  // A mesh too small to keep the device busy over drawsPerFrame draws is drawn more often, so
+  // that a frame draws at least this many vertices (0: exactly drawsPerFrame). On the H200 a
+  // 302-vertex part timed over 8 draws read 0.07 ns per vertex for its floor (the timestamps
+  // bracket almost nothing); the default is the 2,009-vertex head at 8 draws.
+  uint32_t minVerticesPerFrame = 16000;
   uint32_t frames = 7;         // + 1 warm-up frame, not counted
   uint32_t rounds = 3;         // passes over every program; the best pass counts
 };
@@ -71,6 +76,11 @@ struct GpuBenchReport {
 };
 
 GpuBenchReport runGpuBench(const GpuBenchOptions& opts);
+
+// Draws per timed frame of a mesh of `vertices`: at least `draws`, and enough that the frame
+// draws `minVertices` vertices, at most kMostDrawsPerFrame.
+inline constexpr uint32_t kMostDrawsPerFrame = 100000;
+uint32_t drawsPerFrame(uint32_t draws, uint32_t minVertices, size_t vertices);
 
 // A CPU device (lavapipe): its timestamp queries miss work it defers (on the 2,009-vertex head
 // they read 55 ns per vertex where submit-to-fence took 1,000), so bench and calibrate time it

@@ -91,10 +91,40 @@ sg::GpuBenchOptions quickBench(const std::string& rules) {
   b.render.mesh = "head";
   b.render.width = b.render.height = 32;
   b.drawsPerFrame = 1;
+  b.minVerticesPerFrame = 0;
   b.frames = 1;
   b.rounds = 1;
   b.floor = false;
   return b;
+}
+
+TEST(GpuBench, ASmallMeshIsDrawnOftenEnoughThatEachFrameDrawsTheMinimum) {
+  EXPECT_EQ(sg::drawsPerFrame(8, 16000, 180000), 8u);   // Dawn scale: --draws as given
+  EXPECT_EQ(sg::drawsPerFrame(8, 16000, 2009), 8u);     // the head: 16,072 vertices at 8
+  EXPECT_EQ(sg::drawsPerFrame(8, 16000, 2000), 8u);     // exactly 16,000
+  EXPECT_EQ(sg::drawsPerFrame(8, 16000, 1999), 9u);
+  EXPECT_EQ(sg::drawsPerFrame(8, 16000, 302), 53u);     // RobotExpressive's 302-vertex part
+  EXPECT_EQ(sg::drawsPerFrame(8, 0, 302), 8u);          // 0: exactly --draws
+  EXPECT_EQ(sg::drawsPerFrame(8, 100000000, 1), sg::kMostDrawsPerFrame);
+  EXPECT_EQ(sg::drawsPerFrame(0, 0, 0), 1u);
+
+  // The report states the draws a frame took, and the time per vertex divides by them: the
+  // head drawn once (no minimum) and 8 times (the minimum) costs about the same per vertex.
+  sg::GpuBenchOptions b = quickBench(sourcePath("examples/dawn/rules.yaml"));
+  b.alternatives = false;
+  b.rasterOff = false;
+  b.frames = 3;
+  sg::GpuBenchReport once = sg::runGpuBench(b);
+  b.minVerticesPerFrame = 16000;
+  sg::GpuBenchReport many = sg::runGpuBench(b);
+  EXPECT_EQ(once.drawsPerFrame, 1u);
+  EXPECT_EQ(many.drawsPerFrame, 8u);
+  EXPECT_NE(sg::formatGpuBench(many).find("8 draws per frame"), std::string::npos);
+  ASSERT_GT(once.rows[0].rasterOnWallNsPerVertex, 0);
+  const double ratio = many.rows[0].rasterOnWallNsPerVertex / once.rows[0].rasterOnWallNsPerVertex;
+  // Host time is a submit overhead o plus d per draw: (o + 8d) / 8(o + d) <= 1 when divided by the
+  // 8 draws taken, (o + 8d) / (o + d) >= 1 when not.
+  EXPECT_LT(ratio, 1.3) << "per-vertex time not divided by the draws taken";
 }
 
 TEST(GpuBench, BufferFedAlternativesAreValidatedAndTimed) {
