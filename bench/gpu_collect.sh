@@ -15,7 +15,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 device=${1-NVIDIA}
 outdir=${2:-.}
 source "$here/gpu_env.sh"
-t=(--no-validation-layers --meshes "${SG_MESHES:-dawn,head}" --draws "${SG_DRAWS:-32}"
+t=(--no-validation-layers --meshes "${SG_MESHES:-dawn,head}" --draws "${SG_DRAWS:-32}" --min-frame-vertices "${SG_MIN_FRAME_VERTICES:-64000}"
    --frames "${SG_FRAMES:-7}" --rounds "${SG_ROUNDS:-2}" --refits 0 --no-check)
 [ -n "$device" ] && t+=(--device "$device")
 dawnRules=(-r "$here/examples/dawn/rules.yaml" --templates "$here/templates")

@@ -113,8 +113,8 @@ struct CalibrateCommand {
     while (start <= meshes.size()) {
       size_t comma = meshes.find(',', start);
       std::string m = meshes.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-      if (m != "dawn" && m != "head" && m != "small")
-        throw CLI::ValidationError("--meshes", "expected a comma-separated list of dawn, head, small; got '" + meshes + "'");
+      if (m != "dawn" && m != "head" && m != "limb" && m != "small")
+        throw CLI::ValidationError("--meshes", "expected a comma-separated list of dawn, head, limb, small; got '" + meshes + "'");
       co.meshes.push_back(m);
       if (comma == std::string::npos) break;
       start = comma + 1;
@@ -187,7 +187,7 @@ void registerCalibrate(CLI::App& app, CliState& state) {
   sub->add_option("-o,--output", cmd->output, "Device profile (YAML) to write");
   sub->add_option("--meshes", cmd->meshes, "Procedural meshes, comma-separated; all are fitted, meshes of two sizes give per-draw "
                                            "weights, the first one's size is the profile's vertices_per_draw "
-                                           "(default dawn,head: 180,000 and 2,009 vertices)");
+                                           "(default dawn,head: 180,000 and 2,009 vertices; limb: 825, a small draw)");
   sub->add_option("--rig", cmd->co.rigs, "Also time the plan of this rig, its forced alternatives and bench's floors; "
                                          "repeat for several rigs (a packed layout beside the float one). A glTF rig "
                                          "(MODEL.glb#m/p, or MODEL.glb#* for every primitive) is timed on its own mesh");

@@ -83,8 +83,9 @@ ProbeMesh probeMesh(const std::string& name) {
   m.name = name;
   int rings = 40, segments = 48;  // validate's head: 2,009 vertices (cached on a GPU)
   if (name == "dawn") rings = 299, segments = 599;  // 180,000 vertices
+  else if (name == "limb") rings = 24, segments = 32;  // 825 vertices, as the limb's: a small draw, latency-bound
   else if (name == "small") rings = 8, segments = 8;  // tests
-  else if (name != "head") throw std::invalid_argument(fmt::format("calibration mesh '{}': head, dawn or small", name));
+  else if (name != "head") throw std::invalid_argument(fmt::format("calibration mesh '{}': head, dawn, limb or small", name));
   m.mesh = rt::makeHead(rings, segments, mo);
   m.indices = gridIndices(rings, segments);
   return m;

@@ -10,6 +10,7 @@ inline CalibrationOptions quickCalibration() {
   CalibrationOptions o;
   o.meshes = {"small"};
   o.drawsPerFrame = 1;
+  o.minVerticesPerFrame = 0;
   o.frames = 1;
   o.rounds = 1;
   return o;

@@ -358,4 +358,26 @@ TEST(Calibrate, TimesThePlansTheDevicesLimitsAllow) {
   }
   EXPECT_GT(uniformPalette, 0u);
 }
+
+TEST(Calibrate, TheLimbMeshTimesProbesAndPlansAtTheLimbsSize) {
+  // A small draw beside Dawn scale and the head: probes and plans alike at 825 vertices, so the
+  // per-draw weights see one size; every probe and plan still validated first.
+  CalibrationOptions o = testing::quickCalibration();
+  o.meshes = {"limb"};
+  o.check = false;
+  o.validationLayers = false;
+  o.rigs = {std::string(SG_SOURCE_DIR) + "/tests/validate/data/limb16.rig.yaml"};
+  o.plans.fragmentPath = std::string(SG_SOURCE_DIR) + "/tests/validate/data/world.frag";
+  o.plans.rulesPaths = {std::string(SG_SOURCE_DIR) + "/rules/standard.yaml"};
+  const CalibrationReport r = calibrateDevice(o);
+  size_t probes = 0, plans = 0;
+  for (const auto& s : r.samples) {
+    EXPECT_TRUE(s.validated) << s.label << ": " << s.failure;
+    EXPECT_EQ(s.mesh, "limb") << s.label;
+    EXPECT_EQ(s.vertices, 825) << s.label;
+    (s.rig.empty() ? probes : plans) += 1;
+  }
+  EXPECT_GT(probes, 5u);
+  EXPECT_GT(plans, 2u);
+}
 }  // namespace sg
