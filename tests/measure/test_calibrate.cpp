@@ -379,5 +379,8 @@ TEST(Calibrate, TheLimbMeshTimesProbesAndPlansAtTheLimbsSize) {
   }
   EXPECT_GT(probes, 5u);
   EXPECT_GT(plans, 2u);
+  // The log says how it was timed.
+  EXPECT_NE(formatCalibration(r).find("over 1 draws per frame (a smaller mesh more: at least 0 vertices), median of 1 frames"),
+            std::string::npos);
 }
 }  // namespace sg
