@@ -48,7 +48,7 @@ struct CalibrateCommand {
         *device = driver == std::string::npos ? first.substr(8)
                                               : first.substr(8, driver - 8) + " (" + first.substr(driver + 10, end - driver - 10) + ")";
       }
-      for (auto& s : parseCalibrationSamples(in, {{"dawn", 180000}, {"head", 2009}, {"limb", 825}}, std::filesystem::path(f).filename().string()))
+      for (auto& s : parseCalibrationSamples(in, {{"dawn", 180000}, {"head", 2009}}, std::filesystem::path(f).filename().string()))
         all.push_back(std::move(s));
     }
     if (all.empty()) throw InputError(SourceLoc{files.front(), 0, 0}, "no calibration samples in these logs");
