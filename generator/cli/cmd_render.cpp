@@ -218,7 +218,7 @@ void registerRender(CLI::App& app, CliState& state) {
       ->check(CLI::IsMember({"head", "limb", "dawn"}));
   b->add_option("--size", bench->size, "Render target WIDTHxHEIGHT with rasterization on (default 256x256)");
   b->add_option("--draws", bench->bo.drawsPerFrame, "Draws of the mesh between two timestamps (default 8)")
-      ->check(CLI::Range(1, 100000));
+      ->check(CLI::Range(uint32_t(1), kMostDrawsPerFrame));
   b->add_option("--min-frame-vertices", bench->bo.minVerticesPerFrame,
                 "A smaller mesh (a model's part) is drawn more often than --draws, so that each timed frame draws at least this "
                 "many vertices (default 16000: the 2,009-vertex head at 8 draws; 0: exactly --draws)")
