@@ -163,8 +163,10 @@ struct CalibrateCommand {
       }
       if (ns - first > 1000000000LL) _exit(130);
     });
+    // The handler stays until exit: restoring the default here let timeout's second copy, 0.2 s
+    // after the first, kill a run that had just stopped and was writing what it timed (exit 130
+    // under the sanitizers, cli_device_profile). The profile is written atomically either way.
     CalibrationReport rep = calibrateDevice(co);
-    std::signal(SIGINT, SIG_DFL);
     std::cout << formatCalibration(rep);
     size_t failed = 0;
     for (const auto& s : rep.samples) failed += !s.validated;
