@@ -772,6 +772,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           c.plans = pc.plans;
           c.spearman = pc.spearman;
           c.generatedOverFastest = pc.generatedOverFastest;
+          if (!std::isnan(pc.generatedOverFastest)) c.byRound = generatedOverFastestByRound(br.rows);
           rep.checks.push_back(c);
         }
         for (const auto& row : br.rows) {
@@ -903,8 +904,11 @@ std::string formatCalibration(const CalibrationReport& r) {
   for (const auto& f : r.fits) s += fitLine(f) + "\n";
   for (const auto& c : r.checks)
     s += fmt::format("check of {} on '{}' under the fitted profile: {} plans, predicted vs measured Spearman {:.3f}; "
-                     "the chosen plan takes {:.3f}x the fastest\n",
-                     c.rig, c.mesh, c.plans, c.spearman, c.generatedOverFastest);
+                     "the chosen plan takes {:.3f}x the fastest{}\n",
+                     c.rig, c.mesh, c.plans, c.spearman, c.generatedOverFastest,
+                     std::isnan(c.byRound.least) ? std::string()
+                                                 : fmt::format(" (within one round: {:.3f}x to {:.3f}x over {} rounds)",
+                                                               c.byRound.least, c.byRound.most, c.byRound.rounds));
   s += formatLeaveOneRigOut(r.heldOut);
   s += formatHeldOutCheck(r.check);
   for (const auto& n : r.notes) s += "note: " + n + "\n";

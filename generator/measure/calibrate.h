@@ -105,6 +105,7 @@ struct CalibrationCheck {
   size_t plans = 0;
   double spearman = NAN;            // predicted against measured over its plans
   double generatedOverFastest = NAN;  // the chosen plan's time over the fastest plan's
+  RoundSpread byRound;                // the same ratio within each round (generatedOverFastestByRound)
 };
 
 // Leave-one-rig-out (docs/device-profiles.md, "Held-out error"): for each rig, the profile

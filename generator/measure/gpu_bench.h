@@ -53,6 +53,15 @@ struct GpuBenchRow {
   double rasterOnWallNsPerVertex = -1;   // host submit-to-fence time (see rt::Timing::wallNs)
   double rasterOffCpuNsPerVertex = -1;   // this process's CPU time over it, raster off (rt::Timing::cpuNs): calibrate's clock on a CPU device
   double rasterOffWallNsPerVertex = -1;
+  // The prediction clock's figure (GpuBenchReport::predictionClock) in each round, in round
+  // order: a program's number above is its best; these say how far one round is from another.
+  std::vector<double> roundNsPerVertex;
+};
+
+// A ratio's least and greatest over the rounds it was taken in (NaN, NaN: fewer than two).
+struct RoundSpread {
+  double least = NAN, most = NAN;
+  size_t rounds = 0;
 };
 
 struct GpuBenchReport {
@@ -71,6 +80,9 @@ struct GpuBenchReport {
   // timestamps on a GPU; on a CPU device the clock calibrate fits there (isCpuDevice).
   double spearmanPredictedOn = NAN;
   double generatedOverFastestOn = NAN;
+  // The same ratio taken within each round by the prediction clock: its least and greatest
+  // over the rounds, the spread a reader weighs the best-of-rounds ratio against.
+  RoundSpread byRound;
   std::string predictionClock;
   std::vector<Diagnostic> notes;  // loading's (which stored form is read, what budgets removed)
 };
@@ -105,6 +117,11 @@ struct PredictionCheck {
   double generatedOverFastest = NAN;
 };
 PredictionCheck checkPredictions(const std::vector<GpuBenchRow>& rows, double GpuBenchRow::*clock);
+
+// The generated program's time over the fastest plan's within each round (roundNsPerVertex of
+// the rows checkPredictions counts, the generated program first): least and greatest over the
+// rounds every such row was timed in; NaN, NaN with fewer than two such rounds.
+RoundSpread generatedOverFastestByRound(const std::vector<GpuBenchRow>& rows);
 
 // Markdown table + summary lines.
 std::string formatGpuBench(const GpuBenchReport& report);

@@ -359,6 +359,29 @@ TEST(Calibrate, TimesThePlansTheDevicesLimitsAllow) {
   EXPECT_GT(uniformPalette, 0u);
 }
 
+TEST(Calibrate, TheCheckStatesTheChosenPlansRatioWithinEachRound) {
+  // Two rounds: each check line gives the chosen plan over the fastest within each round too,
+  // the figures generatedOverFastestByRound takes from that rig's bench.
+  CalibrationOptions o = testing::quickCalibration();
+  o.rounds = 2;
+  o.probes = false;
+  o.validationLayers = false;
+  o.rigs = {std::string(SG_SOURCE_DIR) + "/tests/validate/data/limb16.rig.yaml"};
+  o.plans.fragmentPath = std::string(SG_SOURCE_DIR) + "/tests/validate/data/world.frag";
+  o.plans.rulesPaths = {std::string(SG_SOURCE_DIR) + "/rules/standard.yaml"};
+  const CalibrationReport r = calibrateDevice(o);
+  ASSERT_FALSE(r.checks.empty());
+  const std::string text = formatCalibration(r);
+  for (const auto& c : r.checks) {
+    ASSERT_GT(c.plans, 1u) << c.rig;
+    EXPECT_EQ(c.byRound.rounds, 2u) << c.rig;
+    EXPECT_LE(c.byRound.least, c.byRound.most) << c.rig;
+    EXPECT_GE(c.byRound.least, 1.0) << c.rig;  // no plan is faster than the fastest within a round
+    EXPECT_NE(text.find(fmt::format("(within one round: {:.3f}x to {:.3f}x over 2 rounds)", c.byRound.least, c.byRound.most)),
+              std::string::npos);
+  }
+}
+
 TEST(Calibrate, TheLimbMeshTimesProbesAndPlansAtTheLimbsSize) {
   // A small draw beside Dawn scale and the head: probes and plans alike at 825 vertices, so the
   // per-draw weights see one size; every probe and plan still validated first.
