@@ -4,13 +4,15 @@
 # timed), so the plan the profile chooses is itself timed, and each rig's portable plan (this
 # device's profile and another's, below). Usage: bash gpu_verify.sh PROFILE [DEVICE=NVIDIA];
 # on a CPU device SG_RASTER=off times by the clock its profile was fitted on (process CPU time).
+# SG_ROUNDS passes over the programs (default 2); with two or more each summary states the
+# chosen plan's ratio to the fastest within each round as well (its spread).
 # SG_VERIFY_TABLES=FILE keeps every bench table (each alternative's time) beside the summary.
 set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 profile=$1
 device=${2-NVIDIA}
 source "$here/gpu_env.sh"
-b=(--device "$device" --no-validation-layers --raster "${SG_RASTER:-on}" --draws "${SG_DRAWS:-32}" --frames "${SG_FRAMES:-7}" --rounds 2 --no-floor)
+b=(--device "$device" --no-validation-layers --raster "${SG_RASTER:-on}" --draws "${SG_DRAWS:-32}" --frames "${SG_FRAMES:-7}" --rounds "${SG_ROUNDS:-2}" --no-floor)
 data="$here/examples/heldout"
 std=(-r "$here/rules/standard.yaml" --templates "$here/templates")
 one() {  # one LABEL ARGS...: bench, then its summary lines
