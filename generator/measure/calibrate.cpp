@@ -389,8 +389,7 @@ DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, co
   // under its fetch): the fit favours the plans the search must order right, those near the fastest.
   std::vector<FitRow> rows;
   for (const CalibrationSample* s : used) {
-    FitRow r{s->amounts, s->vertices, s->workload, s->measuredNs, 1.0, ""};
-    if (!s->rig.empty() && s->label.rfind("plan", 0) == 0) r.group = s->rig + "\n" + s->mesh;  // a rig's plans on one mesh
+    FitRow r{s->amounts, s->vertices, s->workload, s->measuredNs, 1.0};
     if (!s->rig.empty() && nearBestPower > 0) r.weight = std::pow(fastest.at({s->rig, s->mesh}) / s->measuredNs, nearBestPower);
     rows.push_back(r);
   }
@@ -841,13 +840,12 @@ namespace {
 std::string rooflineLines(const DeviceProfile& p) {
   std::string s;
   if (!p.pipes.empty()) {
-    s += p.hasThresholdPipe() ? "pipes:  # a program takes the additive part plus its slowest pipe, one below zero counting zero\n"
-                              : "pipes:  # overlapped: a program takes the additive part plus its slowest pipe\n";
+    s += "pipes:  # overlapped: a program takes the additive part plus its slowest pipe\n";
     for (const auto& pipe : p.pipes) {
       s += fmt::format("  {}:\n", pipe.name);
       bool any = false;
       for (int t = 0; t < kTermCount; ++t)
-        if (pipe.nanoseconds[size_t(t)] != 0) s += fmt::format("    {}: {:.6g}\n", termName(t), pipe.nanoseconds[size_t(t)]), any = true;
+        if (pipe.nanoseconds[size_t(t)] > 0) s += fmt::format("    {}: {:.6g}\n", termName(t), pipe.nanoseconds[size_t(t)]), any = true;
       if (!any) s.replace(s.size() - 1, 1, " {}\n");
     }
   }
@@ -872,7 +870,7 @@ std::string weightLines(const DeviceProfile& p) {
   std::string s = "weights:\n";
   for (int t = 0; t < kTermCount; ++t) s += fmt::format("  {}: {:.6g}\n", termName(t), p.nanoseconds[size_t(t)]);
   // Pipes and the workload scaling are written whether or not the fit found per-draw costs
-  // (before session 17 a profile without them lost its scaled_by lines).
+  // (before session 17 a profile without them lost its pipes and scaled_by lines).
   if (!p.hasDrawWeights()) return s + rooflineLines(p);
   s += fmt::format("vertices_per_draw: {:g}\ndraw_weights:\n", p.verticesPerDraw);
   for (int t = 0; t < kTermCount; ++t)
@@ -932,7 +930,7 @@ std::string deviceProfileYaml(const CalibrationReport& r) {
                      c.spearman, c.generatedOverFastest);
   if (!r.heldOut.rows.empty()) s += "# " + heldOutSummary(r.heldOut) + "\n";
   if (!r.check.rows.empty()) s += "# " + heldOutSummary(r.check, "held-out check") + "\n";
-  if (!r.profile.pipes.empty() || r.nearBestPower >= 0) s += fmt::format("# form: {}\n", r.profile.pipes.empty() ? "additive" : r.profile.hasThresholdPipe() ? "spill" : "roofline");
+  if (!r.profile.pipes.empty() || r.nearBestPower >= 0) s += fmt::format("# form: {}\n", r.profile.pipes.empty() ? "additive" : "roofline");
   s += fmt::format("device: \"{}\"\nunit: ns\n", r.profile.device);
   return s + weightLines(r.profile);
 }

@@ -4,16 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iterator>
-#include <map>
 #include <set>
 #include <stdexcept>
 
 namespace sg {
 
-const char* profileFormName(ProfileForm form) {
-  return form == ProfileForm::Roofline ? "roofline" : form == ProfileForm::Spill ? "spill" : "additive";
-}
+const char* profileFormName(ProfileForm form) { return form == ProfileForm::Roofline ? "roofline" : "additive"; }
 
 DeviceProfile profileForm(ProfileForm form) {
   DeviceProfile p;
@@ -24,12 +20,6 @@ DeviceProfile profileForm(ProfileForm form) {
   // warp reads, at 2.6 and at 12.2 joints per warp alike (docs/device-profiles.md).
   p.scaledBy[kTermIndexedUniformVec4Loads] = kFeatureJointsPerWarp;
   p.workloadDefaults[kFeatureJointsPerWarp] = 1;
-  if (form == ProfileForm::Spill) {
-    DeviceProfile::Pipe spill;
-    spill.name = "spill";
-    spill.nanoseconds[kTermLocations] = 1;  // marks membership until fitted
-    p.pipes.push_back(spill);
-  }
   if (form == ProfileForm::Roofline) {
     auto pipe = [&](const char* name, std::initializer_list<int> terms) {
       DeviceProfile::Pipe x;
@@ -129,157 +119,6 @@ DeviceProfile toProfile(const DeviceProfile& form, const Layout& l, const std::v
   return p;
 }
 
-// Weighted linear least squares, residual scale * (a . theta - target), some parameters >= 0.
-struct LinearRow {
-  std::vector<double> a;
-  double target = 0, scale = 1;
-};
-
-class LinearCost : public ceres::CostFunction {
- public:
-  explicit LinearCost(const LinearRow& r) : r_(r) {
-    set_num_residuals(1);
-    mutable_parameter_block_sizes()->push_back(static_cast<int32_t>(r.a.size()));
-  }
-  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    double v = -r_.target;
-    for (size_t j = 0; j < r_.a.size(); ++j) v += r_.a[j] * parameters[0][j];
-    residuals[0] = r_.scale * v;
-    if (jacobians && jacobians[0])
-      for (size_t j = 0; j < r_.a.size(); ++j) jacobians[0][j] = r_.scale * r_.a[j];
-    return true;
-  }
-
- private:
-  const LinearRow& r_;
-};
-
-// The parameters and the final cost (half the sum of squared residuals).
-std::pair<std::vector<double>, double> solveLinear(const std::vector<LinearRow>& rows, const std::vector<bool>& nonNegative) {
-  std::vector<double> theta(nonNegative.size(), 0.0);
-  ceres::Problem problem;
-  for (const LinearRow& r : rows) problem.AddResidualBlock(new LinearCost(r), nullptr, theta.data());
-  for (size_t j = 0; j < theta.size(); ++j)
-    if (nonNegative[j]) problem.SetParameterLowerBound(theta.data(), static_cast<int>(j), 0.0);
-  ceres::Solver::Options o;
-  o.linear_solver_type = ceres::DENSE_QR;
-  o.max_num_iterations = 500;
-  o.function_tolerance = 1e-14;
-  o.gradient_tolerance = 1e-16;
-  o.parameter_tolerance = 1e-14;
-  o.num_threads = 1;  // deterministic
-  o.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(o, &problem, &summary);
-  return {theta, summary.final_cost};
-}
-
-// The spill form (fit.h). Stage 1 fits the terms a plan choice changes on the differences
-// between the plans of each group; stage 2 the level on every row, stage 1's part fixed.
-DeviceProfile fitSpill(const std::vector<FitRow>& rows, const DeviceProfile& skeleton, bool drawWeights) {
-  // Loads are counted, not their bytes: a CPU pays per load instruction (gathered lane by
-  // lane), and bytes beside the vec4 count let the fit trade one for the other.
-  static constexpr int kChoiceTerms[] = {kTermArithmetic, kTermLocations, kTermAttributeBytes, kTermBufferLoads,
-                                         kTermIndexedUniformLoads, kTermBufferVec4Loads, kTermIndexedUniformVec4Loads};
-  constexpr size_t kChoice = std::size(kChoiceTerms);
-  std::map<std::string, size_t> members;
-  for (const FitRow& r : rows)
-    if (!r.group.empty()) ++members[r.group];
-  std::map<std::string, size_t> groupIndex;
-  for (const auto& [g, n] : members)
-    if (n > 1) groupIndex.emplace(g, groupIndex.size());
-  if (groupIndex.empty())
-    throw std::runtime_error("calibration: the spill form fits its choice on a rig's plans: no rig has two timed plans on one mesh");
-  std::vector<std::array<double, kTermCount>> xs;
-  for (const FitRow& r : rows) xs.push_back(scaledAmounts(skeleton, r));
-  double mostLocations = 0;
-  for (size_t i = 0; i < rows.size(); ++i)
-    if (groupIndex.count(rows[i].group)) mostLocations = std::max(mostLocations, xs[i][kTermLocations]);
-
-  // Stage 1, for each whole threshold: choice terms, h, then one free level per group.
-  std::vector<bool> nonNegative(kChoice + 1 + groupIndex.size(), false);
-  std::fill(nonNegative.begin(), nonNegative.begin() + kChoice + 1, true);
-  std::vector<double> choice;
-  double bestCost = INFINITY, threshold = 0;
-  for (double l0 = 0; l0 <= mostLocations; ++l0) {
-    std::vector<LinearRow> lr;
-    for (size_t i = 0; i < rows.size(); ++i) {
-      auto g = groupIndex.find(rows[i].group);
-      if (g == groupIndex.end()) continue;
-      LinearRow r;
-      r.a.assign(nonNegative.size(), 0.0);
-      for (size_t j = 0; j < kChoice; ++j) r.a[j] = xs[i][static_cast<size_t>(kChoiceTerms[j])];
-      r.a[kChoice] = std::max(0.0, xs[i][kTermLocations] - l0);
-      r.a[kChoice + 1 + g->second] = 1;
-      r.target = rows[i].measuredNs;
-      r.scale = std::sqrt(rows[i].weight) / rows[i].measuredNs;
-      lr.push_back(std::move(r));
-    }
-    auto [theta, cost] = solveLinear(lr, nonNegative);
-    if (cost < bestCost * (1 - 1e-9)) bestCost = cost, choice = theta, threshold = l0;
-  }
-  const double h = choice[kChoice];
-
-  // Stage 2: vertices, outputs and arithmetic per vertex (and per draw) on every row.
-  static constexpr int kLevelTerms[] = {kTermVertices, kTermOutputs, kTermArithmetic};
-  constexpr size_t kLevel = std::size(kLevelTerms);
-  const size_t levelParams = drawWeights ? 2 * kLevel : kLevel;
-  std::vector<LinearRow> lr;
-  for (size_t i = 0; i < rows.size(); ++i) {
-    double fixed = h * std::max(0.0, xs[i][kTermLocations] - threshold);
-    for (size_t j = 0; j < kChoice; ++j) fixed += choice[j] * xs[i][static_cast<size_t>(kChoiceTerms[j])];
-    LinearRow r;
-    r.a.assign(levelParams, 0.0);
-    for (size_t j = 0; j < kLevel; ++j) {
-      r.a[j] = xs[i][static_cast<size_t>(kLevelTerms[j])];
-      if (drawWeights) r.a[kLevel + j] = r.a[j] / rows[i].vertices;
-    }
-    r.target = rows[i].measuredNs - fixed;
-    r.scale = std::sqrt(rows[i].weight) / rows[i].measuredNs;
-    lr.push_back(std::move(r));
-  }
-  const std::vector<double> level = solveLinear(lr, std::vector<bool>(levelParams, true)).first;
-
-  DeviceProfile p = skeleton;
-  p.pipes.clear();
-  for (size_t j = 0; j < kChoice; ++j) p.nanoseconds[static_cast<size_t>(kChoiceTerms[j])] = choice[j];
-  for (size_t j = 0; j < kLevel; ++j) {
-    p.nanoseconds[static_cast<size_t>(kLevelTerms[j])] += level[j];
-    if (drawWeights) p.drawNanoseconds[static_cast<size_t>(kLevelTerms[j])] = std::min(level[kLevel + j], kMaxProfileDrawWeightNs);
-  }
-  for (double& w : p.nanoseconds) w = std::min(w, kMaxProfileWeightNs);
-  if (h > 0) {
-    DeviceProfile::Pipe spill;
-    spill.name = "spill";
-    spill.nanoseconds[kTermLocations] = std::min(h, kMaxProfileWeightNs);
-    spill.nanoseconds[kTermVertices] = -std::min(h * threshold, kMaxProfileWeightNs);
-    p.pipes.push_back(spill);
-  }
-  return p;
-}
-
-// Workload defaults and the fit's own error, whatever the form.
-FitResult finishFit(FitResult out, const std::vector<FitRow>& rows) {
-  // Where a generation's mesh is unknown, price it like the median mesh the fit saw.
-  std::vector<double> joints;
-  for (const FitRow& r : rows)
-    if (r.workload.jointsPerWarp > 0) joints.push_back(r.workload.jointsPerWarp);
-  if (!joints.empty()) {
-    std::nth_element(joints.begin(), joints.begin() + static_cast<long>(joints.size() / 2), joints.end());
-    out.profile.workloadDefaults[kFeatureJointsPerWarp] = joints[joints.size() / 2];
-  }
-  double sq = 0;
-  for (const FitRow& r : rows) {
-    DeviceProfile at = out.profile;
-    at.workload = r.workload;
-    const double e = std::abs(at.predictNanoseconds(r.amounts, r.vertices) / r.measuredNs - 1);
-    sq += e * e;
-    out.maxRelativeError = std::max(out.maxRelativeError, e);
-  }
-  out.rmsRelativeError = std::sqrt(sq / double(rows.size()));
-  return out;
-}
-
 }  // namespace
 
 FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form) {
@@ -287,15 +126,6 @@ FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form) {
   std::set<double> sizes;
   for (const FitRow& r : rows) sizes.insert(r.vertices);
   const DeviceProfile skeleton = profileForm(form);
-  if (form == ProfileForm::Spill) {
-    FitResult out;
-    out.converged = true;
-    double workload = 0;
-    for (const FitRow& r : rows) workload = std::max(workload, r.vertices);
-    out.profile = fitSpill(rows, skeleton, sizes.size() > 1);
-    if (out.profile.hasDrawWeights()) out.profile.verticesPerDraw = workload;
-    return finishFit(out, rows);
-  }
   const Layout l = layoutOf(skeleton, sizes.size() > 1);
   std::vector<std::array<double, kTermCount>> xs;
   for (const FitRow& r : rows) xs.push_back(scaledAmounts(skeleton, r));
@@ -350,7 +180,24 @@ FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form) {
   double workload = 0;
   for (const FitRow& r : rows) workload = std::max(workload, r.vertices);
   out.profile = toProfile(skeleton, l, best, workload);
-  return finishFit(out, rows);
+  // Where a generation's mesh is unknown, price it like the median mesh the fit saw.
+  std::vector<double> joints;
+  for (const FitRow& r : rows)
+    if (r.workload.jointsPerWarp > 0) joints.push_back(r.workload.jointsPerWarp);
+  if (!joints.empty()) {
+    std::nth_element(joints.begin(), joints.begin() + static_cast<long>(joints.size() / 2), joints.end());
+    out.profile.workloadDefaults[kFeatureJointsPerWarp] = joints[joints.size() / 2];
+  }
+  double sq = 0;
+  for (const FitRow& r : rows) {
+    DeviceProfile at = out.profile;
+    at.workload = r.workload;
+    const double e = std::abs(at.predictNanoseconds(r.amounts, r.vertices) / r.measuredNs - 1);
+    sq += e * e;
+    out.maxRelativeError = std::max(out.maxRelativeError, e);
+  }
+  out.rmsRelativeError = std::sqrt(sq / double(rows.size()));
+  return out;
 }
 
 }  // namespace sg

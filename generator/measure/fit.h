@@ -24,22 +24,10 @@ struct FitRow {
   Workload workload;    // of the mesh it was timed on
   double measuredNs = 0;
   double weight = 1;  // of its squared relative error
-  // The plans of one rig on one mesh share a group ("" for probes and floors): the spill form
-  // fits what decides between plans on the differences within each group.
-  std::string group;
 };
 
-// additive and roofline as above; spill (a CPU device, docs/device-profiles.md "The spill form"):
-//   ns = sum_t (w_t + d_t / V) x_t  +  h max(0, L - L0)
-// where L is the vertex input locations: a CPU's vertex stage fetches every input before the
-// shader runs, and beyond the L0 its registers hold each one costs h more. It is fitted in two
-// stages: first the weights of what differs between the plans of one rig on one mesh (every
-// term but vertices and outputs, h and L0) on those differences alone, each group with a free
-// level of its own, L0 the whole number that fits best; then, those fixed, the level (vertices,
-// outputs and arithmetic per vertex, and per draw) on every row, probes and floors included.
-// In the profile h is a pipe of locations with a vertices weight of -h L0.
-enum class ProfileForm { Additive, Roofline, Spill };
-const char* profileFormName(ProfileForm form);  // "additive", "roofline", "spill"
+enum class ProfileForm { Additive, Roofline };
+const char* profileFormName(ProfileForm form);  // "additive", "roofline"
 
 struct FitResult {
   DeviceProfile profile;       // device and file left empty
@@ -50,7 +38,7 @@ struct FitResult {
 
 // Per-draw weights only when the rows' draws differ in size (else they cannot be told apart
 // from per-vertex ones). Deterministic: same rows, same weights. Throws std::runtime_error
-// without rows (the spill form: without a group of two plans or more).
+// without rows.
 FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form);
 
 // The form's skeleton: pipes (empty for additive) and the workload scaling, weights zero.

@@ -37,7 +37,7 @@ double parseNumber(const YamlCtx& c, const YAML::Node& n, const std::string& wha
 // weights: or draw_weights: (term -> ns per unit).
 // `what` names one weight in messages ("weight", "draw weight").
 void parseTermWeights(const YamlCtx& c, const YAML::Node& w, const char* section, const char* what, double max,
-                      std::array<double, kTermCount>& out, bool negativeVertices = false) {
+                      std::array<double, kTermCount>& out) {
   c.expectMap(w, section);
   for (auto it = w.begin(); it != w.end(); ++it) {
     const std::string key = c.scalar(it->first, "weight name");
@@ -49,8 +49,8 @@ void parseTermWeights(const YamlCtx& c, const YAML::Node& w, const char* section
       for (int t = 0; t < kTermCount; ++t) known += fmt::format("{}{}", t ? ", " : "", termName(t));
       c.fail(it->first, fmt::format("unknown cost term '{}' (known: {})", key, known));
     }
-    out[static_cast<size_t>(term)] = parseNumber(c, it->second, fmt::format("{} '{}'", what, key), "nanoseconds", "ns",
-                                                 negativeVertices && term == kTermVertices ? -max : 0, max);
+    out[static_cast<size_t>(term)] =
+        parseNumber(c, it->second, fmt::format("{} '{}'", what, key), "nanoseconds", "ns", 0, max);
   }
 }
 
@@ -83,10 +83,6 @@ double DeviceProfile::feature(int f) const {
 double DeviceProfile::perVertex(int term, double vertices) const {
   const size_t t = static_cast<size_t>(term);
   return (nanoseconds[t] + (drawNanoseconds[t] > 0 ? drawNanoseconds[t] / vertices : 0.0)) * feature(scaledBy[t]);
-}
-
-bool DeviceProfile::hasThresholdPipe() const {
-  return std::any_of(pipes.begin(), pipes.end(), [](const Pipe& p) { return p.nanoseconds[kTermVertices] < 0; });
 }
 
 bool DeviceProfile::hasDrawWeights() const {
@@ -132,9 +128,8 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
     for (auto it = pipes.begin(); it != pipes.end(); ++it) {
       DeviceProfile::Pipe pipe;
       pipe.name = c.scalar(it->first, "pipe name");
-      // Its `vertices` weight may be negative: the pipe binds only past a threshold.
       parseTermWeights(c, it->second, "pipe", fmt::format("pipe '{}' weight", pipe.name).c_str(), kMaxProfileWeightNs,
-                       pipe.nanoseconds, /*negativeVertices=*/true);
+                       pipe.nanoseconds);
       prof.pipes.push_back(std::move(pipe));
     }
     if (prof.pipes.size() > kMaxProfilePipes)
@@ -188,8 +183,6 @@ std::vector<TermWeights> profileComponents(const DeviceProfile& profile) {
       w[t] += std::llround(pipe.nanoseconds[t] * profile.feature(profile.scaledBy[t]) * kFemtosecondsPerNanosecond);
     out.push_back(w);
   }
-  // A pipe that can fall below zero counts zero there: the additive part alone is a component.
-  if (profile.hasThresholdPipe()) out.push_back(additive);
   return out;
 }
 
@@ -224,11 +217,10 @@ PlanCostPrediction predictPlanCost(const Plan& plan, const Problem& p, const Dev
   const std::vector<TermWeights> comps = profileComponents(profile);
   const int64_t additive = weighTerms(w, out.amounts);
   double slowest = 0;
-  const bool floorAtZero = profile.hasThresholdPipe();  // then no pipe binds below zero
-  for (size_t k = 0; k < profile.pipes.size(); ++k) {
+  for (size_t k = 0; k < comps.size(); ++k) {
     const double ns = static_cast<double>(weighTerms(comps[k], out.amounts) - additive) / kFemtosecondsPerNanosecond;
     out.pipeNanoseconds.push_back(ns);
-    if ((out.slowestPipe < 0 && !(floorAtZero && ns <= 0)) || ns > slowest) {
+    if (out.slowestPipe < 0 || ns > slowest) {
       slowest = ns;
       out.slowestPipe = static_cast<int>(k);
     }
@@ -264,7 +256,7 @@ std::string describePlanCost(const Plan& plan, const Problem& p, const DevicePro
                        static_cast<double>(w[t]) / kFemtosecondsPerNanosecond, c.nanoseconds[t]);
     // A roofline's term is priced in its pipes: what it adds to each (summed in the pipe's line).
     for (const DeviceProfile::Pipe& pipe : profile.pipes)
-      if (pipe.nanoseconds[t] != 0) {  // a threshold pipe's vertices weight is negative
+      if (pipe.nanoseconds[t] > 0) {
         const double perUnit = pipe.nanoseconds[t] * profile.feature(profile.scaledBy[t]);
         out += fmt::format("  + {:.6f} x {} = {:.3f} in {}", perUnit, c.amounts[t], perUnit * double(c.amounts[t]), pipe.name);
       }
@@ -272,9 +264,7 @@ std::string describePlanCost(const Plan& plan, const Problem& p, const DevicePro
   }
   for (size_t k = 0; k < c.pipeNanoseconds.size(); ++k)
     out += fmt::format("    {:<26} {:>8} {:>10} {:>9.3f}{}\n", "pipe " + profile.pipes[k].name, "", "", c.pipeNanoseconds[k],
-                       static_cast<int>(k) == c.slowestPipe ? "  (slowest: counted)"
-                       : c.pipeNanoseconds[k] <= 0         ? "  (below zero: counts nothing)"
-                                                            : "");
+                       static_cast<int>(k) == c.slowestPipe ? "  (slowest: counted)" : "");
   if (profile.workload.known()) out += fmt::format("    workload: {}\n", describeWorkload(profile.workload));
   out += fmt::format("    {:<26} {:>8} {:>10} {:>9.3f}\n", "total", "", "", c.totalNanoseconds);
   return out;

@@ -39,16 +39,12 @@ struct DeviceProfile {
   double verticesPerDraw = 0;  // the workload priced for; required when a draw weight is set
   // A roofline (docs/device-profiles.md, "Roofline profiles"): pipes the device overlaps, each
   // a weighted sum of terms (ns per unit per vertex); a program takes the additive part above
-  // plus its slowest pipe, a pipe below zero counting zero. None: the additive model alone
-  // (every profile before issue 33). A pipe's `vertices` weight alone may be negative: a pipe
-  // that binds only past a threshold (the spill form: vertex inputs beyond what a CPU's
-  // registers hold, docs/device-profiles.md "The spill form").
+  // plus its slowest pipe. None: the additive model alone (every profile before issue 33).
   struct Pipe {
     std::string name;  // "fetch", "memory", ...
     std::array<double, kTermCount> nanoseconds{};
   };
   std::vector<Pipe> pipes;
-  bool hasThresholdPipe() const;  // a pipe with a negative weight (it can fall below zero)
   // Per term, the workload feature its weights (additive and in every pipe) are multiplied by:
   // an indexed uniform load costs per distinct address a warp reads (`joints_per_warp`).
   std::array<int, kTermCount> scaledBy{};

@@ -326,101 +326,25 @@ TEST(Calibrate, TheRooflineFitPredictsRowsItNeverSawWhereTheAdditiveCannot) {
   }
 }
 
-// A CPU-like device (the spill form, measure/fit.h): each vertex input location beyond 12
-// costs 4 ns, a storage-buffer vec4 load 1.2 ns, a vertex 7 ns and an output 1.1 ns; arithmetic
-// sets a rig's level (0.3 ns a slot) and every rig has a level of its own besides (what no
-// term says: 0 to 30 ns). Each rig's plans trade vertex inputs for buffer loads.
-TEST(Calibrate, TheSpillFitRecoversTheThresholdAndTheChoiceWeightsThroughRigLevels) {
-  std::vector<CalibrationSample> samples;
-  auto time = [](const CalibrationSample& s, double rigLevel) {
-    return 7.0 + 1.1 * double(s.amounts[kTermOutputs]) + 0.3 * double(s.amounts[kTermArithmetic]) +
-           1.2 * double(s.amounts[kTermBufferVec4Loads]) + 4.0 * std::max(0.0, double(s.amounts[kTermLocations]) - 12) + rigLevel;
-  };
-  std::mt19937 rng(5);
-  for (int rig = 0; rig < 8; ++rig) {
-    const int inputs = 6 + 3 * rig;  // 6 to 27 locations when everything is an attribute
-    const double level = std::uniform_real_distribution<double>(0, 30)(rng);
-    const int outputs = 8 + 2 * rig, slots = 60 + 10 * rig;
-    for (int buffered = 0; buffered <= 6; buffered += 2)
-      for (int extra : {0, 1, 3})  // inputs read from buffers; attributes of another form (e.g. decoded)
-        for (int unrolled : {0, 1}) {  // the same inputs, more arithmetic
-        CalibrationSample s;
-        s.label = fmt::format("plan: {} inputs from buffers, {} more, {}", buffered, extra, unrolled);
-        s.rig = fmt::format("rig{}", rig);
-        s.mesh = "m";
-        s.vertices = 1000;
-        s.validated = true;
-        s.amounts[kTermLocations] = inputs - buffered + extra;
-        s.amounts[kTermBufferVec4Loads] = buffered;
-        s.amounts[kTermArithmetic] = slots + 5 * extra + 20 * unrolled;
-        s.amounts[kTermOutputs] = outputs;
-        s.amounts[kTermVertices] = 1;
-        s.measuredNs = time(s, level);
-        samples.push_back(s);
-      }
-  }
-  for (int slots : {10, 100, 300}) {  // probes: no rig level
-    CalibrationSample s;
-    s.label = fmt::format("arithmetic {}", slots);
-    s.mesh = "m";
-    s.vertices = 1000;
-    s.validated = true;
-    s.amounts[kTermLocations] = 1;
-    s.amounts[kTermArithmetic] = slots;
-    s.amounts[kTermOutputs] = 4;
-    s.amounts[kTermVertices] = 1;
-    s.measuredNs = time(s, 0);
-    samples.push_back(s);
-  }
-  const DeviceProfile p = fitDeviceProfile(samples, "spill device", 1000, 0, ProfileForm::Spill);
-  ASSERT_EQ(p.pipes.size(), 1u);
-  ASSERT_TRUE(p.hasThresholdPipe());
-  // The choice: h and L0 (= -vertices / h), the vec4 load; no price on a location below L0.
-  const double h = p.pipes[0].nanoseconds[kTermLocations];
-  EXPECT_NEAR(h, 4.0, 1e-3);
-  EXPECT_NEAR(-p.pipes[0].nanoseconds[kTermVertices] / h, 12.0, 1e-3);
-  EXPECT_NEAR(p.nanoseconds[kTermBufferVec4Loads], 1.2, 1e-3);
-  EXPECT_NEAR(p.nanoseconds[kTermLocations], 0.0, 1e-3);
-  // Arithmetic: 0.3 within the rigs (stage 1), and the level stage may add what it explains of
-  // the rigs' own levels (here random, so a little: at most a tenth).
-  EXPECT_GE(p.nanoseconds[kTermArithmetic], 0.3 - 1e-3);
-  EXPECT_LT(p.nanoseconds[kTermArithmetic], 0.33);
-  // Within every rig the fitted profile orders the plans as the device does, and picks its fastest.
-  std::map<std::string, std::pair<double, double>> fastest, chosen;  // rig -> (measured, predicted)
-  for (const auto& s : samples) {
-    if (s.rig.empty()) continue;
-    const double predicted = p.predictNanoseconds(s.amounts, s.vertices);
-    auto [f, fresh] = fastest.emplace(s.rig, std::make_pair(s.measuredNs, predicted));
-    if (!fresh && s.measuredNs < f->second.first) f->second = {s.measuredNs, predicted};
-    auto [c, freshC] = chosen.emplace(s.rig, std::make_pair(s.measuredNs, predicted));
-    if (!freshC && predicted < c->second.second) c->second = {s.measuredNs, predicted};
-  }
-  for (const auto& [rig, c] : chosen) EXPECT_DOUBLE_EQ(c.first, fastest.at(rig).first) << rig;
-  // An additive fit of the same rows cannot see the threshold: it misses a rig's fastest plan.
-  const DeviceProfile sum = fitDeviceProfile(samples, "spill device", 1000, 0, ProfileForm::Additive);
-  int missed = 0;
-  for (int rig = 0; rig < 8; ++rig) {
-    double bestMeasured = INFINITY, chosenMeasured = 0, bestPredicted = INFINITY;
-    for (const auto& s : samples)
-      if (s.rig == fmt::format("rig{}", rig)) {
-        const double predicted = sum.predictNanoseconds(s.amounts, s.vertices);
-        bestMeasured = std::min(bestMeasured, s.measuredNs);
-        if (predicted < bestPredicted) bestPredicted = predicted, chosenMeasured = s.measuredNs;
-      }
-    missed += chosenMeasured > bestMeasured * 1.0001;
-  }
-  EXPECT_GT(missed, 0);
-  // Written and read back (a negative vertices weight in its pipe), it predicts the same.
+TEST(Calibrate, AProfileWithoutPerDrawWeightsKeepsItsScalingWhenWritten) {
+  // One mesh size fits no per-draw weight; the profile's workload scaling (a uniform load at a
+  // per-vertex index costs per joint a warp reads) and its default must still be written, or
+  // the file read back prices those loads 4x cheaper here (before session 17 they were lost).
+  DeviceProfile p = profileForm(ProfileForm::Additive);
+  p.device = "one size";
+  p.nanoseconds[kTermVertices] = 2;
+  p.nanoseconds[kTermIndexedUniformLoads] = 0.1;
+  p.workloadDefaults[kFeatureJointsPerWarp] = 4;
+  ASSERT_FALSE(p.hasDrawWeights());
   CalibrationReport r;
   r.profile = p;
-  const std::string yaml = deviceProfileYaml(r);
-  EXPECT_NE(yaml.find("# form: spill"), std::string::npos);
-  const DeviceProfile back = parseDeviceProfile(yaml, "spill.yaml");
-  for (const auto& s : samples)
-    EXPECT_NEAR(back.predictNanoseconds(s.amounts, s.vertices), p.predictNanoseconds(s.amounts, s.vertices), 1e-5 * s.measuredNs);
-  // Without a rig's plans to compare there is nothing to fit the choice on.
-  std::vector<CalibrationSample> probes(samples.end() - 3, samples.end());
-  EXPECT_THROW(fitDeviceProfile(probes, "spill device", 1000, 0, ProfileForm::Spill), std::runtime_error);
+  const DeviceProfile back = parseDeviceProfile(deviceProfileYaml(r), "one-size.yaml");
+  EXPECT_EQ(back.scaledBy[kTermIndexedUniformLoads], kFeatureJointsPerWarp);
+  TermAmounts a{};
+  a[kTermVertices] = 1;
+  a[kTermIndexedUniformLoads] = 16;
+  EXPECT_DOUBLE_EQ(p.predictNanoseconds(a, 1000), 2 + 16 * 0.1 * 4);
+  EXPECT_DOUBLE_EQ(back.predictNanoseconds(a, 1000), p.predictNanoseconds(a, 1000));
 }
 
 TEST(Calibrate, SpearmanTreatsTimesWithinTheSpreadAsTies) {
