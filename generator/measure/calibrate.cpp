@@ -603,6 +603,12 @@ std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, cons
     } catch (const std::exception&) {
       continue;  // a row that failed ("FAILED, not timed")
     }
+    if (const std::string* median = at(cells, "median round ns/vertex"); median && *median != "—") {
+      try {
+        s.medianRoundNs = std::stod(*median);
+      } catch (const std::exception&) {
+      }
+    }
     s.validated = true;
     samples.push_back(s);
   }
@@ -688,13 +694,15 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           t.frames = opts.frames + 1;
           t.rasterize = !hostClock;
           t.captureStride = run.capture.strideBytes;
+          std::vector<double> rounds;
           for (uint32_t r = 0; r < std::max<uint32_t>(1, opts.rounds); ++r) {
             rt::Timing tm = renderer.time(req, t);
             const std::vector<double>& clock = hostClock ? tm.cpuNs : tm.frameNs;
             std::vector<double> frames(clock.begin() + 1, clock.end());
-            double ns = medianOf(frames) / (double(t.drawsPerFrame) * double(tm.verticesPerDraw));
-            s.measuredNs = s.measuredNs < 0 ? ns : std::min(s.measuredNs, ns);
+            rounds.push_back(medianOf(frames) / (double(t.drawsPerFrame) * double(tm.verticesPerDraw)));
           }
+          s.measuredNs = *std::min_element(rounds.begin(), rounds.end());
+          s.medianRoundNs = medianOf(rounds);
         }
       } catch (const std::exception& e) {
         s.validated = false;
@@ -788,6 +796,10 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           s.validated = row.validation == "pass" || (!row.hasCost && row.*clock > 0);
           s.failure = s.validated ? "" : row.validation;
           s.measuredNs = !s.validated ? -1 : row.*clock;
+          // bench keeps each round by its prediction clock, calibrate's own on either device
+          if (s.validated && !row.roundNsPerVertex.empty() &&
+              *std::min_element(row.roundNsPerVertex.begin(), row.roundNsPerVertex.end()) == s.measuredNs)
+            s.medianRoundNs = medianOf(row.roundNsPerVertex);
           rep.samples.push_back(std::move(s));
         }
       }
@@ -891,16 +903,18 @@ std::string fitLine(const CalibrationFit& f) {
 std::string formatCalibration(const CalibrationReport& r) {
   std::string s = fmt::format("device: {} (driver: {}); clock: {}\n\n| mesh | rig | program | ", r.device, r.driver, r.clock);
   for (int t = 0; t < kTermCount; ++t) s += fmt::format("{} | ", termName(t));
-  s += "measured ns/vertex | predicted | joints per warp | vertices per draw |\n|---|---|---|";
+  s += "measured ns/vertex | predicted | joints per warp | vertices per draw | median round ns/vertex |\n|---|---|---|";
   for (int t = 0; t < kTermCount; ++t) s += "---:|";
-  s += "---:|---:|---:|---:|\n";
+  s += "---:|---:|---:|---:|---:|\n";
   for (const auto& x : r.samples) {
     s += fmt::format("| {} | {} | {} | ", x.mesh, x.rig.empty() ? "—" : x.rig, x.label);
     for (int t = 0; t < kTermCount; ++t) s += fmt::format("{} | ", x.amounts[size_t(t)]);
     s += x.validated ? fmt::format("{:.4f} | {:.4f} | ", x.measuredNs, x.predictedNs)
                      : fmt::format("FAILED, not timed: {} | — | ", x.failure);
     // The workload it was timed on: the fit scales terms by it, so a log refits (--from-log).
-    s += fmt::format("{:.4f} | {:g} |\n", x.workload.jointsPerWarp, x.vertices);
+    s += fmt::format("{:.4f} | {:g} | ", x.workload.jointsPerWarp, x.vertices);
+    // Its spread: the best round is the measured figure, the median round this one.
+    s += x.medianRoundNs >= 0 ? fmt::format("{:.4f} |\n", x.medianRoundNs) : "— |\n";
   }
   s += "\nfitted (ns per unit per vertex; draw weights: ns per unit per draw):\n" + weightLines(r.profile);
   for (const auto& f : r.fits) s += fitLine(f) + "\n";

@@ -86,7 +86,8 @@ struct CalibrationSample {
   TermAmounts amounts{};
   bool validated = false;
   std::string failure;      // why it was not timed (its outputs disagreed, or it did not run)
-  double measuredNs = -1;   // per vertex, raster on, timestamps
+  double measuredNs = -1;   // per vertex, raster on, timestamps: its best round
+  double medianRoundNs = -1;  // its median round by the same clock (-1: not recorded): the sample's spread
   double predictedNs = -1;  // under the fitted profile
 };
 

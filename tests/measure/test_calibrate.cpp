@@ -393,6 +393,18 @@ TEST(Calibrate, TheCheckStatesTheChosenPlansRatioWithinEachRound) {
   const CalibrationReport r = calibrateDevice(o);
   ASSERT_FALSE(r.checks.empty());
   const std::string text = formatCalibration(r);
+  // Each timed sample records its median round too, at or above its best; the log keeps it.
+  std::istringstream log(text);
+  const std::vector<CalibrationSample> back = parseCalibrationSamples(log, {}, "");
+  ASSERT_FALSE(back.empty());
+  size_t timed = 0;
+  for (const auto& s : r.samples) {
+    if (!s.validated) continue;
+    ++timed;
+    EXPECT_GE(s.medianRoundNs, s.measuredNs) << s.label;
+  }
+  EXPECT_EQ(back.size(), timed);
+  for (const auto& s : back) EXPECT_GE(s.medianRoundNs, s.measuredNs) << s.label;
   for (const auto& c : r.checks) {
     ASSERT_GT(c.plans, 1u) << c.rig;
     EXPECT_EQ(c.byRound.rounds, 2u) << c.rig;
