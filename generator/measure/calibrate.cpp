@@ -796,10 +796,8 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           s.validated = row.validation == "pass" || (!row.hasCost && row.*clock > 0);
           s.failure = s.validated ? "" : row.validation;
           s.measuredNs = !s.validated ? -1 : row.*clock;
-          // bench keeps each round by its prediction clock, calibrate's own on either device
-          if (s.validated && !row.roundNsPerVertex.empty() &&
-              *std::min_element(row.roundNsPerVertex.begin(), row.roundNsPerVertex.end()) == s.measuredNs)
-            s.medianRoundNs = medianOf(row.roundNsPerVertex);
+          // bench keeps each round by its prediction clock, which the raster modes above make `clock`
+          if (s.validated && !row.roundNsPerVertex.empty()) s.medianRoundNs = medianOf(row.roundNsPerVertex);
           rep.samples.push_back(std::move(s));
         }
       }
@@ -921,10 +919,7 @@ std::string formatCalibration(const CalibrationReport& r) {
   for (const auto& c : r.checks)
     s += fmt::format("check of {} on '{}' under the fitted profile: {} plans, predicted vs measured Spearman {:.3f}; "
                      "the chosen plan takes {:.3f}x the fastest{}\n",
-                     c.rig, c.mesh, c.plans, c.spearman, c.generatedOverFastest,
-                     std::isnan(c.byRound.least) ? std::string()
-                                                 : fmt::format(" (within one round: {:.3f}x to {:.3f}x over {} rounds)",
-                                                               c.byRound.least, c.byRound.most, c.byRound.rounds));
+                     c.rig, c.mesh, c.plans, c.spearman, c.generatedOverFastest, describeRoundSpread(c.byRound));
   s += formatLeaveOneRigOut(r.heldOut);
   s += formatHeldOutCheck(r.check);
   for (const auto& n : r.notes) s += "note: " + n + "\n";

@@ -289,6 +289,11 @@ RoundSpread generatedOverFastestByRound(const std::vector<GpuBenchRow>& rows) {
   return r;
 }
 
+std::string describeRoundSpread(const RoundSpread& spread) {
+  if (std::isnan(spread.least)) return "";
+  return fmt::format(" (within one round: {:.3f}x to {:.3f}x over {} rounds)", spread.least, spread.most, spread.rounds);
+}
+
 GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   const TargetEnv env = opts.render.gen.targetEnv;
   timeCpuDevicesSingleThreaded();
@@ -519,10 +524,7 @@ std::string formatGpuBench(const GpuBenchReport& r) {
   if (!std::isnan(r.spearmanPredictedOn) || !std::isnan(r.generatedOverFastestOn))
     s += fmt::format("device profile: predicted vs measured ({}; within 0.5 %: ties) Spearman {:.2f}; the generated program takes "
                      "{:.3f}x the fastest generated one{}\n",
-                     r.predictionClock, r.spearmanPredictedOn, r.generatedOverFastestOn,
-                     std::isnan(r.byRound.least) ? std::string()
-                                                 : fmt::format(" (within one round: {:.3f}x to {:.3f}x over {} rounds)", r.byRound.least,
-                                                               r.byRound.most, r.byRound.rounds));
+                     r.predictionClock, r.spearmanPredictedOn, r.generatedOverFastestOn, describeRoundSpread(r.byRound));
   return s;
 }
 

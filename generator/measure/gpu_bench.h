@@ -122,6 +122,9 @@ PredictionCheck checkPredictions(const std::vector<GpuBenchRow>& rows, double Gp
 // the rows checkPredictions counts, the generated program first): least and greatest over the
 // rounds every such row was timed in; NaN, NaN with fewer than two such rounds.
 RoundSpread generatedOverFastestByRound(const std::vector<GpuBenchRow>& rows);
+// " (within one round: 1.087x to 1.121x over 6 rounds)", or "" without a spread: bench's and
+// calibrate's summary lines.
+std::string describeRoundSpread(const RoundSpread& spread);
 
 // Markdown table + summary lines.
 std::string formatGpuBench(const GpuBenchReport& report);
