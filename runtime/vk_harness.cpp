@@ -234,6 +234,11 @@ struct Harness::Impl {
     VkPhysicalDeviceTransformFeedbackFeaturesEXT xfbFeat{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_TRANSFORM_FEEDBACK_FEATURES_EXT};
     xfbFeat.transformFeedback = VK_TRUE;
     f2.pNext = &xfbFeat;
+    // Where the device has it (setup::Device reads the same feature back): bench's count of
+    // what one draw shaded (rt::Renderer::statistics).
+    VkPhysicalDeviceFeatures supported{};
+    vkGetPhysicalDeviceFeatures(dev.pd, &supported);
+    f2.features.pipelineStatisticsQuery = supported.pipelineStatisticsQuery;
     const char* ext = VK_EXT_TRANSFORM_FEEDBACK_EXTENSION_NAME;
     VkDeviceCreateInfo ci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
     ci.pNext = &f2;

@@ -132,4 +132,36 @@ Timing Renderer::time(const DrawRequest& r, const TimingRequest& t) {
   return out;
 }
 
+std::optional<DrawStatistics> Renderer::statistics(const DrawRequest& r) {
+  const setup::Device& dev = impl_->device;
+  if (!dev.pipelineStatistics) return std::nullopt;
+  VkQueryPool query = VK_NULL_HANDLE;
+  VkQueryPoolCreateInfo qci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+  qci.queryType = VK_QUERY_TYPE_PIPELINE_STATISTICS;
+  qci.queryCount = 1;
+  // Results come back in the order of the bits: vertex shader, clipping, fragment shader.
+  qci.pipelineStatistics = VK_QUERY_PIPELINE_STATISTIC_VERTEX_SHADER_INVOCATIONS_BIT |
+                           VK_QUERY_PIPELINE_STATISTIC_CLIPPING_PRIMITIVES_BIT |
+                           VK_QUERY_PIPELINE_STATISTIC_FRAGMENT_SHADER_INVOCATIONS_BIT;
+  check(vkCreateQueryPool(dev.h.device, &qci, nullptr, &query), "vkCreateQueryPool");
+  struct PoolGuard {
+    VkDevice d;
+    VkQueryPool q;
+    ~PoolGuard() { vkDestroyQueryPool(d, q, nullptr); }
+  } guard{dev.h.device, query};
+  setup::ProgramObjects o(dev, r, passOf(r, true));
+  o.upload();
+  vkCmdResetQueryPool(o.cmd(), query, 0, 1);
+  o.beginPass();
+  vkCmdBeginQuery(o.cmd(), query, 0, 0);
+  o.drawIndexed();
+  vkCmdEndQuery(o.cmd(), query, 0);
+  o.endPass();
+  o.submitAndWait();
+  uint64_t v[3] = {0, 0, 0};
+  check(vkGetQueryPoolResults(dev.h.device, query, 0, 1, sizeof(v), v, sizeof(v), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+        "vkGetQueryPoolResults");
+  return DrawStatistics{v[0], v[1], v[2]};
+}
+
 }  // namespace sg::rt

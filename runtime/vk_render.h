@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,14 @@ struct Timing {
   uint32_t verticesPerDraw = 0;  // vertex shader invocations asked for per draw (unique vertices)
 };
 
+// What one draw of a request made the device do (a pipeline statistics query): vertex shader
+// invocations (each vertex the post-transform cache did not hold shaded again), primitives
+// out of clipping, and fragment shader invocations (the pixels its triangles cover that pass
+// the depth test LESS in a cleared target: the fragment work a frame's first draw does).
+struct DrawStatistics {
+  uint64_t vertexInvocations = 0, clippedPrimitives = 0, fragmentInvocations = 0;
+};
+
 class Renderer {
  public:
   // Draws with the harness's device and queue; the harness must outlive the renderer.
@@ -65,6 +74,8 @@ class Renderer {
   // Throws std::runtime_error on a bad request or a Vulkan error.
   Image draw(const DrawRequest& request);
   Timing time(const DrawRequest& request, const TimingRequest& timing);
+  // One draw, rasterized, counted; std::nullopt where the device has no pipelineStatisticsQuery.
+  std::optional<DrawStatistics> statistics(const DrawRequest& request);
   // "<driver name> <driver info>" (VkPhysicalDeviceDriverProperties), or the driver version number.
   std::string driver() const;
 

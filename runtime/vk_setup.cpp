@@ -85,6 +85,9 @@ Device::Device(const Harness::Handles& handles) : h(handles) {
   std::vector<VkQueueFamilyProperties> families(n);
   vkGetPhysicalDeviceQueueFamilyProperties(h.physicalDevice, &n, families.data());
   timestampBits = h.queueFamily < n ? families[h.queueFamily].timestampValidBits : 0;
+  VkPhysicalDeviceFeatures features{};
+  vkGetPhysicalDeviceFeatures(h.physicalDevice, &features);
+  pipelineStatistics = features.pipelineStatisticsQuery;
   bindXfb = reinterpret_cast<PFN_vkCmdBindTransformFeedbackBuffersEXT>(
       vkGetDeviceProcAddr(h.device, "vkCmdBindTransformFeedbackBuffersEXT"));
   beginXfb = reinterpret_cast<PFN_vkCmdBeginTransformFeedbackEXT>(vkGetDeviceProcAddr(h.device, "vkCmdBeginTransformFeedbackEXT"));

@@ -24,6 +24,7 @@ struct Device {
   VkPhysicalDeviceMemoryProperties memProps{};
   VkPhysicalDeviceTransformFeedbackPropertiesEXT xfbProps{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_TRANSFORM_FEEDBACK_PROPERTIES_EXT};
   uint32_t timestampBits = 0;
+  bool pipelineStatistics = false;  // the harness enables pipelineStatisticsQuery wherever the device has it
   PFN_vkCmdBindTransformFeedbackBuffersEXT bindXfb = nullptr;
   PFN_vkCmdBeginTransformFeedbackEXT beginXfb = nullptr;
   PFN_vkCmdEndTransformFeedbackEXT endXfb = nullptr;

@@ -411,6 +411,15 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   rep.workload = gen.workload;
   rep.vertices = scene.mesh.vertexCount;
   rep.triangles = scene.indices.size() / 3;
+  if (opts.rasterOn && programs.front().row.validation == "pass") {
+    rt::DrawRequest req = drawRequest(programs.front().render, frag, textures, scene);
+    req.width = opts.render.width;
+    req.height = opts.render.height;
+    if (auto st = renderer.statistics(req); st && rep.vertices > 0) {
+      rep.shadedVerticesPerVertex = double(st->vertexInvocations) / double(rep.vertices);
+      rep.fragmentsPerVertex = double(st->fragmentInvocations) / double(rep.vertices);
+    }
+  }
   const uint32_t draws = drawsPerFrame(opts.drawsPerFrame, opts.minVerticesPerFrame, scene.mesh.vertexCount);
   rep.drawsPerFrame = draws;
   rep.frames = opts.frames;
@@ -493,6 +502,9 @@ std::string formatGpuBench(const GpuBenchReport& r) {
                               r.device, r.driver, r.limits.empty() ? "" : r.limits + "\n", r.vertices, r.triangles,
                               r.drawsPerFrame, r.frames, r.rounds, r.width, r.height);
   s.insert(s.size() - 1, "workload: " + describeWorkload(r.workload) + "\n");
+  if (r.fragmentsPerVertex >= 0)
+    s.insert(s.size() - 1, fmt::format("one draw, counted by the device: {:.3f} vertex shader invocations and {:.2f} fragments per vertex\n",
+                                       r.shadedVerticesPerVertex, r.fragmentsPerVertex));
   const GpuBenchRow* gen = nullptr;
   for (const auto& row : r.rows)
     if (row.label == "generated") gen = &row;

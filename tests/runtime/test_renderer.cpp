@@ -1,3 +1,5 @@
+// The renderer (runtime/vk_render.h).
+//
 // Textures are mipmapped at upload (runtime/vk_setup.cpp): a pattern minified far must
 // come out as its average, not as whichever texels the pixel centres happen to hit.
 // Pattern: a white line every 4th texel column, black elsewhere, so the average is 1/4
@@ -11,7 +13,9 @@
 
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
 
 namespace {
 
@@ -72,15 +76,17 @@ class Mipmaps : public ::testing::Test {
     harness_.reset();
   }
 
-  // Draws the quad into a size x size target with `fragment` reading `textures`.
-  static Image draw(const std::string& fragment, std::vector<Texture> textures, uint32_t size) {
+  // The quad from x = -1 to `right` in clip space, full height, into a width x height target,
+  // with `fragment` reading `textures`.
+  static DrawRequest quad(const std::string& fragment, std::vector<Texture> textures, uint32_t width, uint32_t height,
+                          float right = 1) {
     DrawRequest r;
     r.vertexCount = 4;
     VertexStream s;
     s.location = 0;
     s.format = VK_FORMAT_R32G32_SFLOAT;
     s.stride = 8;
-    const float corners[8] = {-1, -1, 1, -1, 1, 1, -1, 1};
+    const float corners[8] = {-1, -1, right, -1, right, 1, -1, 1};
     s.data.resize(sizeof corners);
     std::memcpy(s.data.data(), corners, sizeof corners);
     r.streams.push_back(s);
@@ -88,8 +94,13 @@ class Mipmaps : public ::testing::Test {
     r.vertexSpirv = compile(sg::Stage::Vertex, kQuad);
     r.fragmentSpirv = compile(sg::Stage::Fragment, fragment);
     r.indices = {0, 1, 2, 0, 2, 3};
-    r.width = r.height = size;
-    Image img = renderer_->draw(r);
+    r.width = width;
+    r.height = height;
+    return r;
+  }
+  // Draws the quad into a size x size target.
+  static Image draw(const std::string& fragment, std::vector<Texture> textures, uint32_t size) {
+    Image img = renderer_->draw(quad(fragment, std::move(textures), size, size));
     EXPECT_TRUE(harness_->validationMessages().empty()) << harness_->validationMessages().front();
     return img;
   }
@@ -155,3 +166,30 @@ void main() { color = textureLod(pattern, uv, 20.0); })";
 }
 
 }  // namespace
+
+// Two triangles that tile a rectangle of pixels cover each of its pixels once (the top-left
+// rule gives the shared edge's pixels to one of them). A device counts at least those
+// invocations and may add helpers (lavapipe shades whole blocks along an edge: 3,456 for the
+// 3,072 pixels of a full 64x48 target), never a fragment for a quad wholly off the target. Each
+// of the 4 vertices is shaded at least once and at most once per index that names it.
+TEST_F(Mipmaps, DrawStatisticsCountTheCoveredPixelsAndTheShadedVertices) {
+  const std::string flat = R"(#version 450
+layout(location = 0) in vec2 uv;
+layout(location = 0) out vec4 color;
+void main() { color = vec4(uv, 0.0, 1.0); })";
+  uint64_t previous = UINT64_MAX;
+  for (auto [right, covered] : {std::pair{1.0f, 64u * 48u}, std::pair{0.0f, 32u * 48u}, std::pair{-0.5f, 16u * 48u}}) {
+    std::optional<DrawStatistics> st = renderer_->statistics(quad(flat, {}, 64, 48, right));
+    if (!st) GTEST_SKIP() << "the device has no pipelineStatisticsQuery";
+    EXPECT_GE(st->fragmentInvocations, covered) << "right edge at " << right;
+    EXPECT_LT(st->fragmentInvocations, 2u * covered) << "right edge at " << right;
+    EXPECT_LT(st->fragmentInvocations, previous) << "right edge at " << right;  // less covered, fewer
+    previous = st->fragmentInvocations;
+    EXPECT_GE(st->vertexInvocations, 4u);
+    EXPECT_LE(st->vertexInvocations, 6u);
+  }
+  // From x = -2 to -1: left of the target, its right edge on the target's left one.
+  DrawRequest off = quad(flat, {}, 64, 48, -2.0f);
+  EXPECT_EQ(renderer_->statistics(off)->fragmentInvocations, 0u);
+  EXPECT_TRUE(harness_->validationMessages().empty()) << harness_->validationMessages().front();
+}
