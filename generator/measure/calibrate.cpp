@@ -603,12 +603,18 @@ std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, cons
     } catch (const std::exception&) {
       continue;  // a row that failed ("FAILED, not timed")
     }
-    if (const std::string* median = at(cells, "median round ns/vertex"); median && *median != "—") {
-      try {
-        s.medianRoundNs = std::stod(*median);
-      } catch (const std::exception&) {
+    // Optional columns (later logs): "—" or absent reads as not recorded.
+    auto optional = [&](const char* name, double& into) {
+      if (const std::string* v = at(cells, name); v && *v != "—") {
+        try {
+          into = std::stod(*v);
+        } catch (const std::exception&) {
+        }
       }
-    }
+    };
+    optional("median round ns/vertex", s.medianRoundNs);
+    optional("shaded vertices per vertex", s.shadedPerVertex);
+    optional("fragments per vertex", s.fragmentsPerVertex);
     s.validated = true;
     samples.push_back(s);
   }
@@ -703,6 +709,10 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           }
           s.measuredNs = *std::min_element(rounds.begin(), rounds.end());
           s.medianRoundNs = medianOf(rounds);
+          if (auto st = renderer.statistics(req)) {
+            s.shadedPerVertex = double(st->vertexInvocations) / s.vertices;
+            s.fragmentsPerVertex = double(st->fragmentInvocations) / s.vertices;
+          }
         }
       } catch (const std::exception& e) {
         s.validated = false;
@@ -798,6 +808,8 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           s.measuredNs = !s.validated ? -1 : row.*clock;
           // bench keeps each round by its prediction clock, which the raster modes above make `clock`
           if (s.validated && !row.roundNsPerVertex.empty()) s.medianRoundNs = medianOf(row.roundNsPerVertex);
+          s.shadedPerVertex = br.shadedVerticesPerVertex;
+          s.fragmentsPerVertex = br.fragmentsPerVertex;
           rep.samples.push_back(std::move(s));
         }
       }
@@ -901,9 +913,10 @@ std::string fitLine(const CalibrationFit& f) {
 std::string formatCalibration(const CalibrationReport& r) {
   std::string s = fmt::format("device: {} (driver: {}); clock: {}\n\n| mesh | rig | program | ", r.device, r.driver, r.clock);
   for (int t = 0; t < kTermCount; ++t) s += fmt::format("{} | ", termName(t));
-  s += "measured ns/vertex | predicted | joints per warp | vertices per draw | median round ns/vertex |\n|---|---|---|";
+  s += "measured ns/vertex | predicted | joints per warp | vertices per draw | median round ns/vertex | "
+       "shaded vertices per vertex | fragments per vertex |\n|---|---|---|";
   for (int t = 0; t < kTermCount; ++t) s += "---:|";
-  s += "---:|---:|---:|---:|---:|\n";
+  s += "---:|---:|---:|---:|---:|---:|---:|\n";
   for (const auto& x : r.samples) {
     s += fmt::format("| {} | {} | {} | ", x.mesh, x.rig.empty() ? "—" : x.rig, x.label);
     for (int t = 0; t < kTermCount; ++t) s += fmt::format("{} | ", x.amounts[size_t(t)]);
@@ -912,7 +925,9 @@ std::string formatCalibration(const CalibrationReport& r) {
     // The workload it was timed on: the fit scales terms by it, so a log refits (--from-log).
     s += fmt::format("{:.4f} | {:g} | ", x.workload.jointsPerWarp, x.vertices);
     // Its spread: the best round is the measured figure, the median round this one.
-    s += x.medianRoundNs >= 0 ? fmt::format("{:.4f} |\n", x.medianRoundNs) : "— |\n";
+    s += x.medianRoundNs >= 0 ? fmt::format("{:.4f} | ", x.medianRoundNs) : "— | ";
+    // What the device shaded for one draw of its mesh (raster on): the harness's share of the time.
+    s += x.fragmentsPerVertex >= 0 ? fmt::format("{:.4f} | {:.4f} |\n", x.shadedPerVertex, x.fragmentsPerVertex) : "— | — |\n";
   }
   s += "\nfitted (ns per unit per vertex; draw weights: ns per unit per draw):\n" + weightLines(r.profile);
   for (const auto& f : r.fits) s += fitLine(f) + "\n";

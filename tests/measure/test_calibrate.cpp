@@ -435,6 +435,21 @@ TEST(Calibrate, TheLimbMeshTimesProbesAndPlansAtTheLimbsSize) {
   }
   EXPECT_GT(probes, 5u);
   EXPECT_GT(plans, 2u);
+  // What one raster-on draw of the limb made the device shade: every vertex is referenced, so
+  // shaded at least once, and at most once per triangle of the limb's grid that holds it (6);
+  // the limb covers pixels. The log keeps both figures.
+  for (const auto& s : r.samples) {
+    EXPECT_GE(s.shadedPerVertex, 1.0) << s.label;
+    EXPECT_LE(s.shadedPerVertex, 6.0) << s.label;
+    EXPECT_GT(s.fragmentsPerVertex, 0.0) << s.label;
+  }
+  std::istringstream log(formatCalibration(r));
+  const std::vector<CalibrationSample> back = parseCalibrationSamples(log, {}, "");
+  ASSERT_EQ(back.size(), r.samples.size());
+  for (size_t i = 0; i < back.size(); ++i) {
+    EXPECT_NEAR(back[i].shadedPerVertex, r.samples[i].shadedPerVertex, 1e-4) << back[i].label;
+    EXPECT_NEAR(back[i].fragmentsPerVertex, r.samples[i].fragmentsPerVertex, 1e-4) << back[i].label;
+  }
   // The log says how it was timed.
   EXPECT_NE(formatCalibration(r).find("over 1 draws per frame (a smaller mesh more: at least 0 vertices), median of 1 frames"),
             std::string::npos);
