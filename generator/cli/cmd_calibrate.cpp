@@ -96,7 +96,7 @@ struct CalibrateCommand {
   }
 
   int run() {
-    co.form = form == "roofline" ? ProfileForm::Roofline : ProfileForm::Additive;
+    co.form = form == "roofline" ? ProfileForm::Roofline : form == "raster" ? ProfileForm::Raster : ProfileForm::Additive;
     if (!writeCorpus.empty()) return writeCorpusFiles();
     if (!fromLogs.empty()) return refit();
     if (!evaluate.empty()) {
@@ -135,7 +135,7 @@ struct CalibrateCommand {
     co.rigs = rigs;
     co.check = !noCheck;
     co.probes = !noProbes;
-    co.form = form == "roofline" ? ProfileForm::Roofline : ProfileForm::Additive;
+    co.form = form == "roofline" ? ProfileForm::Roofline : form == "raster" ? ProfileForm::Raster : ProfileForm::Additive;
     if (!output.empty()) {
       std::vector<InputFile> inputs;
       for (const auto& r : co.rigs) inputs.push_back({isGltfPath(r) ? parseGltfRef(r).file : r, "a rig"});
@@ -230,8 +230,8 @@ void registerCalibrate(CLI::App& app, CliState& state) {
                   "With --check-log: predict the logs' plans with this device profile (no fit, no device)")
       ->check(CLI::ExistingFile);
   sub->add_flag("--no-probes", cmd->noProbes, "With --rig: time only the rigs' programs (samples for another fit)");
-  sub->add_option("--form", cmd->form, "The model fitted: additive (default) or roofline (docs/device-profiles.md)")
-      ->check(CLI::IsMember({"additive", "roofline"}));
+  sub->add_option("--form", cmd->form, "The model fitted: additive (default), roofline, or raster (the roofline with the fragments a draw covers priced instead of per-draw weights; docs/device-profiles.md)")
+      ->check(CLI::IsMember({"additive", "roofline", "raster"}));
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer (use for timings)");
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }

@@ -117,6 +117,7 @@ Probe baseProbe(const ProbeMesh& m, const std::string& label, int outputs) {
   p.amounts[kTermAttributeBytes] = 16;
   p.amounts[kTermOutputs] = 4 + 4 * outputs;
   p.amounts[kTermVertices] = 1;
+  p.amounts[kTermFragments] = 1;
   return p;
 }
 
@@ -596,6 +597,8 @@ std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, cons
     s.request = request;
     s.label = cells[3];
     s.fitted = s.label.rfind("checked plan", 0) != 0;
+    // A fixed term a log predates is every program's: 1 (`fragments`, since session 18).
+    s.amounts[kTermFragments] = 1;
     try {
       for (int t = 0; t < kTermCount; ++t)
         if (const std::string* amount = at(cells, termName(t))) s.amounts[size_t(t)] = std::stoll(*amount);
@@ -614,7 +617,7 @@ std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, cons
     };
     optional("median round ns/vertex", s.medianRoundNs);
     optional("shaded vertices per vertex", s.shadedPerVertex);
-    optional("fragments per vertex", s.fragmentsPerVertex);
+    optional("fragments per vertex", s.workload.fragmentsPerVertex);
     s.validated = true;
     samples.push_back(s);
   }
@@ -711,7 +714,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           s.medianRoundNs = medianOf(rounds);
           if (auto st = renderer.statistics(req)) {
             s.shadedPerVertex = double(st->vertexInvocations) / s.vertices;
-            s.fragmentsPerVertex = double(st->fragmentInvocations) / s.vertices;
+            s.workload.fragmentsPerVertex = double(st->fragmentInvocations) / s.vertices;
           }
         }
       } catch (const std::exception& e) {
@@ -809,7 +812,6 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           // bench keeps each round by its prediction clock, which the raster modes above make `clock`
           if (s.validated && !row.roundNsPerVertex.empty()) s.medianRoundNs = medianOf(row.roundNsPerVertex);
           s.shadedPerVertex = br.shadedVerticesPerVertex;
-          s.fragmentsPerVertex = br.fragmentsPerVertex;
           rep.samples.push_back(std::move(s));
         }
       }
@@ -927,7 +929,8 @@ std::string formatCalibration(const CalibrationReport& r) {
     // Its spread: the best round is the measured figure, the median round this one.
     s += x.medianRoundNs >= 0 ? fmt::format("{:.4f} | ", x.medianRoundNs) : "— | ";
     // What the device shaded for one draw of its mesh (raster on): the harness's share of the time.
-    s += x.fragmentsPerVertex >= 0 ? fmt::format("{:.4f} | {:.4f} |\n", x.shadedPerVertex, x.fragmentsPerVertex) : "— | — |\n";
+    s += x.shadedPerVertex >= 0 ? fmt::format("{:.4f} | ", x.shadedPerVertex) : "— | ";
+    s += x.workload.fragmentsPerVertex > 0 ? fmt::format("{:.4f} |\n", x.workload.fragmentsPerVertex) : "— |\n";
   }
   s += "\nfitted (ns per unit per vertex; draw weights: ns per unit per draw):\n" + weightLines(r.profile);
   for (const auto& f : r.fits) s += fitLine(f) + "\n";
@@ -954,7 +957,12 @@ std::string deviceProfileYaml(const CalibrationReport& r) {
                      c.spearman, c.generatedOverFastest);
   if (!r.heldOut.rows.empty()) s += "# " + heldOutSummary(r.heldOut) + "\n";
   if (!r.check.rows.empty()) s += "# " + heldOutSummary(r.check, "held-out check") + "\n";
-  if (!r.profile.pipes.empty() || r.nearBestPower >= 0) s += fmt::format("# form: {}\n", r.profile.pipes.empty() ? "additive" : "roofline");
+  if (!r.profile.pipes.empty() || r.nearBestPower >= 0) {
+    const ProfileForm form = r.profile.pipes.empty()                                           ? ProfileForm::Additive
+                             : r.profile.scaledBy[kTermFragments] == kFeatureFragmentsPerVertex ? ProfileForm::Raster
+                                                                                                 : ProfileForm::Roofline;
+    s += fmt::format("# form: {}\n", profileFormName(form));
+  }
   s += fmt::format("device: \"{}\"\nunit: ns\n", r.profile.device);
   return s + weightLines(r.profile);
 }

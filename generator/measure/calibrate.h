@@ -88,9 +88,9 @@ struct CalibrationSample {
   std::string failure;      // why it was not timed (its outputs disagreed, or it did not run)
   double measuredNs = -1;   // per vertex, raster on, timestamps: its best round
   double medianRoundNs = -1;  // its median round by the same clock (-1: not recorded): the sample's spread
-  // What one raster-on draw of its mesh made the device shade, per vertex (bench's
-  // shadedVerticesPerVertex, fragmentsPerVertex; -1: not counted): the harness's side of the time.
-  double shadedPerVertex = -1, fragmentsPerVertex = -1;
+  // Vertex shader invocations per vertex of one raster-on draw of its mesh (bench's
+  // shadedVerticesPerVertex; -1: not counted); its fragments are workload.fragmentsPerVertex.
+  double shadedPerVertex = -1;
   double predictedNs = -1;  // under the fitted profile
 };
 

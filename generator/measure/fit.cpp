@@ -9,7 +9,9 @@
 
 namespace sg {
 
-const char* profileFormName(ProfileForm form) { return form == ProfileForm::Roofline ? "roofline" : "additive"; }
+const char* profileFormName(ProfileForm form) {
+  return form == ProfileForm::Roofline ? "roofline" : form == ProfileForm::Raster ? "raster" : "additive";
+}
 
 DeviceProfile profileForm(ProfileForm form) {
   DeviceProfile p;
@@ -20,7 +22,9 @@ DeviceProfile profileForm(ProfileForm form) {
   // warp reads, at 2.6 and at 12.2 joints per warp alike (docs/device-profiles.md).
   p.scaledBy[kTermIndexedUniformVec4Loads] = kFeatureJointsPerWarp;
   p.workloadDefaults[kFeatureJointsPerWarp] = 1;
-  if (form == ProfileForm::Roofline) {
+  // The fragment shader's and rasterizer's work comes with each fragment a draw covers.
+  if (form == ProfileForm::Raster) p.scaledBy[kTermFragments] = kFeatureFragmentsPerVertex;
+  if (form != ProfileForm::Additive) {
     auto pipe = [&](const char* name, std::initializer_list<int> terms) {
       DeviceProfile::Pipe x;
       x.name = name;
@@ -41,8 +45,9 @@ DeviceProfile profileForm(ProfileForm form) {
 
 namespace {
 
-// The parameters: per-vertex additive weights (the additive form: every term; the roofline:
-// `vertices` alone), per-draw weights (every term, when draws differ), then each pipe's terms.
+// The parameters: per-vertex additive weights (the additive form: every term but `fragments`;
+// the roofline: `vertices` alone; the raster form: `vertices` and `fragments`), per-draw weights
+// (every term, when draws differ; not in the raster form), then each pipe's terms.
 struct Layout {
   std::vector<int> additive, perDraw;
   std::vector<std::pair<size_t, int>> pipeTerms;  // (pipe, term)
@@ -52,9 +57,10 @@ struct Layout {
 
 Layout layoutOf(const DeviceProfile& form, bool drawWeights) {
   Layout l;
+  const bool raster = form.scaledBy[kTermFragments] == kFeatureFragmentsPerVertex;
   for (int t = 0; t < kTermCount; ++t)
-    if (form.pipes.empty() || t == kTermVertices) l.additive.push_back(t);
-  if (drawWeights)
+    if (t == kTermFragments ? raster : (form.pipes.empty() || t == kTermVertices)) l.additive.push_back(t);
+  if (drawWeights && !raster)
     for (int t = 0; t < kTermCount; ++t) l.perDraw.push_back(t);
   l.pipes = form.pipes.size();
   for (size_t p = 0; p < form.pipes.size(); ++p)
@@ -125,7 +131,16 @@ FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form) {
   if (rows.empty()) throw std::runtime_error("calibration: no validated timing to fit");
   std::set<double> sizes;
   for (const FitRow& r : rows) sizes.insert(r.vertices);
-  const DeviceProfile skeleton = profileForm(form);
+  DeviceProfile skeleton = profileForm(form);
+  // Where a row's fragments were not counted, and where a generation's are unknown: the median
+  // of the rows that were.
+  std::vector<double> fragments;
+  for (const FitRow& r : rows)
+    if (r.workload.fragmentsPerVertex > 0) fragments.push_back(r.workload.fragmentsPerVertex);
+  if (form == ProfileForm::Raster && !fragments.empty()) {
+    std::nth_element(fragments.begin(), fragments.begin() + static_cast<long>(fragments.size() / 2), fragments.end());
+    skeleton.workloadDefaults[kFeatureFragmentsPerVertex] = fragments[fragments.size() / 2];
+  }
   const Layout l = layoutOf(skeleton, sizes.size() > 1);
   std::vector<std::array<double, kTermCount>> xs;
   for (const FitRow& r : rows) xs.push_back(scaledAmounts(skeleton, r));

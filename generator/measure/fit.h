@@ -3,12 +3,16 @@
 // solved by Ceres Solver (bounded nonlinear least squares). Two forms of model:
 //   additive  ns = sum_t (w_t + d_t / V) x_t                      (every profile before issue 33)
 //   roofline  ns = sum_t (w_t + d_t / V) x_t  +  max_p sum_{t in p} w_pt x_t
+//   raster    the roofline without per-draw weights, its additive part the fixed cost per vertex
+//             and one per fragment the draw covers (x_fragments scaled by fragments per vertex)
 // where x_t is the amount of term t, scaled by a workload feature where the form says so
 // (uniform loads at a per-vertex index, elements and vec4s, by the joints a warp reads), and
 // V the vertices per draw. In the roofline form the additive part holds the per-vertex fixed
 // cost and the per-draw weights; the pipes hold the rest (fetch: locations and attribute bytes;
 // memory: storage-buffer loads; constant: uniform loads at a per-vertex index; alu: arithmetic;
-// output: outputs), which the device overlaps.
+// output: outputs), which the device overlaps. The raster form prices what the per-draw weights
+// stood in for on the H200 (docs/device-profiles.md, "The rasterizer's share"): the fragments a
+// draw covers, counted by the device.
 #pragma once
 #include <string>
 #include <vector>
@@ -26,8 +30,8 @@ struct FitRow {
   double weight = 1;  // of its squared relative error
 };
 
-enum class ProfileForm { Additive, Roofline };
-const char* profileFormName(ProfileForm form);  // "additive", "roofline"
+enum class ProfileForm { Additive, Roofline, Raster };
+const char* profileFormName(ProfileForm form);  // "additive", "roofline", "raster"
 
 struct FitResult {
   DeviceProfile profile;       // device and file left empty

@@ -124,6 +124,7 @@ TermAmounts floorAmounts(const GenerateResult& floor, const Problem& generated, 
   }
   a[kTermOutputs] = generated.fixedTerms[kTermOutputs];
   a[kTermVertices] = 1;
+  a[kTermFragments] = 1;
   return a;
 }
 
@@ -319,6 +320,22 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   const Rig& rig = in.rig;
   FragmentProgram frag = compileFragmentFile(gen.fragmentPath, env);
   std::vector<rt::Texture> textures = texturesFor(frag, opts.render.lighting);
+  // The fragments a draw covers are part of the workload too (a profile may price them): counted
+  // on one draw of the plan chosen without them, where the device can count. Every plan that
+  // validates writes the same positions, so covers the same pixels.
+  rt::Renderer renderer(validator.harness());
+  double shadedPerVertex = -1;
+  if (scene.mesh.vertexCount > 0) {
+    GenerateOptions first = gen;
+    rt::DrawRequest req = drawRequest(generateFrom(in, first), frag, textures, scene);
+    req.width = opts.render.width;
+    req.height = opts.render.height;
+    if (auto st = renderer.statistics(req)) {
+      shadedPerVertex = double(st->vertexInvocations) / double(scene.mesh.vertexCount);
+      gen.workload.fragmentsPerVertex = double(st->fragmentInvocations) / double(scene.mesh.vertexCount);
+      in = loadInputs(gen);
+    }
+  }
 
   // The programs: generated, its forced alternatives, the hand port, the floor.
   std::vector<Program> programs;
@@ -402,7 +419,6 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     if (!v.validationMessages.empty()) p.row.validation += ": validation layer: " + v.validationMessages.front();
   }
 
-  rt::Renderer renderer(validator.harness());
   GpuBenchReport rep;
   rep.notes = in.notes;
   rep.device = validator.harness().deviceName();
@@ -411,15 +427,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   rep.workload = gen.workload;
   rep.vertices = scene.mesh.vertexCount;
   rep.triangles = scene.indices.size() / 3;
-  if (programs.front().row.validation == "pass") {  // whichever raster modes are timed
-    rt::DrawRequest req = drawRequest(programs.front().render, frag, textures, scene);
-    req.width = opts.render.width;
-    req.height = opts.render.height;
-    if (auto st = renderer.statistics(req); st && rep.vertices > 0) {
-      rep.shadedVerticesPerVertex = double(st->vertexInvocations) / double(rep.vertices);
-      rep.fragmentsPerVertex = double(st->fragmentInvocations) / double(rep.vertices);
-    }
-  }
+  rep.shadedVerticesPerVertex = shadedPerVertex;
   const uint32_t draws = drawsPerFrame(opts.drawsPerFrame, opts.minVerticesPerFrame, scene.mesh.vertexCount);
   rep.drawsPerFrame = draws;
   rep.frames = opts.frames;
@@ -502,9 +510,9 @@ std::string formatGpuBench(const GpuBenchReport& r) {
                               r.device, r.driver, r.limits.empty() ? "" : r.limits + "\n", r.vertices, r.triangles,
                               r.drawsPerFrame, r.frames, r.rounds, r.width, r.height);
   s.insert(s.size() - 1, "workload: " + describeWorkload(r.workload) + "\n");
-  if (r.fragmentsPerVertex >= 0)
+  if (r.shadedVerticesPerVertex >= 0)
     s.insert(s.size() - 1, fmt::format("one draw, counted by the device: {:.3f} vertex shader invocations and {:.2f} fragments per vertex\n",
-                                       r.shadedVerticesPerVertex, r.fragmentsPerVertex));
+                                       r.shadedVerticesPerVertex, r.workload.fragmentsPerVertex));
   const GpuBenchRow* gen = nullptr;
   for (const auto& row : r.rows)
     if (row.label == "generated") gen = &row;

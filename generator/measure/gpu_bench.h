@@ -69,9 +69,9 @@ struct GpuBenchReport {
   std::string limits;  // the device limits the plans were searched under ("" = the flags)
   size_t vertices = 0, triangles = 0;
   Workload workload;  // of the mesh and pose timed; the plans are priced for it
-  // What one raster-on draw of the generated program made the device shade
-  // (rt::Renderer::statistics), per vertex of the mesh; -1 where the device cannot count.
-  double shadedVerticesPerVertex = -1, fragmentsPerVertex = -1;
+  // Vertex shader invocations per vertex of one raster-on draw (rt::Renderer::statistics; its
+  // fragments are workload.fragmentsPerVertex); -1 where the device cannot count.
+  double shadedVerticesPerVertex = -1;
   uint32_t drawsPerFrame = 0, frames = 0, rounds = 0, width = 0, height = 0;
   std::vector<GpuBenchRow> rows;
   // Over the generated plan and its alternatives (rows with a cost): Pearson correlation of

@@ -58,7 +58,7 @@ void parseTermWeights(const YamlCtx& c, const YAML::Node& w, const char* section
 
 const char* featureName(int feature) {
   static const char* const names[] = {"none", "joints_per_warp", "invocations_per_vertex", "active_morph_targets",
-                                      "joints_per_warp_squared"};
+                                      "joints_per_warp_squared", "fragments_per_vertex"};
   return feature >= 0 && feature < kFeatureCount ? names[feature] : "?";
 }
 
@@ -69,6 +69,7 @@ double DeviceProfile::feature(int f) const {
     case kFeatureJointsPerWarp: v = workload.jointsPerWarp > 0 ? workload.jointsPerWarp : -1; break;
     case kFeatureInvocationsPerVertex: v = workload.invocationsPerVertex > 0 ? workload.invocationsPerVertex : -1; break;
     case kFeatureActiveMorphTargets: v = workload.activeMorphTargets; break;
+    case kFeatureFragmentsPerVertex: v = workload.fragmentsPerVertex > 0 ? workload.fragmentsPerVertex : -1; break;
     case kFeatureJointsPerWarpSquared: {
       const double j = feature(kFeatureJointsPerWarp);
       return j * j;

@@ -26,6 +26,7 @@ enum WorkloadFeature {
   kFeatureInvocationsPerVertex,
   kFeatureActiveMorphTargets,
   kFeatureJointsPerWarpSquared,
+  kFeatureFragmentsPerVertex,
   kFeatureCount
 };
 // "joints_per_warp", ...: the keys of a profile's `scaled_by:` values and `workload_defaults:`.

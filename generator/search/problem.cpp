@@ -35,7 +35,7 @@ const char* termName(int term) {
   static const char* const names[kTermCount] = {"arithmetic",   "locations",  "attribute_bytes",
                                                 "buffer_bytes", "buffer_loads", "indexed_uniform_loads",
                                                 "buffer_vec4_loads", "indexed_uniform_vec4_loads",
-                                                "outputs",      "vertices"};
+                                                "outputs",      "vertices",     "fragments"};
   return term >= 0 && term < kTermCount ? names[term] : "?";
 }
 
@@ -126,6 +126,7 @@ class Builder {
     p_.goals.erase(std::unique(p_.goals.begin(), p_.goals.end()), p_.goals.end());
     std::sort(p_.init.begin(), p_.init.end());
     p_.fixedTerms[kTermVertices] = 1;
+    p_.fixedTerms[kTermFragments] = 1;
     for (const auto& v : varyings) p_.fixedTerms[kTermOutputs] += int64_t{componentCount(v.type)} * std::max(1, v.arraySize);
     priceProblem(p_, kSlotWeights);
     setDeviceLimits(p_, kVulkanMinVertexAttributes, kVulkanMinUniformBytes, kVulkanMinStorageBuffers);

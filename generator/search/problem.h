@@ -54,6 +54,10 @@ enum CostTerm {
   kTermIndexedUniformVec4Loads,
   kTermOutputs,             // output components written (the varyings and gl_Position)
   kTermVertices,            // 1: the fixed cost of running the program for one vertex
+  // 1: the rasterizer's and fragment shader's work that comes with drawing a vertex, priced
+  // per fragment its draw covers (a profile scales it by the workload's fragments per vertex).
+  // The same for every plan of a request: it moves the level of a prediction, not a choice.
+  kTermFragments,
   kTermCount
 };
 using TermAmounts = std::array<int64_t, kTermCount>;
@@ -62,7 +66,7 @@ const char* termName(int term);
 // Search cost units per unit of each term (int64: A* stays exact). Without a profile the
 // unit is the instruction slot; a profile's unit is the femtosecond (docs/device-profiles.md).
 using TermWeights = std::array<int64_t, kTermCount>;
-constexpr TermWeights kSlotWeights = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+constexpr TermWeights kSlotWeights = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
 // sum of weight x amount (checked: a hostile profile cannot overflow it silently).
 int64_t weighTerms(const TermWeights& w, const TermAmounts& a);
 

@@ -12,6 +12,7 @@ std::string describeWorkload(const Workload& w) {
                                  : ", active morph targets unknown (all)";
   s += w.invocationsPerVertex > 0 ? fmt::format(", {:.3f} shader invocations per vertex", w.invocationsPerVertex)
                                   : ", invocations per vertex unknown";
+  if (w.fragmentsPerVertex > 0) s += fmt::format(", {:.2f} fragments per vertex", w.fragmentsPerVertex);
   if (!w.source.empty()) s += " (" + w.source + ")";
   return s;
 }

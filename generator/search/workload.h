@@ -22,8 +22,14 @@ struct Workload {
   double invocationsPerVertex = 0;
   // Where the figures come from, for reports: "mesh 'dawn' (180000 vertices)", "".
   std::string source;
+  // Fragments one draw's triangles cover per vertex, as a device counts them (fragment shader
+  // invocations over vertices; measure/workload.h: bench and calibrate count them, a generation
+  // is told or does not know). 0 = unknown.
+  double fragmentsPerVertex = 0;
 
-  bool known() const { return verticesPerDraw > 0 || jointsPerWarp > 0 || activeMorphTargets >= 0 || invocationsPerVertex > 0; }
+  bool known() const {
+    return verticesPerDraw > 0 || jointsPerWarp > 0 || activeMorphTargets >= 0 || invocationsPerVertex > 0 || fragmentsPerVertex > 0;
+  }
 };
 
 // One line for reports (explain, bench): "180000 vertices per draw, 3.42 joints per warp, ...

@@ -441,14 +441,14 @@ TEST(Calibrate, TheLimbMeshTimesProbesAndPlansAtTheLimbsSize) {
   for (const auto& s : r.samples) {
     EXPECT_GE(s.shadedPerVertex, 1.0) << s.label;
     EXPECT_LE(s.shadedPerVertex, 6.0) << s.label;
-    EXPECT_GT(s.fragmentsPerVertex, 0.0) << s.label;
+    EXPECT_GT(s.workload.fragmentsPerVertex, 0.0) << s.label;
   }
   std::istringstream log(formatCalibration(r));
   const std::vector<CalibrationSample> back = parseCalibrationSamples(log, {}, "");
   ASSERT_EQ(back.size(), r.samples.size());
   for (size_t i = 0; i < back.size(); ++i) {
     EXPECT_NEAR(back[i].shadedPerVertex, r.samples[i].shadedPerVertex, 1e-4) << back[i].label;
-    EXPECT_NEAR(back[i].fragmentsPerVertex, r.samples[i].fragmentsPerVertex, 1e-4) << back[i].label;
+    EXPECT_NEAR(back[i].workload.fragmentsPerVertex, r.samples[i].workload.fragmentsPerVertex, 1e-4) << back[i].label;
   }
   // The log says how it was timed.
   EXPECT_NE(formatCalibration(r).find("over 1 draws per frame (a smaller mesh more: at least 0 vertices), median of 1 frames"),
