@@ -326,6 +326,64 @@ TEST(Calibrate, TheRooflineFitPredictsRowsItNeverSawWhereTheAdditiveCannot) {
   }
 }
 
+// The same pipes, no per-draw cost, and a price per fragment a draw covers (the H200's raster-on
+// clock: docs/device-profiles.md, "The rasterizer's share"). Fragments per vertex vary from mesh
+// to mesh independently of its size, so the raster form fits them and the roofline's per-draw
+// weights cannot stand in for them.
+std::vector<CalibrationSample> rasterRows(uint32_t seed, int n, double fragmentNs) {
+  std::vector<CalibrationSample> out = roofline::rows(seed, n);
+  std::mt19937 rng(seed + 100);
+  roofline::Device d;
+  d.drawNs = 0;
+  for (auto& s : out) {
+    s.amounts[kTermFragments] = 1;
+    s.workload.fragmentsPerVertex = std::uniform_real_distribution<double>(0.2, 150)(rng);
+    s.measuredNs = d.ns(s.amounts, s.vertices, s.workload.jointsPerWarp) + fragmentNs * s.workload.fragmentsPerVertex;
+  }
+  return out;
+}
+
+TEST(Calibrate, TheRasterFitPricesTheFragmentsADrawCovers) {
+  const double fragmentNs = 0.05;
+  const std::vector<CalibrationSample> train = rasterRows(1, 160, fragmentNs), test = rasterRows(2, 80, fragmentNs);
+  auto heldOutRms = [&](const DeviceProfile& p, bool fragmentsKnown) {
+    double sq = 0;
+    for (const auto& s : test) {
+      DeviceProfile at = p;
+      at.workload = s.workload;
+      if (!fragmentsKnown) at.workload.fragmentsPerVertex = 0;
+      const double e = at.predictNanoseconds(s.amounts, s.vertices) / s.measuredNs - 1;
+      sq += e * e;
+    }
+    return std::sqrt(sq / double(test.size()));
+  };
+  const DeviceProfile raster = fitDeviceProfile(train, "raster device", 180000, 0, ProfileForm::Raster);
+  const DeviceProfile roof = fitDeviceProfile(train, "raster device", 180000, 0, ProfileForm::Roofline);
+  EXPECT_FALSE(raster.hasDrawWeights());
+  EXPECT_EQ(raster.scaledBy[kTermFragments], kFeatureFragmentsPerVertex);
+  EXPECT_NEAR(raster.nanoseconds[kTermFragments], fragmentNs, 0.002);
+  EXPECT_NEAR(raster.nanoseconds[kTermVertices], roofline::Device{}.vertexNs, 0.05);
+  EXPECT_LT(heldOutRms(raster, true), 0.01);
+  EXPECT_GT(heldOutRms(roof, true), 0.05);
+  // Where a mesh's fragments are unknown the profile prices the median the fit saw.
+  std::vector<double> seen;
+  for (const auto& s : train) seen.push_back(s.workload.fragmentsPerVertex);
+  std::nth_element(seen.begin(), seen.begin() + static_cast<long>(seen.size() / 2), seen.end());
+  EXPECT_EQ(raster.workloadDefaults[kFeatureFragmentsPerVertex], seen[seen.size() / 2]);
+  EXPECT_GT(heldOutRms(raster, false), heldOutRms(raster, true));
+  // Written and read back, it predicts the same.
+  CalibrationReport r;
+  r.profile = raster;
+  const std::string yaml = deviceProfileYaml(r);
+  EXPECT_NE(yaml.find("# form: raster"), std::string::npos);
+  DeviceProfile back = parseDeviceProfile(yaml, "raster.yaml");
+  for (const auto& s : test) {
+    DeviceProfile a = raster, b = back;
+    a.workload = b.workload = s.workload;
+    EXPECT_NEAR(b.predictNanoseconds(s.amounts, s.vertices), a.predictNanoseconds(s.amounts, s.vertices), 1e-5 * s.measuredNs);
+  }
+}
+
 TEST(Calibrate, AProfileWithoutPerDrawWeightsKeepsItsScalingWhenWritten) {
   // One mesh size fits no per-draw weight; the profile's workload scaling (a uniform load at a
   // per-vertex index costs per joint a warp reads) and its default must still be written, or

@@ -220,6 +220,37 @@ TEST(GpuBench, FloorsReadThePositionInEitherLayoutAndArePredicted) {
   }
 }
 
+// The fragments one draw covers are counted before the search and priced by a profile that has
+// a fragments weight: every row's prediction uses the count, not the profile's default.
+TEST(GpuBench, PlansArePricedForTheFragmentsTheDeviceCounts) {
+  const std::string profile = ::testing::TempDir() + "fragments.yaml";
+  writeText(profile, "device: test\nweights:\n  vertices: 1\n  fragments: 0.01\n"
+                         "scaled_by:\n  fragments: fragments_per_vertex\nworkload_defaults:\n  fragments_per_vertex: 1000\n");
+  double previous = 0;
+  for (uint32_t size : {64u, 128u}) {
+    sg::GpuBenchOptions b = quickBench(sourcePath("examples/dawn/rules.yaml"));
+    b.render.gen.deviceProfilePath = profile;
+    b.render.width = b.render.height = size;
+    b.alternatives = false;
+    b.floor = true;
+    b.rasterOff = false;
+    const sg::GpuBenchReport rep = sg::runGpuBench(b);
+    const double fragments = rep.workload.fragmentsPerVertex;
+    ASSERT_GT(fragments, 0) << size;
+    EXPECT_GE(rep.shadedVerticesPerVertex, 1.0) << size;  // every vertex of the head is drawn
+    for (const auto& row : rep.rows) EXPECT_NEAR(row.predictedNsPerVertex, 1 + 0.01 * fragments, 1e-6) << row.label;
+    EXPECT_NE(sg::formatGpuBench(rep).find(fmt::format("{:.2f} fragments per vertex", fragments)), std::string::npos);
+    // More pixels, more fragments; less than 4x on lavapipe, which counts whole blocks of
+    // invocations around the head's small triangles (the H200 counts 16.0x for 16x the pixels:
+    // bench/data/h200-draw-counts18/exp1.txt).
+    if (previous > 0) {
+      EXPECT_GT(fragments / previous, 1.5);
+      EXPECT_LT(fragments / previous, 4.5);
+    }
+    previous = fragments;
+  }
+}
+
 // On a CPU device (lavapipe, the tests' device) the prediction check uses the clock calibrate
 // fits there, this process's CPU time with the rasterizer discarded, not lavapipe's timestamps
 // (which miss deferred work): the generated program over the fastest passing plan by that clock.
