@@ -15,8 +15,10 @@ for mesh in dawn head; do
   for r in limb16 limb8_palette300 face52 octahedral qtangent limb8 limb4_unorm8 face52_sparse octahedral_or_float qtangent_or_float morph_scaled bitpacked_or_separate; do one "$r $mesh" --rig $H/$r.rig.yaml -f $H/world.frag "${std[@]}" --mesh $mesh; done
   for s in 1 2 3 4 5 6; do while read -r rig frag; do one "$(basename $rig) $mesh" --rig $rig -f $frag "${dawnR[@]}" --mesh $mesh; done < $d/list$s.txt; done
 done
-
-
-
+# Every model primitive the H200 logs timed, on its own mesh.
+for r in $(cat bench/data/h200-bone-columns15/*/*.log bench/data/h200-draw-counts18/*.log | grep -oE "[A-Za-z.-]+\.(glb|gltf)#[0-9]+/[0-9]+" | sort -u); do
+  f=${r%%#*}; p=$(find ../shared/models tests/gltf/data -name "$f" | head -1); [ -z "$p" ] && { echo "no $f"; continue; }
+  case $f in Fox*) fr=tests/gltf/data/solid.frag ;; *) fr=tests/gltf/data/lit.frag ;; esac
+  one "$r" --rig "$p#${r#*#}" -f $fr -r rules/standard.yaml
 done
 echo "same $same, different $diff"
