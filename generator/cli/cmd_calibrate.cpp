@@ -95,8 +95,13 @@ struct CalibrateCommand {
     return 0;
   }
 
+  // --form, which CLI11 has checked against the three names.
+  ProfileForm chosenForm() const {
+    return form == "roofline" ? ProfileForm::Roofline : form == "raster" ? ProfileForm::Raster : ProfileForm::Additive;
+  }
+
   int run() {
-    co.form = form == "roofline" ? ProfileForm::Roofline : form == "raster" ? ProfileForm::Raster : ProfileForm::Additive;
+    co.form = chosenForm();
     if (!writeCorpus.empty()) return writeCorpusFiles();
     if (!fromLogs.empty()) return refit();
     if (!evaluate.empty()) {
@@ -135,7 +140,7 @@ struct CalibrateCommand {
     co.rigs = rigs;
     co.check = !noCheck;
     co.probes = !noProbes;
-    co.form = form == "roofline" ? ProfileForm::Roofline : form == "raster" ? ProfileForm::Raster : ProfileForm::Additive;
+    co.form = chosenForm();
     if (!output.empty()) {
       std::vector<InputFile> inputs;
       for (const auto& r : co.rigs) inputs.push_back({isGltfPath(r) ? parseGltfRef(r).file : r, "a rig"});

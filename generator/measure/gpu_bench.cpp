@@ -326,8 +326,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   rt::Renderer renderer(validator.harness());
   double shadedPerVertex = -1;
   if (scene.mesh.vertexCount > 0) {
-    GenerateOptions first = gen;
-    rt::DrawRequest req = drawRequest(generateFrom(in, first), frag, textures, scene);
+    rt::DrawRequest req = drawRequest(generateFrom(in, gen), frag, textures, scene);
     req.width = opts.render.width;
     req.height = opts.render.height;
     if (auto st = renderer.statistics(req)) {
