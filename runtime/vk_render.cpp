@@ -139,10 +139,9 @@ std::optional<DrawStatistics> Renderer::statistics(const DrawRequest& r) {
   VkQueryPoolCreateInfo qci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
   qci.queryType = VK_QUERY_TYPE_PIPELINE_STATISTICS;
   qci.queryCount = 1;
-  // Results come back in the order of the bits: vertex shader, clipping, fragment shader.
-  qci.pipelineStatistics = VK_QUERY_PIPELINE_STATISTIC_VERTEX_SHADER_INVOCATIONS_BIT |
-                           VK_QUERY_PIPELINE_STATISTIC_CLIPPING_PRIMITIVES_BIT |
-                           VK_QUERY_PIPELINE_STATISTIC_FRAGMENT_SHADER_INVOCATIONS_BIT;
+  // Results come back in the order of the bits: vertex shader, then fragment shader.
+  qci.pipelineStatistics =
+      VK_QUERY_PIPELINE_STATISTIC_VERTEX_SHADER_INVOCATIONS_BIT | VK_QUERY_PIPELINE_STATISTIC_FRAGMENT_SHADER_INVOCATIONS_BIT;
   check(vkCreateQueryPool(dev.h.device, &qci, nullptr, &query), "vkCreateQueryPool");
   struct PoolGuard {
     VkDevice d;
@@ -158,10 +157,10 @@ std::optional<DrawStatistics> Renderer::statistics(const DrawRequest& r) {
   vkCmdEndQuery(o.cmd(), query, 0);
   o.endPass();
   o.submitAndWait();
-  uint64_t v[3] = {0, 0, 0};
+  uint64_t v[2] = {0, 0};
   check(vkGetQueryPoolResults(dev.h.device, query, 0, 1, sizeof(v), v, sizeof(v), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
         "vkGetQueryPoolResults");
-  return DrawStatistics{v[0], v[1], v[2]};
+  return DrawStatistics{v[0], v[1]};
 }
 
 }  // namespace sg::rt

@@ -56,11 +56,11 @@ struct Timing {
 };
 
 // What one draw of a request made the device do (a pipeline statistics query): vertex shader
-// invocations (each vertex the post-transform cache did not hold shaded again), primitives
-// out of clipping, and fragment shader invocations (the pixels its triangles cover that pass
-// the depth test LESS in a cleared target: the fragment work a frame's first draw does).
+// invocations (each vertex the post-transform cache did not hold shaded again) and fragment
+// shader invocations (the pixels its triangles cover that pass the depth test LESS in a
+// cleared target: the fragment work a frame's first draw does).
 struct DrawStatistics {
-  uint64_t vertexInvocations = 0, clippedPrimitives = 0, fragmentInvocations = 0;
+  uint64_t vertexInvocations = 0, fragmentInvocations = 0;
 };
 
 class Renderer {

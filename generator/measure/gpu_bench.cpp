@@ -315,13 +315,10 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   // are priced for the workload of the mesh and pose timed (measure/workload.h).
   if (gen.maxVertices == 0) gen.maxVertices = static_cast<int64_t>(scene.mesh.vertexCount) + 1;
   gen.workload = sceneWorkload(scene, isGltfPath(gen.rigPath) ? gen.rigPath : "procedural mesh '" + opts.render.mesh + "'");
-  in = loadInputs(gen);
-  scene = renderScene(in.rig, opts.render);
-  const Rig& rig = in.rig;
   FragmentProgram frag = compileFragmentFile(gen.fragmentPath, env);
   std::vector<rt::Texture> textures = texturesFor(frag, opts.render.lighting);
-  // The fragments a draw covers are part of the workload too (a profile may price them): counted
-  // on one draw of the plan chosen without them, where the device can count. Every plan that
+  // The fragments a draw covers are part of the workload too (a profile may price them): counted,
+  // where the device can, on one draw of a plan priced without the workload. Every plan that
   // validates writes the same positions, so covers the same pixels.
   rt::Renderer renderer(validator.harness());
   double shadedPerVertex = -1;
@@ -332,9 +329,11 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     if (auto st = renderer.statistics(req)) {
       shadedPerVertex = double(st->vertexInvocations) / double(scene.mesh.vertexCount);
       gen.workload.fragmentsPerVertex = double(st->fragmentInvocations) / double(scene.mesh.vertexCount);
-      in = loadInputs(gen);
     }
   }
+  in = loadInputs(gen);
+  scene = renderScene(in.rig, opts.render);
+  const Rig& rig = in.rig;
 
   // The programs: generated, its forced alternatives, the hand port, the floor.
   std::vector<Program> programs;
@@ -510,8 +509,8 @@ std::string formatGpuBench(const GpuBenchReport& r) {
                               r.drawsPerFrame, r.frames, r.rounds, r.width, r.height);
   s.insert(s.size() - 1, "workload: " + describeWorkload(r.workload) + "\n");
   if (r.shadedVerticesPerVertex >= 0)
-    s.insert(s.size() - 1, fmt::format("one draw, counted by the device: {:.3f} vertex shader invocations and {:.2f} fragments per vertex\n",
-                                       r.shadedVerticesPerVertex, r.workload.fragmentsPerVertex));
+    s.insert(s.size() - 1, fmt::format("one draw, counted by the device: {:.3f} vertex shader invocations per vertex (its fragments: the workload's)\n",
+                                       r.shadedVerticesPerVertex));
   const GpuBenchRow* gen = nullptr;
   for (const auto& row : r.rows)
     if (row.label == "generated") gen = &row;
