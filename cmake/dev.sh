@@ -92,18 +92,19 @@ plain_build() {  # plain_build [target...]: only those targets; the suite is con
 }
 # The product (CLI, libraries, benchmarks) in the plain tree, with the suite configured so
 # that its uninstrumented tests can run: labels cmake and bench, and the tests that shrink or
-# skip their data under sanitizers (tests/validate: `kSanitized`), which are built for it.
-full_scale_tests='^(Buffers\.Face52TargetsAt180kVerticesDenseAndSparse|Program\.AgreesWithTreeOnDawnSubset|Program\.AgreesWithTreeOnRandomDefinitions)$'
+# skip their data under sanitizers (`SG_SANITIZED`; tests/validate: `kSanitized`), which are built for it.
+full_scale_tests='^(Buffers\.Face52TargetsAt180kVerticesDenseAndSparse|Program\.AgreesWithTreeOnDawnSubset|Program\.AgreesWithTreeOnRandomDefinitions|RuleCheck\.StandardLibraryOverSeveralRigsChecksEveryRule|ThreeJs\.EverySharedModelAgreesWithThreeJs)$'
 product_build() {
   SHADERGEN_SUITE=ON plain_build generator/all runtime/all generator/validate/all generator/render/all generator/measure/all \
-    generator/bake/all generator/cli/all bench/all test_validate_buffers test_validate_program
+    generator/bake/all generator/cli/all bench/all test_validate_buffers test_validate_program test_validate_rule_check \
+    test_gltf_three
 }
 product_test() {
   local n
   n=$(ctest --test-dir "$build" -N -R "$full_scale_tests" | sed -n 's/^Total Tests: //p')
-  [ "$n" = 3 ] || { echo "dev.sh: $n of the 3 full-scale tests found (renamed? update full_scale_tests)" >&2; return 1; }
+  [ "$n" = 5 ] || { echo "dev.sh: $n of the 5 full-scale tests found (renamed? update full_scale_tests)" >&2; return 1; }
   ctest --test-dir "$build" --output-on-failure -j"$(nproc)" -L 'cmake|bench' &&
-    ctest --test-dir "$build" --output-on-failure -R "$full_scale_tests"
+    ctest --test-dir "$build" --output-on-failure -j"$(nproc)" -R "$full_scale_tests"
 }
 # One instrumented tree serves both the sanitizer suite and the fuzz targets.
 sanitize_build=${SHADERGEN_SANITIZE_BUILD_DIR:-build-sanitize}

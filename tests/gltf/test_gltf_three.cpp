@@ -233,6 +233,11 @@ const std::map<std::string, std::set<std::string>> kKnownDifferences = {};
 
 TEST(ThreeJs, EverySharedModelAgreesWithThreeJs) {
   SKIP_WITHOUT_NODE();
+#ifdef SG_SANITIZED
+  // Every shared model posed by both (35 s under ASan): the import and posing code it runs is
+  // sanitized by the glTF tests beside it. The plain suite runs it (cmake/dev.sh).
+  GTEST_SKIP() << "every shared model against three.js: run by the plain suite";
+#endif
   for (const auto& mc : kModels) {
     SCOPED_TRACE(mc.model);
     const std::string model = modelPath(mc.model);
