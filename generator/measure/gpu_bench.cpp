@@ -337,13 +337,14 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
 
   // The programs: generated, its forced alternatives, the hand port, the floor.
   std::vector<Program> programs;
-  auto addGenerated = [&](const GenerateOptions& g, const std::string& label) -> bool {
+  auto addGenerated = [&](const GenerateOptions& g, const std::string& label, std::vector<std::string> bans = {}) -> bool {
     GenerateOptions render = g, capture = g;
     render.capture = false;
     capture.capture = true;
     Program p;
     p.render = generateFrom(in, render);
     p.row.label = label;
+    p.row.bans = std::move(bans);
     for (int a : p.render.plan.actions) p.row.rules.push_back(p.render.in.problem.actions[a].name);
     for (const auto& q : programs)
       if (q.row.hasCost && q.row.rules == p.row.rules) return false;  // the same plan again
@@ -368,10 +369,12 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
       for (const auto& alt : producers) {
         if (alt == p.actions[a].name) continue;
         GenerateOptions forced = gen;
+        std::vector<std::string> bans;
         for (const auto& other : producers)
-          if (other != alt) forced.bannedRules.push_back(other);
+          if (other != alt) bans.push_back(other);
+        forced.bannedRules.insert(forced.bannedRules.end(), bans.begin(), bans.end());
         try {
-          addGenerated(forced, fmt::format("forced {} for {}", alt, p.facts[p.actions[a].add].name));
+          addGenerated(forced, fmt::format("forced {} for {}", alt, p.facts[p.actions[a].add].name), bans);
         } catch (const InputError&) {
           // the alternative needs something this rig cannot provide
         }
@@ -497,6 +500,14 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   rep.spearmanPredictedOn = predictedOn.spearman;
   rep.generatedOverFastestOn = predictedOn.generatedOverFastest;
   if (!std::isnan(rep.generatedOverFastestOn)) rep.byRound = generatedOverFastestByRound(rep.rows);
+  for (size_t k = 0; k < rep.rows.size(); ++k) {
+    const GpuBenchRow& row = rep.rows[k];
+    if (row.hasCost && row.validation == "pass" && row.*clock > 0 &&
+        (rep.fastestPlan < 0 || row.*clock < rep.rows[size_t(rep.fastestPlan)].*clock))
+      rep.fastestPlan = static_cast<int>(k);
+  }
+  if (rep.fastestPlan >= 0 && rep.rows.front().*clock > 0)
+    rep.fastestOverGenerated = rep.rows[size_t(rep.fastestPlan)].*clock / rep.rows.front().*clock;
   const auto& msgs = validator.harness().validationMessages();
   if (!msgs.empty()) throw std::runtime_error("validation layer: " + msgs.front());
   return rep;
@@ -543,6 +554,17 @@ std::string formatGpuBench(const GpuBenchReport& r) {
     s += fmt::format("device profile: predicted vs measured ({}; within 0.5 %: ties) Spearman {:.2f}; the generated program takes "
                      "{:.3f}x the fastest generated one{}\n",
                      r.predictionClock, r.spearmanPredictedOn, r.generatedOverFastestOn, describeRoundSpread(r.byRound));
+  // The device's own answer, for a build that wants it: which plan to pin, and how.
+  if (r.fastestPlan > 0) {
+    const GpuBenchRow& f = r.rows[size_t(r.fastestPlan)];
+    std::string flags;
+    for (const auto& b : f.bans) flags += " --ban " + b;
+    s += fmt::format("fastest validated plan ({}): {}{}; generate writes it with{} added\n", r.predictionClock, f.label,
+                     std::isnan(r.fastestOverGenerated) ? "" : fmt::format(", {:.3f}x the generated one's time", r.fastestOverGenerated),
+                     flags);
+  } else if (r.fastestPlan == 0) {
+    s += fmt::format("fastest validated plan ({}): the generated one\n", r.predictionClock);
+  }
   return s;
 }
 

@@ -37,6 +37,9 @@ struct GpuBenchOptions {
 struct GpuBenchRow {
   std::string label;               // "generated", "forced <rule> for <fact>", "hand port", "floor"
   std::vector<std::string> rules;  // plan rules (generated programs)
+  // The rules to --ban, beside the options' own, that make generate write this program: a
+  // forced alternative's are the other rules producing its fact ("generated": none).
+  std::vector<std::string> bans;
   bool hasCost = false;            // a plan of the search (planCost)
   bool hasAmounts = false;         // amounts known: the plans and the floors
   int64_t planCost = 0;
@@ -87,6 +90,10 @@ struct GpuBenchReport {
   // over the rounds, the spread a reader weighs the best-of-rounds ratio against.
   RoundSpread byRound;
   std::string predictionClock;
+  // The validated plan (generated or forced) that `predictionClock` timed fastest: an index
+  // into rows, -1 where none was timed by it. Its `bans` make generate write it.
+  int fastestPlan = -1;
+  double fastestOverGenerated = NAN;  // its time over the generated program's, by that clock
   std::vector<Diagnostic> notes;  // loading's (which stored form is read, what budgets removed)
 };
 

@@ -11,6 +11,7 @@
 
 #include "common/input_file.h"
 #include "measure/gpu_bench.h"
+#include "pipeline/generate.h"
 #include "runtime/procedural.h"
 #include "test_util.h"
 
@@ -284,6 +285,37 @@ TEST(GpuBench, ACpuDeviceIsCheckedByTheClockItsProfileWasFittedOn) {
   // The CPU clock has its column, the generated program's figure first in it.
   EXPECT_NE(text.find("| raster off, process CPU |"), std::string::npos);
   EXPECT_NE(text.find(fmt::format(" {:.4f} (1.00x) |\n", rep.rows.front().rasterOffCpuNsPerVertex)), std::string::npos);
+
+  // The fastest validated plan by that clock is named, with the bans that make generate write
+  // it: generate with them gives that plan's rules (checked for it and the first forced row).
+  int fastestRow = -1;
+  for (size_t k = 0; k < rep.rows.size(); ++k)
+    if (rep.rows[k].hasCost && rep.rows[k].validation == "pass" &&
+        (fastestRow < 0 || rep.rows[k].rasterOffCpuNsPerVertex < rep.rows[size_t(fastestRow)].rasterOffCpuNsPerVertex))
+      fastestRow = static_cast<int>(k);
+  ASSERT_EQ(rep.fastestPlan, fastestRow);
+  EXPECT_DOUBLE_EQ(rep.fastestOverGenerated, rep.rows[size_t(fastestRow)].rasterOffCpuNsPerVertex / rep.rows.front().rasterOffCpuNsPerVertex);
+  EXPECT_TRUE(rep.rows.front().bans.empty());
+  ASSERT_GT(rep.rows.size(), 2u);
+  for (size_t k : {size_t(1), size_t(fastestRow)}) {
+    const sg::GpuBenchRow& row = rep.rows[k];
+    if (row.label == "generated") continue;
+    SCOPED_TRACE(row.label);
+    ASSERT_FALSE(row.bans.empty());
+    sg::GenerateOptions g = b.render.gen;
+    g.bannedRules.insert(g.bannedRules.end(), row.bans.begin(), row.bans.end());
+    const sg::GenerateResult r = sg::generate(g);
+    std::vector<std::string> rules;
+    for (int a : r.plan.actions) rules.push_back(r.in.problem.actions[a].name);
+    EXPECT_EQ(rules, row.rules);
+  }
+  const size_t line = text.find("fastest validated plan (raster off, process CPU time (a CPU device)): ");
+  ASSERT_NE(line, std::string::npos) << text;
+  if (fastestRow == 0) {
+    EXPECT_NE(text.find("): the generated one\n", line), std::string::npos);
+  } else {
+    for (const auto& ban : rep.rows[size_t(fastestRow)].bans) EXPECT_NE(text.find(" --ban " + ban, line), std::string::npos) << ban;
+  }
 }
 
 // What `program` writes for every vertex of the mesh, captured with the generated program's layout.
