@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -42,6 +43,10 @@ SharedInputs loadShared(const Manifest& m, const std::vector<Variant>& variants,
   SharedInputs s;
   s.rules = loadRulesStage(m.rules);
   s.templates = loadTemplatesStage(m.templates);
+  for (const auto& v : variants)  // a misspelt ban would otherwise change nothing silently
+    for (const auto& b : v.rig->bans)
+      if (std::none_of(s.rules.rules.begin(), s.rules.rules.end(), [&](const Rule& r) { return r.name == b; }))
+        throw InputError(v.rig->banLoc, fmt::format("rig '{}' bans '{}': no rule of that name in the rules files", v.rig->name, b));
   for (const auto& v : variants) {
     if (!s.rigs.count(v.rig->path)) {
       try {
@@ -94,6 +99,10 @@ std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v,
   if (m.emits("hlsl")) h.field("hlsl").field(shaderModelName(m.hlsl.shaderModel));
   if (m.emits("msl")) h.field("msl").field(mslVersionName(m.msl)).field(mslPlatformName(m.msl.platform));
   h.field(v.rig->path).field(v.pass->fragment);
+  if (!v.rig->bans.empty()) {  // absent without bans: the keys of manifests before them stay
+    h.field("bans");
+    for (const auto& b : v.rig->bans) h.field(b);
+  }
   for (const auto& [k, val] : v.params) h.field(k).field(std::to_string(val));
   h.field("maps");
   for (const auto& ov : v.pass->maps) {
@@ -210,6 +219,7 @@ GenerateOptions generateOptionsOf(const Manifest& m, const Variant& v, const Bui
   o.overrides = v.pass->maps;
   o.conventions = v.pass->conventions;
   o.rigParams = v.params;
+  o.bannedRules = v.rig->bans;
   o.maxError = m.maxError;
   o.heuristic = m.heuristic;
   o.templateDir = m.templates;

@@ -182,13 +182,23 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
   }
 
   std::map<std::string, std::vector<std::string>> wholeModels;  // rig name -> its primitives' rig names
-  if (!root["rigs"]) y.fail(root, "the manifest needs 'rigs' (name: rig file)");
+  if (!root["rigs"]) y.fail(root, "the manifest needs 'rigs' (name: rig file, or name: { path: rig file, ban: [...] })");
   y.expectMap(root["rigs"], "'rigs'");
   for (const auto& kv : root["rigs"]) {
     ManifestRig r;
     r.name = y.scalar(kv.first, "a rig name");
     r.loc = locOf(kv.first, file);
-    r.path = resolvePath(file, y.scalar(kv.second, "a rig file"));
+    if (kv.second.IsMap()) {  // { path: RIG, ban: [rule, ...] }
+      y.checkKeys(kv.second, {"path", "ban"});
+      if (!kv.second["path"]) y.fail(kv.second, fmt::format("rig '{}' needs 'path'", r.name));
+      r.path = resolvePath(file, y.scalar(kv.second["path"], "'path'"));
+      if (kv.second["ban"]) {
+        r.bans = scalarOrList(y, kv.second["ban"], "a rule name or a list of them");
+        r.banLoc = locOf(kv.second["ban"], file);
+      }
+    } else {
+      r.path = resolvePath(file, y.scalar(kv.second, "a rig file"));
+    }
     if (!safeStem(r.name)) y.fail(kv.first, fmt::format("rig name '{}' must be letters, digits, '-', '_' or '.'", r.name));
     if (!isWholeModelRef(r.path)) {
       m.rigs.push_back(r);

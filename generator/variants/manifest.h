@@ -30,6 +30,10 @@ struct ManifestRig {
   std::string name;
   std::string path;  // YAML rig or MODEL.glb#m/p
   SourceLoc loc;
+  // Rules its variants' search may not use, as `generate --ban` (`ban:`): a plan `bench` timed
+  // faster on the device, pinned (docs/variants.md, "Pinning a plan").
+  std::vector<std::string> bans;
+  SourceLoc banLoc;
 };
 
 // One axis: `rig` and `pass` pick named rigs and passes; any other axis sets the rig

@@ -4,6 +4,7 @@
 // whatever the thread count, and failures that leave the index out.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -228,6 +229,12 @@ TEST(Manifest, ErrorsAreLocated) {
   EXPECT_NE(d.message.find("not a safe file name"), std::string::npos) << d.message;
   d = fail(head + "name: \"{lod}\"\n");
   EXPECT_NE(d.message.find("unknown axis '{lod}'"), std::string::npos) << d.message;
+  // The map form of a rig: its keys and its path are checked where they are written.
+  d = fail("rules: r.yaml\nrigs:\n  face: { path: f.rig.yaml, bna: [x] }\npasses:\n  color: c.frag\n");
+  EXPECT_NE(d.message.find("bna"), std::string::npos) << d.message;
+  EXPECT_EQ(d.loc.line, 3);
+  d = fail("rules: r.yaml\nrigs:\n  face: { ban: [x] }\npasses:\n  color: c.frag\n");
+  EXPECT_NE(d.message.find("rig 'face' needs 'path'"), std::string::npos) << d.message;
   d = fail("rigs: [a, b]\n");
   EXPECT_EQ(d.loc.file, (dir / "bad.yaml").string());
   EXPECT_GT(d.loc.line, 0);
@@ -508,4 +515,65 @@ TEST(Build, TheWorkloadIsRecordedAndKeyed) {
   const auto d = errorOf([&] { loadManifest((dir / "bad.yaml").string()); });
   EXPECT_NE(d.message.find("unknown mesh 'cube'"), std::string::npos) << d.message;
   EXPECT_EQ(d.loc.line, 6);
+}
+
+// A rig's `ban:` (docs/variants.md, "Pinning a plan"): its variants are generate()'s with those
+// --bans, byte for byte; the bans are in the cache key (the rig's variants regenerate, the
+// others stay cached); a misspelt rule name is an error at the ban's line.
+TEST(Build, ARigsBansPinItsPlansAndAreInTheKey) {
+  auto dir = freshDir("ban");
+  const fs::path plain = smallManifest(dir);
+  const std::string text = readAll(plain);
+  const std::string rigLine = "  face: face.rig.yaml\n";
+  ASSERT_NE(text.find(rigLine), std::string::npos);
+  auto withFace = [&](const std::string& face) {
+    std::string t = text;
+    t.replace(t.find(rigLine), rigLine.size(), face);
+    writeText(dir / "pinned.yaml", t);
+    return loadManifest((dir / "pinned.yaml").string());
+  };
+  const std::vector<std::string> bans = {"skin_matrix_blend", "skin_matrix_blend_buffer_palette"};
+  Manifest pinned = withFace("  face:\n    path: face.rig.yaml\n    ban: [skin_matrix_blend, skin_matrix_blend_buffer_palette]\n");
+  ASSERT_EQ(pinned.rigs[0].name, "face");
+  EXPECT_EQ(pinned.rigs[0].bans, bans);
+  EXPECT_TRUE(pinned.rigs[1].bans.empty());
+
+  BuildOptions bo;
+  bo.cacheDir = (dir / "cache").string();
+  Manifest m = loadManifest(plain.string());
+  BuildReport before = buildVariants(m, expandVariants(m), bo);
+  ASSERT_EQ(before.failed, 0u);
+  const std::vector<Variant> variants = expandVariants(pinned);
+  BuildReport r = buildVariants(pinned, variants, bo);
+  ASSERT_EQ(r.failed, 0u);
+  const auto files = filesOf(r);
+  size_t face = 0, blendsReplaced = 0;
+  for (const auto& b : r.variants) {
+    const Variant& v = *b.variant;
+    GenerateOptions o;
+    o.rigPath = v.rig->path;
+    o.fragmentPath = v.pass->fragment;
+    o.rulesPaths = pinned.rules;
+    o.rigParams = v.params;
+    o.outputName = b.outputs.at("glsl");
+    if (v.rig->name == "face") {
+      ++face;
+      o.bannedRules = bans;
+      for (const auto& rule : b.rules) EXPECT_TRUE(rule != bans[0] && rule != bans[1]) << v.name << ": " << rule;
+      blendsReplaced += std::count(b.rules.begin(), b.rules.end(), "skin_matrix_blend_buffered_influences");
+    }
+    EXPECT_EQ(files.at(b.outputs.at("glsl")), generate(o).glsl.text) << v.name;
+  }
+  // The 4-influence face variants blend with the influences from buffers instead.
+  EXPECT_GT(blendsReplaced, 0u);
+  EXPECT_EQ(r.generated, face);
+  EXPECT_EQ(r.cached, variants.size() - face);
+
+  const Diagnostic d = errorOf([&] {
+    Manifest bad = withFace("  face:\n    path: face.rig.yaml\n    ban: skin_matrix_blendd\n");
+    buildVariants(bad, expandVariants(bad), BuildOptions{});
+  });
+  EXPECT_NE(d.message.find("rig 'face' bans 'skin_matrix_blendd': no rule of that name"), std::string::npos) << d.message;
+  EXPECT_EQ(d.loc.file, (dir / "pinned.yaml").string());
+  EXPECT_EQ(d.loc.line, 6);  // output, rules, rigs, face, path, ban
 }
