@@ -386,6 +386,11 @@ std::string indexEntry(const Manifest& m, const BuiltVariant& b) {
   std::string rules;
   for (const auto& rule : b.rules) rules += (rules.empty() ? "" : ", ") + jsonString(rule);
   out += fmt::format("      \"rules\": [{}],\n", rules);
+  if (!v.rig->bans.empty()) {  // a pinned plan (docs/variants.md): what its search left out
+    std::string bans;
+    for (const auto& ban : v.rig->bans) bans += (bans.empty() ? "" : ", ") + jsonString(ban);
+    out += fmt::format("      \"bans\": [{}],\n", bans);
+  }
   out += fmt::format("      \"spirv_sha256\": {},\n", jsonString(b.spirvHash));
   out += fmt::format("      \"validated\": {},\n", b.validation ? "true" : "false");
   if (const auto& val = b.validation)  // where and when the result was made (cached with it)

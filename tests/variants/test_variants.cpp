@@ -566,6 +566,13 @@ TEST(Build, ARigsBansPinItsPlansAndAreInTheKey) {
   }
   // The 4-influence face variants blend with the influences from buffers instead.
   EXPECT_GT(blendsReplaced, 0u);
+  // index.json says which variants were pinned, and by what; the others carry no "bans".
+  const std::string& index = files.at(r.indexPath);
+  const std::string listed = "\"bans\": [\"skin_matrix_blend\", \"skin_matrix_blend_buffer_palette\"]";
+  size_t n = 0;
+  for (size_t at = index.find(listed); at != std::string::npos; at = index.find(listed, at + 1)) ++n;
+  EXPECT_EQ(n, face);
+  EXPECT_EQ(index.find("\"bans\""), index.find(listed));
   EXPECT_EQ(r.generated, face);
   EXPECT_EQ(r.cached, variants.size() - face);
 
