@@ -58,6 +58,19 @@ std::map<std::string, std::string> filesOf(const BuildReport& r) {
   return m;
 }
 
+// What one `generate` command is given for a built variant, written out here (not the
+// builder's generateOptionsOf): the outputs must equal that command's.
+GenerateOptions generateCommandOf(const Manifest& m, const BuiltVariant& b) {
+  const Variant& v = *b.variant;
+  GenerateOptions o;
+  o.rigPath = v.rig->path;
+  o.fragmentPath = v.pass->fragment;
+  o.rulesPaths = m.rules;
+  o.rigParams = v.params;
+  o.outputName = b.outputs.at("glsl");
+  return o;
+}
+
 }  // namespace
 
 // NIST's examples (FIPS 180-2, appendix B; the CAVS SHA256ShortMsg 8-bit message): the
@@ -254,13 +267,7 @@ TEST(Build, OutputsAreGeneratesBytes) {
   std::map<std::string, std::set<std::string>> pathsOfModule;  // SPIR-V bytes -> output paths
   for (const auto& b : r.variants) {
     const Variant& v = *b.variant;
-    GenerateOptions o;
-    o.rigPath = v.rig->path;
-    o.fragmentPath = v.pass->fragment;
-    o.rulesPaths = m.rules;
-    o.rigParams = v.params;
-    o.outputName = b.outputs.at("glsl");
-    GenerateResult g = generate(o);
+    GenerateResult g = generate(generateCommandOf(m, b));
     EXPECT_EQ(files.at(b.outputs.at("glsl")), g.glsl.text) << v.name;
     std::string spv(reinterpret_cast<const char*>(g.spirv.words.data()), g.spirv.words.size() * 4);
     EXPECT_EQ(files.count(b.outputs.at("spv")) ? files.at(b.outputs.at("spv")) : b.spirv, spv) << v.name;
@@ -550,12 +557,7 @@ TEST(Build, ARigsBansPinItsPlansAndAreInTheKey) {
   size_t face = 0, blendsReplaced = 0;
   for (const auto& b : r.variants) {
     const Variant& v = *b.variant;
-    GenerateOptions o;
-    o.rigPath = v.rig->path;
-    o.fragmentPath = v.pass->fragment;
-    o.rulesPaths = pinned.rules;
-    o.rigParams = v.params;
-    o.outputName = b.outputs.at("glsl");
+    GenerateOptions o = generateCommandOf(pinned, b);
     if (v.rig->name == "face") {
       ++face;
       o.bannedRules = bans;
