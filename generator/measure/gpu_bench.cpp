@@ -257,6 +257,7 @@ PredictionCheck checkPredictions(const std::vector<GpuBenchRow>& rows, double Gp
   for (const auto& r : rows)
     if (r.hasCost && r.validation == "pass" && r.*clock > 0) {
       ++c.plans;
+      if (r.*clock < fastest) c.fastest = static_cast<int>(&r - rows.data());
       fastest = std::min(fastest, r.*clock);
       if (r.predictedNsPerVertex >= 0) predicted.push_back(r.predictedNsPerVertex), measured.push_back(r.*clock);
     }
@@ -337,8 +338,12 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
 
   // The programs: generated, its forced alternatives, the hand port, the floor.
   std::vector<Program> programs;
-  auto addGenerated = [&](const GenerateOptions& g, const std::string& label, std::vector<std::string> bans = {}) -> bool {
-    GenerateOptions render = g, capture = g;
+  // A plan of the options with `bans` added: "generated" has none, a forced alternative the
+  // other rules producing its fact (the row keeps them: generate --ban writes the same plan).
+  auto addGenerated = [&](const std::string& label, std::vector<std::string> bans = {}) -> bool {
+    GenerateOptions render = gen;
+    render.bannedRules.insert(render.bannedRules.end(), bans.begin(), bans.end());
+    GenerateOptions capture = render;
     render.capture = false;
     capture.capture = true;
     Program p;
@@ -358,7 +363,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     programs.push_back(std::move(p));
     return true;
   };
-  addGenerated(gen, "generated");
+  addGenerated("generated");
   const GenerateResult chosen = programs.front().render, chosenCapture = programs.front().capture;  // programs grows
   if (opts.alternatives) {
     const Problem& p = chosen.in.problem;
@@ -368,13 +373,11 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
         if (act.add == p.actions[a].add) producers.push_back(act.name);
       for (const auto& alt : producers) {
         if (alt == p.actions[a].name) continue;
-        GenerateOptions forced = gen;
         std::vector<std::string> bans;
         for (const auto& other : producers)
           if (other != alt) bans.push_back(other);
-        forced.bannedRules.insert(forced.bannedRules.end(), bans.begin(), bans.end());
         try {
-          addGenerated(forced, fmt::format("forced {} for {}", alt, p.facts[p.actions[a].add].name), bans);
+          addGenerated(fmt::format("forced {} for {}", alt, p.facts[p.actions[a].add].name), std::move(bans));
         } catch (const InputError&) {
           // the alternative needs something this rig cannot provide
         }
@@ -500,12 +503,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   rep.spearmanPredictedOn = predictedOn.spearman;
   rep.generatedOverFastestOn = predictedOn.generatedOverFastest;
   if (!std::isnan(rep.generatedOverFastestOn)) rep.byRound = generatedOverFastestByRound(rep.rows);
-  for (size_t k = 0; k < rep.rows.size(); ++k) {
-    const GpuBenchRow& row = rep.rows[k];
-    if (row.hasCost && row.validation == "pass" && row.*clock > 0 &&
-        (rep.fastestPlan < 0 || row.*clock < rep.rows[size_t(rep.fastestPlan)].*clock))
-      rep.fastestPlan = static_cast<int>(k);
-  }
+  rep.fastestPlan = predictedOn.fastest;
   if (rep.fastestPlan >= 0 && rep.rows.front().*clock > 0)
     rep.fastestOverGenerated = rep.rows[size_t(rep.fastestPlan)].*clock / rep.rows.front().*clock;
   const auto& msgs = validator.harness().validationMessages();

@@ -123,6 +123,7 @@ void timeCpuDevicesSingleThreaded();
 // on, calibrate for its own clock.
 struct PredictionCheck {
   size_t plans = 0;
+  int fastest = -1;  // the row of the fastest plan counted (-1: none), with or without predictions
   double spearman = NAN;
   double generatedOverFastest = NAN;
 };

@@ -362,7 +362,7 @@ LoadedInputs loadInputs(const GenerateOptions& opts) {
   for (const std::string& path : opts.portableProfilePaths) portable.push_back(loadDeviceProfileStage(path));
   LoadedInputs in = prepareInputs(std::move(rig), rules, fragment, opts, profile, portable);
   for (const auto& b : opts.bannedRules)  // a misspelt --ban would otherwise change nothing silently
-    if (std::none_of(in.rules.rules.begin(), in.rules.rules.end(), [&](const Rule& r) { return r.name == b; }))
+    if (!in.rules.findRule(b))
       throw InputError(SourceLoc{}, fmt::format("--ban {}: no rule of that name in the rules files", b));
   return in;
 }

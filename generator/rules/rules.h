@@ -130,6 +130,7 @@ struct RuleSet {
   const VaryingMapping* findVarying(const std::string& name) const;
   const NamingConvention* findConvention(const std::string& name) const;
   const SharedSnippet* findSnippet(const std::string& name) const;
+  const Rule* findRule(const std::string& name) const;  // nullptr: no rule of that name (a misspelt ban)
 };
 
 // Loads rule files (and their `include:`s, relative to the including file) into one set.

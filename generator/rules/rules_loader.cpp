@@ -504,6 +504,12 @@ const SemanticDecl* RuleSet::findSemantic(const std::string& name) const {
   return nullptr;
 }
 
+const Rule* RuleSet::findRule(const std::string& name) const {
+  for (const auto& r : rules)
+    if (r.name == name) return &r;
+  return nullptr;
+}
+
 const SharedSnippet* RuleSet::findSnippet(const std::string& name) const {
   for (const auto& s : snippets)
     if (s.name == name) return &s;

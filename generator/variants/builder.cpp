@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -43,10 +42,10 @@ SharedInputs loadShared(const Manifest& m, const std::vector<Variant>& variants,
   SharedInputs s;
   s.rules = loadRulesStage(m.rules);
   s.templates = loadTemplatesStage(m.templates);
-  for (const auto& v : variants)  // a misspelt ban would otherwise change nothing silently
-    for (const auto& b : v.rig->bans)
-      if (std::none_of(s.rules.rules.begin(), s.rules.rules.end(), [&](const Rule& r) { return r.name == b; }))
-        throw InputError(v.rig->banLoc, fmt::format("rig '{}' bans '{}': no rule of that name in the rules files", v.rig->name, b));
+  for (const ManifestRig& r : m.rigs)  // a misspelt ban would otherwise change nothing silently
+    for (const auto& b : r.bans)
+      if (!s.rules.findRule(b))
+        throw InputError(r.banLoc, fmt::format("rig '{}' bans '{}': no rule of that name in the rules files", r.name, b));
   for (const auto& v : variants) {
     if (!s.rigs.count(v.rig->path)) {
       try {
