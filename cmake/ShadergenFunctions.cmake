@@ -16,7 +16,11 @@
 #     [CAPTURE]                 # transform-feedback build (to read outputs back with sg::rt::Harness)
 #     [MAP <Name=sem[,sem...]>...]  # --map overrides of fragment inputs
 #     [TEMPLATES <dir>]         # --templates (default: the ones shipped with shadergen)
-#     [DEVICE_PROFILE <file>]   # --device-profile: the plan cheapest on that device (docs/device-profiles.md)
+#     [DEVICE_PROFILE <file>...] # --device-profile: the plan cheapest on that device; several: the
+#                               # portable plan, least worst-case regret (docs/device-profiles.md)
+#     [MESH head|limb|dawn]     # --mesh: the procedural mesh a YAML rig's profile prices (needs DEVICE_PROFILE)
+#     [BAN <rule>...]           # --ban: pin a plan (the fastest one `shadergen bench` names)
+#     [SET <NAME=VALUE>...]     # --set: a rig deformer parameter (level of detail)
 #     [DEPENDS <file>...])      # extra dependencies of the generator run
 #
 # Runs `shadergen generate` in a custom command whose DEPFILE lists every file the
@@ -58,8 +62,8 @@ endfunction()
 
 function(shadergen_add_vertex_shader target)
   set(options OPTIMIZE EMBED CAPTURE HLSL MSL)
-  set(one RIG FRAGMENT OUTPUT_NAME TARGET_ENV TEMPLATES DEVICE_PROFILE HLSL_SHADER_MODEL MSL_VERSION MSL_PLATFORM)
-  set(multi RULES MAP DEPENDS)
+  set(one RIG FRAGMENT OUTPUT_NAME TARGET_ENV TEMPLATES MESH HLSL_SHADER_MODEL MSL_VERSION MSL_PLATFORM)
+  set(multi RULES MAP DEPENDS DEVICE_PROFILE BAN SET)
   cmake_parse_arguments(PARSE_ARGV 1 SG "${options}" "${one}" "${multi}")
 
   if(SG_UNPARSED_ARGUMENTS)
@@ -85,6 +89,13 @@ function(shadergen_add_vertex_shader target)
       message(FATAL_ERROR "shadergen_add_vertex_shader(${target}): ${o} needs MSL")
     endif()
   endforeach()
+  # The generator refuses these too, but only at build time, once per edit.
+  if(SG_MESH AND NOT SG_DEVICE_PROFILE)
+    message(FATAL_ERROR "shadergen_add_vertex_shader(${target}): MESH needs DEVICE_PROFILE (without a profile the mesh prices nothing)")
+  endif()
+  if(SG_MESH AND NOT SG_MESH MATCHES "^(head|limb|dawn)$")
+    message(FATAL_ERROR "shadergen_add_vertex_shader(${target}): MESH must be head, limb or dawn, not '${SG_MESH}'")
+  endif()
 
   _shadergen_executable(shadergen_add_vertex_shader _sg_exe)
 
@@ -161,12 +172,21 @@ function(shadergen_add_vertex_shader target)
     list(APPEND _args --templates "${_tpl}")
   endif()
 
-  if(SG_DEVICE_PROFILE)
+  foreach(p IN LISTS SG_DEVICE_PROFILE)
     # A dependency as well (the depfile names it too once the generator has run).
-    get_filename_component(_profile "${SG_DEVICE_PROFILE}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+    get_filename_component(_profile "${p}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
     list(APPEND _args --device-profile "${_profile}")
     list(APPEND _extra "${_profile}")
+  endforeach()
+  if(SG_MESH)
+    list(APPEND _args --mesh "${SG_MESH}")
   endif()
+  foreach(b IN LISTS SG_BAN)
+    list(APPEND _args --ban "${b}")
+  endforeach()
+  foreach(v IN LISTS SG_SET)
+    list(APPEND _args --set "${v}")
+  endforeach()
 
   add_custom_command(
     OUTPUT ${_outputs}

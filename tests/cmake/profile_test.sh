@@ -1,0 +1,93 @@
+#!/usr/bin/env bash
+# shadergen_add_vertex_shader(... DEVICE_PROFILE <a> <b> MESH ... BAN ... SET ...) (docs/cmake.md):
+# each shader is byte-identical to `shadergen generate` with the same flags; the mesh, a ban and
+# a --set each change the plan as they do on the command line; both profiles are dependencies
+# (editing the second regenerates the shaders, nothing else does); MESH without a profile, or
+# a mesh that does not exist, is a configure error.
+#
+#   profile_test.sh <shadergen> <source dir> <ninja>
+set -uo pipefail
+SG=$1 SRC=$2 NINJA=$3
+T=$(mktemp -d "${TMPDIR:-/tmp}/sg-cmake-profile-XXXXXX")
+trap 'rm -rf "$T"' EXIT
+fails=0
+fail() { echo "FAIL: $*" >&2; fails=$((fails + 1)); }
+ok() { echo "ok: $*"; }
+
+D="$SRC/examples/dawn"
+P1="$T/h200.yaml" P2="$T/llvmpipe.yaml"
+cp "$SRC/devices/nvidia-h200-raster.yaml" "$P1"
+cp "$SRC/devices/llvmpipe-2core.yaml" "$P2"
+project() {  # project <dir> <shadergen_add_vertex_shader calls, one per line, after "app">
+  mkdir -p "$1"
+  {
+    cat <<CMAKE
+cmake_minimum_required(VERSION 3.22)
+project(profiles CXX)
+add_executable(shadergen::shadergen IMPORTED)
+set_target_properties(shadergen::shadergen PROPERTIES IMPORTED_LOCATION "$SG")
+include("$SRC/cmake/ShadergenFunctions.cmake")
+file(WRITE "\${CMAKE_BINARY_DIR}/main.cpp" "int main() {}\n")
+add_executable(app "\${CMAKE_BINARY_DIR}/main.cpp")
+CMAKE
+    while IFS= read -r args; do
+      echo "shadergen_add_vertex_shader(app RIG \"$D/face.rig.yaml\" FRAGMENT \"$D/face.frag\" RULES \"$D/rules.yaml\" $args)"
+    done <<<"$2"
+  } >"$1/CMakeLists.txt"
+}
+
+# name | the function's arguments | the same as generate flags
+cases=(
+  "dawn|DEVICE_PROFILE $P1 $P2 MESH dawn|--device-profile $P1 --device-profile $P2 --mesh dawn"
+  "head|DEVICE_PROFILE $P1 $P2 MESH head|--device-profile $P1 --device-profile $P2 --mesh head"
+  "banned|DEVICE_PROFILE $P1 $P2 MESH dawn BAN skin_matrix_blend|--device-profile $P1 --device-profile $P2 --mesh dawn --ban skin_matrix_blend"
+  "rigid|DEVICE_PROFILE $P1 $P2 MESH dawn SET influences=1|--device-profile $P1 --device-profile $P2 --mesh dawn --set influences=1"
+)
+calls=""
+for c in "${cases[@]}"; do
+  IFS='|' read -r name args _ <<<"$c"
+  calls+="OUTPUT_NAME $name $args"$'\n'
+done
+project "$T/ok" "${calls%$'\n'}"
+cmake -S "$T/ok" -B "$T/ok/b" -G Ninja -DCMAKE_MAKE_PROGRAM="$NINJA" >"$T/cfg.log" 2>&1 || { cat "$T/cfg.log"; fail "configure"; }
+"$NINJA" -C "$T/ok/b" >"$T/build.log" 2>&1 || { cat "$T/build.log"; fail "build"; }
+G="$T/ok/b/shadergen/app"
+
+for c in "${cases[@]}"; do
+  IFS='|' read -r name _ flags <<<"$c"
+  # shellcheck disable=SC2086
+  "$SG" generate --rig "$D/face.rig.yaml" -f "$D/face.frag" -r "$D/rules.yaml" $flags \
+    -o "$T/cli-$name" --emit glsl,spv,reflection -q || fail "generate $flags"
+  for ext in vert spv json; do
+    cmp -s "$G/$name.$ext" "$T/cli-$name.$ext" || fail "$name.$ext differs from generate $flags"
+  done
+  ok "$name: byte-identical to generate $flags"
+done
+
+blend() { grep -o '// [a-z_]* -> skin.matrix' "$G/$1.vert" | cut -d' ' -f2; }
+[ "$(blend dawn)" = skin_matrix_blend ] && [ "$(blend head)" = skin_matrix_blend_buffered_influences_buffer_palette ] &&
+  ok "MESH prices the workload: the portable plan blends from attributes at Dawn scale, from buffers on the head" ||
+  fail "skin blends: dawn '$(blend dawn)', head '$(blend head)'"
+[ -n "$(blend banned)" ] && [ "$(blend banned)" != skin_matrix_blend ] && ok "BAN: $(blend banned) in place of skin_matrix_blend" ||
+  fail "banned plan blends with '$(blend banned)'"
+[ "$(blend rigid)" = skin_matrix_rigid ] && ok "SET influences=1: skin_matrix_rigid" || fail "SET: '$(blend rigid)'"
+
+grep -q "$P2" "$G/dawn.d" && grep -q "$P1" "$G/dawn.d" && ok "the depfile names both profiles" || fail "depfile: $(cat "$G/dawn.d")"
+"$NINJA" -C "$T/ok/b" | grep -qx 'ninja: no work to do.' && ok "no-op rebuild" || fail "a rebuild ran something"
+touch "$P2"
+n=$("$NINJA" -C "$T/ok/b" | grep -c 'shadergen: generating vertex shader')
+[ "$n" = 4 ] && ok "editing the second profile regenerates the 4 shaders" || fail "after touching $P2: $n regenerated"
+
+project "$T/noprofile" "MESH head"
+if cmake -S "$T/noprofile" -B "$T/noprofile/b" -G Ninja -DCMAKE_MAKE_PROGRAM="$NINJA" >"$T/bad1.log" 2>&1; then
+  fail "MESH without DEVICE_PROFILE configured"
+else
+  grep -q 'MESH needs DEVICE_PROFILE' "$T/bad1.log" && ok "MESH without DEVICE_PROFILE: configure error" || fail "$(cat "$T/bad1.log")"
+fi
+project "$T/nomesh" "DEVICE_PROFILE $P1 MESH torso"
+if cmake -S "$T/nomesh" -B "$T/nomesh/b" -G Ninja -DCMAKE_MAKE_PROGRAM="$NINJA" >"$T/bad2.log" 2>&1; then
+  fail "MESH torso configured"
+else
+  grep -q 'MESH must be head, limb or dawn, not' "$T/bad2.log" && grep -q "'torso'" "$T/bad2.log" && ok "an unknown MESH: configure error" || fail "$(cat "$T/bad2.log")"
+fi
+[ "$fails" -eq 0 ] && echo "PASS" || { echo "$fails failure(s)"; exit 1; }
