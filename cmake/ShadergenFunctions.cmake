@@ -233,7 +233,8 @@ endfunction()
 #     MANIFEST <file>            # the variant manifest (YAML)
 #     [OUTPUT_DIR <dir>]         # default: ${CMAKE_CURRENT_BINARY_DIR}/shadergen/<target>/<manifest name>
 #     [RULES <file>...]          # rules files read before the manifest's (e.g. ${SHADERGEN_RULES_DIR}/standard.yaml)
-#     [DEVICE_PROFILE <file>]    # --device-profile for every variant, in place of the manifest's
+#     [DEVICE_PROFILE <file>...] # --device-profile for every variant, in place of the manifest's;
+#                                # several: the portable plan across them
 #     [VALIDATE]                 # --validate: every variant validated after it is built
 #     [CACHE_URL <url>]          # --cache-url: a shared cache over the local one
 #     [ONE_COMMAND]              # one `shadergen build` for the whole manifest instead (below)
@@ -260,7 +261,7 @@ endfunction()
 # the manifest's file name up to the first '.', upper-cased, non-alphanumerics as '_'),
 # also set in the caller's scope.
 function(shadergen_add_shader_variants target)
-  cmake_parse_arguments(PARSE_ARGV 1 SG "VALIDATE;ONE_COMMAND" "MANIFEST;OUTPUT_DIR;JOBS;DEVICE_PROFILE;CACHE_URL" "RULES;DEPENDS")
+  cmake_parse_arguments(PARSE_ARGV 1 SG "VALIDATE;ONE_COMMAND" "MANIFEST;OUTPUT_DIR;JOBS;CACHE_URL" "RULES;DEPENDS;DEVICE_PROFILE")
   if(SG_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "shadergen_add_shader_variants(${target}): unknown arguments: ${SG_UNPARSED_ARGUMENTS}")
   endif()
@@ -292,11 +293,11 @@ function(shadergen_add_shader_variants target)
     get_filename_component(_r "${r}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
     list(APPEND _list_args -r "${_r}")
   endforeach()
-  if(SG_DEVICE_PROFILE)
-    get_filename_component(_profile "${SG_DEVICE_PROFILE}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+  foreach(p IN LISTS SG_DEVICE_PROFILE)
+    get_filename_component(_profile "${p}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
     list(APPEND _list_args --device-profile "${_profile}")
     list(APPEND _extra "${_profile}")
-  endif()
+  endforeach()
   set(_args ${_list_args} -q)
   if(SG_VALIDATE)
     list(APPEND _args --validate)

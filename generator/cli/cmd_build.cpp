@@ -67,7 +67,7 @@ struct BuildCommand {
   std::string output;
   std::string cacheDir;
   std::vector<std::string> rules;
-  std::string deviceProfile;
+  std::vector<std::string> deviceProfiles;
   bool noCache = false;
   unsigned jobs = 0;
   bool quiet = false;
@@ -88,7 +88,10 @@ struct BuildCommand {
     Manifest m = loadManifest(manifest);
     if (!output.empty()) m.outputDir = output;
     m.rules.insert(m.rules.begin(), rules.begin(), rules.end());
-    if (!deviceProfile.empty()) m.deviceProfile = deviceProfile;
+    if (!deviceProfiles.empty()) {
+      m.deviceProfile = deviceProfiles.front();
+      m.portableProfiles.assign(deviceProfiles.begin() + 1, deviceProfiles.end());
+    }
     std::vector<Variant> variants = expandVariants(m);
     if (list) {  // for build systems: the variants and their name-derived outputs
       for (const auto& v : variants) std::cout << v.name << "\n";
@@ -220,9 +223,9 @@ void registerBuild(CLI::App& app, CliState& state) {
   sub->add_option("manifest", cmd->manifest, "Variant manifest (YAML, docs/variants.md)")->required();
   sub->add_option("-o,--output", cmd->output, "Output directory (default: the manifest's 'output')");
   sub->add_option("-r,--rules", cmd->rules, "Rules file read before the manifest's own (repeatable)");
-  sub->add_option("--device-profile", cmd->deviceProfile,
+  sub->add_option("--device-profile", cmd->deviceProfiles,
                   "Device profile (YAML, docs/device-profiles.md) for every variant, in place of the manifest's "
-                  "'device_profile'");
+                  "'device_profile'. Given several times: the portable plan across them, as generate's");
   sub->add_option("--cache-dir", cmd->cacheDir, "Cache directory (default: <output>/.shadergen-cache)");
   sub->add_flag("--no-cache", cmd->noCache, "Neither read nor write the cache");
   sub->add_option("-j,--jobs", cmd->jobs, "Worker threads (default: every hardware thread)");

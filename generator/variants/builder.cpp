@@ -35,6 +35,7 @@ struct SharedInputs {
   std::map<std::string, FragmentInterface> fragments;  // by path
   std::map<std::string, std::string> digests;          // file -> SHA-256 of its bytes (cache keys)
   std::optional<DeviceProfile> profile;                // the manifest's device_profile
+  std::vector<DeviceProfile> portable;                 // the rest of its list (a portable plan)
 };
 
 SharedInputs loadShared(const Manifest& m, const std::vector<Variant>& variants, const GltfReadOptions& gltf,
@@ -75,6 +76,10 @@ SharedInputs loadShared(const Manifest& m, const std::vector<Variant>& variants,
     s.profile = loadDeviceProfileStage(m.deviceProfile);
     keep(m.deviceProfile);
   }
+  for (const auto& p : m.portableProfiles) {
+    s.portable.push_back(loadDeviceProfileStage(p));
+    keep(p);
+  }
   return s;
 }
 
@@ -84,6 +89,7 @@ std::vector<std::string> inputsOf(const SharedInputs& s, const Variant& v) {
   files.insert(files.end(), s.rules.files.begin(), s.rules.files.end());
   files.push_back(s.templates.file());
   if (s.profile) files.push_back(s.profile->file);  // an input, so part of the cache key and the depfile
+  for (const auto& d : s.portable) files.push_back(d.file);
   return files;
 }
 
@@ -225,6 +231,7 @@ GenerateOptions generateOptionsOf(const Manifest& m, const Variant& v, const Bui
   o.targetEnv = m.targetEnv;
   o.optimize = m.optimize;
   o.deviceProfilePath = m.deviceProfile;
+  o.portableProfilePaths = m.portableProfiles;
   o.outputName = (fs::path(m.outputDir) / (v.name + ".vert")).string();
   return o;
 }
@@ -243,7 +250,7 @@ void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v,
   GenerateOptions o = generateOptionsOf(m, v, opts);
   if (m.emits("hlsl")) o.hlsl = m.hlsl;
   if (m.emits("msl")) o.msl = m.msl;
-  LoadedInputs in = prepareInputs(std::move(rig), s.rules, s.fragments.at(v.pass->fragment), o, s.profile);
+  LoadedInputs in = prepareInputs(std::move(rig), s.rules, s.fragments.at(v.pass->fragment), o, s.profile, s.portable);
   GenerateResult r = generateWith(std::move(in), s.templates, o);
   out.cost = r.plan.cost;
   for (int a : r.plan.actions) out.rules.push_back(r.in.problem.actions[a].name);
@@ -350,8 +357,13 @@ std::string indexJson(const Manifest& m, const std::vector<std::string>& entries
   if (m.emits("msl"))
     out += fmt::format("  \"msl_version\": {},\n  \"msl_platform\": {},\n", jsonString(mslVersionName(m.msl)),
                        jsonString(mslPlatformName(m.msl.platform)));
-  if (!m.deviceProfile.empty())  // then "cost" is femtoseconds per vertex on that device
+  if (!m.deviceProfile.empty() && m.portableProfiles.empty())  // then "cost" is femtoseconds per vertex on that device
     out += fmt::format("  \"device_profile\": {},\n", jsonString(m.deviceProfile));
+  if (!m.portableProfiles.empty()) {  // then "cost" is the worst-case regret: predicted time over the device's best, times 10^9
+    std::string list = jsonString(m.deviceProfile);
+    for (const auto& p : m.portableProfiles) list += ", " + jsonString(p);
+    out += fmt::format("  \"device_profiles\": [{}],\n", list);
+  }
   if (!m.maxError.empty()) {  // in each encoding's unit (degrees, or a fraction of the bounds diagonal)
     std::string budgets;
     for (const auto& [semantic, budget] : m.maxError)

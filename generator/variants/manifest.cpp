@@ -125,7 +125,18 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
     if (!parseTargetEnv(env, m.targetEnv))
       y.fail(root["target_env"], fmt::format("unknown target_env '{}' (vulkan1.0, vulkan1.1, vulkan1.2, vulkan1.3)", env));
   }
-  if (root["device_profile"]) m.deviceProfile = resolvePath(file, y.scalar(root["device_profile"], "'device_profile'"));
+  if (root["device_profile"]) {  // one profile, or a list: the portable plan across them
+    std::vector<std::string> profiles = scalarOrList(y, root["device_profile"], "'device_profile'");
+    if (profiles.empty()) y.fail(root["device_profile"], "'device_profile' is an empty list (leave it out for instruction slots)");
+    for (size_t i = 0; i < profiles.size(); ++i) {
+      profiles[i] = resolvePath(file, profiles[i]);
+      for (size_t j = 0; j < i; ++j)
+        if (profiles[j] == profiles[i])
+          y.fail(root["device_profile"][i], fmt::format("device profile '{}' is listed twice", profiles[i]));
+    }
+    m.deviceProfile = profiles.front();
+    m.portableProfiles.assign(profiles.begin() + 1, profiles.end());
+  }
   if (root["mesh"]) {  // the procedural mesh YAML rigs' programs draw (their workload)
     m.mesh = y.scalar(root["mesh"], "'mesh'");
     if (m.mesh != "head" && m.mesh != "limb" && m.mesh != "dawn")

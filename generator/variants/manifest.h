@@ -86,6 +86,9 @@ struct Manifest {
   // `max_error:` error budgets per encoded semantic, in its encodings' unit (GenerateOptions::maxError).
   std::map<std::string, double> maxError;
   std::string deviceProfile;  // `device_profile:` (docs/device-profiles.md); "" = instruction slots
+  // `device_profile: [a, b, ...]`: the rest of the list, a portable plan across every profile
+  // (GenerateOptions::portableProfilePaths); empty with one profile.
+  std::vector<std::string> portableProfiles;
   // `mesh:` the procedural mesh (head, limb, dawn) whose workload YAML rigs are priced for
   // under the device profile; glTF rigs are measured on their own mesh. "" = unknown.
   std::string mesh;

@@ -3,7 +3,8 @@
 # each shader is byte-identical to `shadergen generate` with the same flags; the mesh, a ban and
 # a --set each change the plan as they do on the command line; both profiles are dependencies
 # (editing the second regenerates the shaders, nothing else does); MESH without a profile, or
-# a mesh that does not exist, is a configure error.
+# a mesh that does not exist, is a configure error. shadergen_add_shader_variants(... DEVICE_PROFILE
+# <a> <b>): each variant is generate's portable plan, and index.json lists both profiles.
 #
 #   profile_test.sh <shadergen> <source dir> <ninja>
 set -uo pipefail
@@ -77,6 +78,32 @@ grep -q "$P2" "$G/dawn.d" && grep -q "$P1" "$G/dawn.d" && ok "the depfile names 
 touch "$P2"
 n=$("$NINJA" -C "$T/ok/b" | grep -c 'shadergen: generating vertex shader')
 [ "$n" = 4 ] && ok "editing the second profile regenerates the 4 shaders" || fail "after touching $P2: $n regenerated"
+
+# The same two profiles for a manifest's variants, one build edge each.
+cat >"$T/m.variants.yaml" <<YAML
+rules: $D/rules.yaml
+mesh: head
+rigs: { face: $D/face.rig.yaml }
+passes: { color: $D/face.frag }
+YAML
+mkdir -p "$T/var"
+cat >"$T/var/CMakeLists.txt" <<CMAKE
+cmake_minimum_required(VERSION 3.22)
+project(variants CXX)
+add_executable(shadergen::shadergen IMPORTED)
+set_target_properties(shadergen::shadergen PROPERTIES IMPORTED_LOCATION "$SG")
+include("$SRC/cmake/ShadergenFunctions.cmake")
+file(WRITE "\${CMAKE_BINARY_DIR}/main.cpp" "int main() {}\n")
+add_executable(app "\${CMAKE_BINARY_DIR}/main.cpp")
+shadergen_add_shader_variants(app MANIFEST "$T/m.variants.yaml" DEVICE_PROFILE "$P1" "$P2")
+CMAKE
+cmake -S "$T/var" -B "$T/var/b" -G Ninja -DCMAKE_MAKE_PROGRAM="$NINJA" >"$T/vcfg.log" 2>&1 || { cat "$T/vcfg.log"; fail "configure variants"; }
+"$NINJA" -C "$T/var/b" >"$T/vbuild.log" 2>&1 || { cat "$T/vbuild.log"; fail "build variants"; }
+V="$T/var/b/shadergen/app/m"
+cmp -s "$V/face-color.vert" "$T/cli-head.vert" && ok "the manifest's variant is generate's portable plan on the head" ||
+  fail "face-color.vert differs from generate --device-profile $P1 --device-profile $P2 --mesh head"
+grep -q "\"device_profiles\": \[\"$P1\", \"$P2\"\]" "$V/index.json" && ok "index.json lists both profiles" ||
+  fail "index.json: $(head -8 "$V/index.json")"
 
 project "$T/noprofile" "MESH head"
 if cmake -S "$T/noprofile" -B "$T/noprofile/b" -G Ninja -DCMAKE_MAKE_PROGRAM="$NINJA" >"$T/bad1.log" 2>&1; then

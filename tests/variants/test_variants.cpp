@@ -524,6 +524,69 @@ TEST(Build, TheWorkloadIsRecordedAndKeyed) {
   EXPECT_EQ(d.loc.line, 6);
 }
 
+// `device_profile: [a, b]` (docs/variants.md, "Device profiles"): every variant is the portable
+// plan generate() writes with --device-profile a --device-profile b, which on the head is neither
+// device's own choice; index.json lists the profiles; each profile's bytes are in the key; an empty
+// list or a profile listed twice is a located error.
+TEST(Build, AListOfProfilesBuildsThePortablePlan) {
+  auto dir = freshDir("portable");
+  fs::copy_file(std::string(SG_SOURCE_DIR) + "/devices/nvidia-h200-raster.yaml", dir / "gpu.yaml");
+  fs::copy_file(std::string(SG_SOURCE_DIR) + "/devices/llvmpipe-2core.yaml", dir / "cpu.yaml");
+  auto manifest = [&](const std::string& profiles) {
+    writeText(dir / "m.yaml", "output: out\nrules: " + kDawn + "rules.yaml\n" + profiles + "mesh: head\n" +
+                                  "rigs:\n  face: " + kDawn + "face.rig.yaml\npasses:\n  color: " + kDawn + "face.frag\n" +
+                                  "axes:\n  influences: [4, 2]\n");
+    return loadManifest((dir / "m.yaml").string());
+  };
+  Manifest m = manifest("device_profile:\n  - gpu.yaml\n  - cpu.yaml\n");
+  EXPECT_EQ(m.deviceProfile, (dir / "gpu.yaml").string());
+  EXPECT_EQ(m.portableProfiles, std::vector<std::string>{(dir / "cpu.yaml").string()});
+  const std::vector<Variant> variants = expandVariants(m);
+  ASSERT_EQ(variants.size(), 2u);
+  BuildOptions bo;
+  const Workload head{2009, 12.23, -1, 2.071, "procedural mesh 'head'"};
+  for (const auto& v : variants) bo.workloads[v.name] = head;
+  BuildReport r = buildVariants(m, variants, bo);
+  ASSERT_EQ(r.failed, 0u);
+  const auto files = filesOf(r);
+  for (const auto& b : r.variants) {
+    GenerateOptions o = generateCommandOf(m, b);
+    o.deviceProfilePath = (dir / "gpu.yaml").string();
+    o.portableProfilePaths = {(dir / "cpu.yaml").string()};
+    o.workload = head;
+    const GenerateResult portable = generate(o);
+    EXPECT_EQ(files.at(b.outputs.at("glsl")), portable.glsl.text) << b.variant->name;
+    EXPECT_EQ(files.at(b.outputs.at("reflection")), reflectionOf(portable)) << b.variant->name;
+    // Neither device's own plan: the choice is the compromise, not the first profile's.
+    for (const std::string& alone : {o.deviceProfilePath, o.portableProfilePaths[0]}) {
+      GenerateOptions one = o;
+      one.deviceProfilePath = alone;
+      one.portableProfilePaths.clear();
+      if (b.variant->params.at("influences") == 4) EXPECT_NE(generate(one).glsl.text, portable.glsl.text) << alone;
+    }
+  }
+  const std::string& index = files.at(r.indexPath);
+  EXPECT_NE(index.find("\"device_profiles\": [\"" + (dir / "gpu.yaml").string() + "\", \"" + (dir / "cpu.yaml").string() + "\"]"),
+            std::string::npos)
+      << index;
+  EXPECT_EQ(index.find("\"device_profile\""), std::string::npos);
+
+  // One profile is another key; so is the second profile's content.
+  Manifest single = manifest("device_profile: gpu.yaml\n");
+  EXPECT_TRUE(single.portableProfiles.empty());
+  EXPECT_NE(buildVariants(single, expandVariants(single), bo).variants[0].key, r.variants[0].key);
+  writeText(dir / "cpu.yaml", readAll(dir / "cpu.yaml") + "# edited\n");
+  m = manifest("device_profile: [gpu.yaml, cpu.yaml]\n");
+  EXPECT_NE(buildVariants(m, expandVariants(m), bo).variants[0].key, r.variants[0].key);
+
+  Diagnostic d = errorOf([&] { manifest("device_profile: []\n"); });
+  EXPECT_NE(d.message.find("'device_profile' is an empty list"), std::string::npos) << d.message;
+  EXPECT_EQ(d.loc.line, 3);
+  d = errorOf([&] { manifest("device_profile:\n  - gpu.yaml\n  - ./gpu.yaml\n"); });
+  EXPECT_NE(d.message.find("gpu.yaml' is listed twice"), std::string::npos) << d.message;
+  EXPECT_EQ(d.loc.line, 5);
+}
+
 // A rig's `ban:` (docs/variants.md, "Pinning a plan"): its variants are generate()'s with those
 // --bans, byte for byte; the bans are in the cache key (the rig's variants regenerate, the
 // others stay cached); a misspelt rule name is an error at the ban's line.
