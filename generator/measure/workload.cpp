@@ -35,7 +35,10 @@ Workload measureWorkload(const rt::Mesh& mesh, const std::vector<uint32_t>& indi
       }
   }
 
-  // Distinct joints per warp-sized group and influence slot, over influences that weigh.
+  // Distinct joints per warp-sized group and influence slot, over influences that weigh; and
+  // per group over all its slots.
+  const size_t groups = (order.size() + kWorkloadWarp - 1) / kWorkloadWarp;
+  std::vector<std::set<float>> footprint(groups);
   double sum = 0;
   size_t pairs = 0;
   for (int set = 0;; ++set) {
@@ -51,9 +54,18 @@ Workload measureWorkload(const rt::Mesh& mesh, const std::vector<uint32_t>& indi
         if (joints.empty()) continue;
         sum += double(joints.size());
         ++pairs;
+        footprint[g / kWorkloadWarp].insert(joints.begin(), joints.end());
       }
   }
   if (pairs) w.jointsPerWarp = sum / double(pairs);
+  double entries = 0;
+  size_t skinned = 0;
+  for (const auto& f : footprint)
+    if (!f.empty()) {
+      entries += double(f.size());
+      ++skinned;
+    }
+  if (skinned) w.paletteEntriesPerWarp = entries / double(skinned);
 
   // Post-transform cache reuse (meshoptimizer's FIFO model), per vertex the draw shades.
   if (triangles && !order.empty()) {
@@ -143,7 +155,7 @@ Workload rigWorkload(const std::string& rigPath, const std::map<std::string, int
     const auto lod = params.find("influences");
     Workload w = measureWorkload(vs.mesh, indices, triangles, active, source,
                                  lod == params.end() ? -1 : int(lod->second));
-    if (!d.indicesError.empty()) w.jointsPerWarp = 0;  // no shading order known
+    if (!d.indicesError.empty()) w.jointsPerWarp = w.paletteEntriesPerWarp = 0;  // no shading order known
     return w;
   }
   Workload w;

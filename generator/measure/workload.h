@@ -11,6 +11,9 @@
 //   number of distinct joint indices among the group's vertices whose weight in that slot is
 //   non-zero; the mean over the (group, slot) pairs that have at least one such vertex. So
 //   1 <= jointsPerWarp <= min(32, joints of the skin); 0 when nothing is skinned.
+// - paletteEntriesPerWarp: the same groups, the distinct joint indices over all their
+//   weighted slots together (a warp's palette footprint); the mean over the groups that have
+//   one. jointsPerWarp <= paletteEntriesPerWarp <= min(32 x slots, joints); 0 unskinned.
 // - activeMorphTargets: the most morph targets with a non-zero weight at once: over every
 //   animation that drives the primitive's mesh node, sampled at its keyframes and halfway
 //   between them; else the node's or mesh's default weights. Procedural meshes have no

@@ -26,6 +26,11 @@ struct Workload {
   // invocations over vertices; measure/workload.h: bench and calibrate count them, a generation
   // is told or does not know). 0 = unknown.
   double fragmentsPerVertex = 0;
+  // Mean over jointsPerWarp's groups of the distinct joint indices a group reads over all its
+  // influence slots together: the palette entries one warp's palette loads touch, its share
+  // of the constant cache (docs/device-profiles.md, "The constant cache's capacity"). Shown,
+  // not priced: no profile term is scaled by it. 0 = unknown or unskinned.
+  double paletteEntriesPerWarp = 0;
 
   bool known() const {
     return verticesPerDraw > 0 || jointsPerWarp > 0 || activeMorphTargets >= 0 || invocationsPerVertex > 0 || fragmentsPerVertex > 0;

@@ -37,6 +37,12 @@ TEST(Workload, JointsPerWarpCountsDistinctWeightedJointsPerGroupAndSlot) {
   EXPECT_DOUBLE_EQ(wl.jointsPerWarp, 3.0);
   // A rig reading only the first influence: slot 0 alone, 4 per group.
   EXPECT_DOUBLE_EQ(measureWorkload(m, {}, false, -1, "hand", 1).jointsPerWarp, 4.0);
+  // A warp's palette footprint, every weighted slot together: {0,1,2,3,7} and {0,1,2,3}.
+  EXPECT_DOUBLE_EQ(wl.paletteEntriesPerWarp, 4.5);
+  EXPECT_DOUBLE_EQ(measureWorkload(m, {}, false, -1, "hand", 1).paletteEntriesPerWarp, 4.0);
+  for (size_t v = 0; v < 32; ++v) j[v].y = 3;  // slot 1 reads a joint slot 0 reads too: one entry
+  EXPECT_DOUBLE_EQ(measureWorkload(m, {}, false, -1, "hand").paletteEntriesPerWarp, 4.0);
+  EXPECT_DOUBLE_EQ(measureWorkload(m, {}, false, -1, "hand").jointsPerWarp, 3.0);
   EXPECT_DOUBLE_EQ(wl.verticesPerDraw, 64);
   EXPECT_EQ(wl.activeMorphTargets, -1);
   EXPECT_EQ(wl.invocationsPerVertex, 0);  // not triangles: unknown
@@ -69,6 +75,7 @@ TEST(Workload, UnskinnedMeshesHaveNoJointsPerWarp) {
   EXPECT_EQ(measureWorkload(m, {0, 1, 2}, true, 0, "").jointsPerWarp, 0);
   rt::Mesh z = skinned(3);  // streams present, every weight 0
   EXPECT_EQ(measureWorkload(z, {0, 1, 2}, true, 0, "").jointsPerWarp, 0);
+  EXPECT_EQ(measureWorkload(z, {0, 1, 2}, true, 0, "").paletteEntriesPerWarp, 0);
 }
 
 TEST(Workload, InvocationsPerVertexCountTransformsPerShadedVertex) {
