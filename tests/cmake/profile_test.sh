@@ -19,10 +19,9 @@ D="$SRC/examples/dawn"
 P1="$T/h200.yaml" P2="$T/llvmpipe.yaml"
 cp "$SRC/devices/nvidia-h200-raster.yaml" "$P1"
 cp "$SRC/devices/llvmpipe-2core.yaml" "$P2"
-project() {  # project <dir> <shadergen_add_vertex_shader calls, one per line, after "app">
+project() {  # project <dir> <calls>: a project whose target `app` gets <calls> (CMake lines)
   mkdir -p "$1"
-  {
-    cat <<CMAKE
+  cat >"$1/CMakeLists.txt" <<CMAKE
 cmake_minimum_required(VERSION 3.22)
 project(profiles CXX)
 add_executable(shadergen::shadergen IMPORTED)
@@ -30,11 +29,15 @@ set_target_properties(shadergen::shadergen PROPERTIES IMPORTED_LOCATION "$SG")
 include("$SRC/cmake/ShadergenFunctions.cmake")
 file(WRITE "\${CMAKE_BINARY_DIR}/main.cpp" "int main() {}\n")
 add_executable(app "\${CMAKE_BINARY_DIR}/main.cpp")
+$2
 CMAKE
-    while IFS= read -r args; do
-      echo "shadergen_add_vertex_shader(app RIG \"$D/face.rig.yaml\" FRAGMENT \"$D/face.frag\" RULES \"$D/rules.yaml\" $args)"
-    done <<<"$2"
-  } >"$1/CMakeLists.txt"
+}
+shaders() {  # shaders <dir> <shadergen_add_vertex_shader arguments after the face's inputs, one call per line>
+  local calls=""
+  while IFS= read -r args; do
+    calls+="shadergen_add_vertex_shader(app RIG \"$D/face.rig.yaml\" FRAGMENT \"$D/face.frag\" RULES \"$D/rules.yaml\" $args)"$'\n'
+  done <<<"$2"
+  project "$1" "$calls"
 }
 
 # name | the function's arguments | the same as generate flags
@@ -49,7 +52,7 @@ for c in "${cases[@]}"; do
   IFS='|' read -r name args _ <<<"$c"
   calls+="OUTPUT_NAME $name $args"$'\n'
 done
-project "$T/ok" "${calls%$'\n'}"
+shaders "$T/ok" "${calls%$'\n'}"
 cmake -S "$T/ok" -B "$T/ok/b" -G Ninja -DCMAKE_MAKE_PROGRAM="$NINJA" >"$T/cfg.log" 2>&1 || { cat "$T/cfg.log"; fail "configure"; }
 "$NINJA" -C "$T/ok/b" >"$T/build.log" 2>&1 || { cat "$T/build.log"; fail "build"; }
 G="$T/ok/b/shadergen/app"
@@ -86,17 +89,7 @@ mesh: head
 rigs: { face: $D/face.rig.yaml }
 passes: { color: $D/face.frag }
 YAML
-mkdir -p "$T/var"
-cat >"$T/var/CMakeLists.txt" <<CMAKE
-cmake_minimum_required(VERSION 3.22)
-project(variants CXX)
-add_executable(shadergen::shadergen IMPORTED)
-set_target_properties(shadergen::shadergen PROPERTIES IMPORTED_LOCATION "$SG")
-include("$SRC/cmake/ShadergenFunctions.cmake")
-file(WRITE "\${CMAKE_BINARY_DIR}/main.cpp" "int main() {}\n")
-add_executable(app "\${CMAKE_BINARY_DIR}/main.cpp")
-shadergen_add_shader_variants(app MANIFEST "$T/m.variants.yaml" DEVICE_PROFILE "$P1" "$P2")
-CMAKE
+project "$T/var" "shadergen_add_shader_variants(app MANIFEST \"$T/m.variants.yaml\" DEVICE_PROFILE \"$P1\" \"$P2\")"
 cmake -S "$T/var" -B "$T/var/b" -G Ninja -DCMAKE_MAKE_PROGRAM="$NINJA" >"$T/vcfg.log" 2>&1 || { cat "$T/vcfg.log"; fail "configure variants"; }
 "$NINJA" -C "$T/var/b" >"$T/vbuild.log" 2>&1 || { cat "$T/vbuild.log"; fail "build variants"; }
 V="$T/var/b/shadergen/app/m"
@@ -105,13 +98,13 @@ cmp -s "$V/face-color.vert" "$T/cli-head.vert" && ok "the manifest's variant is 
 grep -q "\"device_profiles\": \[\"$P1\", \"$P2\"\]" "$V/index.json" && ok "index.json lists both profiles" ||
   fail "index.json: $(head -8 "$V/index.json")"
 
-project "$T/noprofile" "MESH head"
+shaders "$T/noprofile" "MESH head"
 if cmake -S "$T/noprofile" -B "$T/noprofile/b" -G Ninja -DCMAKE_MAKE_PROGRAM="$NINJA" >"$T/bad1.log" 2>&1; then
   fail "MESH without DEVICE_PROFILE configured"
 else
   grep -q 'MESH needs DEVICE_PROFILE' "$T/bad1.log" && ok "MESH without DEVICE_PROFILE: configure error" || fail "$(cat "$T/bad1.log")"
 fi
-project "$T/nomesh" "DEVICE_PROFILE $P1 MESH torso"
+shaders "$T/nomesh" "DEVICE_PROFILE $P1 MESH torso"
 if cmake -S "$T/nomesh" -B "$T/nomesh/b" -G Ninja -DCMAKE_MAKE_PROGRAM="$NINJA" >"$T/bad2.log" 2>&1; then
   fail "MESH torso configured"
 else
