@@ -45,6 +45,15 @@ Result generate(const Options& options) {
     o.optimize = options.optimize;
     o.templateDir = options.templates;
     o.deviceProfilePath = options.deviceProfile;
+    o.portableProfilePaths = options.portableProfiles;
+    o.bannedRules = options.bannedRules;
+    const Workload& w = options.workload;
+    o.workload.verticesPerDraw = w.verticesPerDraw;
+    o.workload.jointsPerWarp = w.jointsPerWarp;
+    o.workload.activeMorphTargets = w.activeMorphTargets;
+    o.workload.invocationsPerVertex = w.invocationsPerVertex;
+    o.workload.fragmentsPerVertex = w.fragmentsPerVertex;
+    if (o.workload.known()) o.workload.source = "given by the caller";
     o.gltf.normalizeWeights = options.normalizeSkinWeights;
     o.gltf.warningsAsErrors = options.warningsAsErrors;
     if (!options.hlslShaderModel.empty()) {

@@ -15,6 +15,19 @@
 
 namespace shadergen {
 
+// What the mesh the program will draw looks like to the device (docs/device-profiles.md,
+// "Workload"): a device profile's weights may depend on it. `shadergen explain --device-profile`
+// prints these figures for a glTF rig's own mesh or a procedural one; the library prices the
+// ones it is given (a glTF rig is not measured here: that takes the measuring stage). Each
+// left at its default is unknown, priced at the profile's default.
+struct Workload {
+  double verticesPerDraw = 0;       // vertices of one draw
+  double jointsPerWarp = 0;         // distinct joints a warp's palette load reads, per influence slot
+  double activeMorphTargets = -1;   // morph targets with a non-zero weight at once (-1: all)
+  double invocationsPerVertex = 0;  // vertex-shader runs per vertex (post-transform cache)
+  double fragmentsPerVertex = 0;    // fragments one draw covers, per vertex
+};
+
 struct Options {
   std::string rig;                   // rig YAML, or a glTF model "model.glb#mesh/primitive"
   std::string fragment;              // the fragment shader to feed (GLSL 450)
@@ -26,6 +39,12 @@ struct Options {
   bool optimize = false;             // spirv-opt -O
   std::string templates;             // "" = the templates installed with shadergen
   std::string deviceProfile;         // device profile YAML (docs/device-profiles.md); "" = instruction slots
+  // More devices' profiles: with deviceProfile, the portable plan, least worst-case regret
+  // across all of them (like --device-profile given several times); `cost` is then that regret
+  // times 10^9.
+  std::vector<std::string> portableProfiles;
+  Workload workload;                 // with a profile: the mesh it prices (like --mesh)
+  std::vector<std::string> bannedRules;  // rules the search may not use (like --ban): pin a plan
   // Also the program for Direct3D / Metal, translated from the SPIR-V (docs/hlsl-msl.md);
   // their bindings go into `reflection`. "" = not made.
   std::string hlslShaderModel;       // "5.0", "5.1", "6.0" .. "6.7"
@@ -52,9 +71,11 @@ struct Result {
   std::vector<uint32_t> spirv;        // validated SPIR-V
   std::string reflection;             // JSON: vertex inputs, uniform layout, outputs (+ HLSL/MSL bindings)
   std::string hlsl, msl;              // when asked for (Options::hlslShaderModel, mslVersion)
-  int64_t cost = 0;                   // plan cost: instruction slots, or femtoseconds per vertex with a profile
+  // Plan cost: instruction slots, or femtoseconds per vertex with a profile (with portable
+  // profiles: the plan's worst regret, times 10^9).
+  int64_t cost = 0;
   // With a device profile: the plan's amount and predicted nanoseconds per vertex of each
-  // cost term ("arithmetic", "locations", ...), and their sum.
+  // cost term ("arithmetic", "locations", ...), and their sum (on Options::deviceProfile's device).
   std::map<std::string, int64_t> termAmounts;
   std::map<std::string, double> termNanoseconds;
   double predictedNanoseconds = 0;
