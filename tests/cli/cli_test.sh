@@ -513,9 +513,10 @@ device_profile)
     fail "per-vertex prediction $dawn_total at 180000, $head_total at 2010"
   # SIGINT stops calibrate's timing and keeps what was timed (a fitted profile and a note), or,
   # before anything was timed, fails saying so: never a death by the signal (exit 130). Dawn scale
-  # after the head keeps it timing well past the signal (the head alone took 4.2 s here, and the
-  # signal at 4 s sometimes came after the end).
-  "$SG" calibrate "${DAWN[@]}" --meshes head,dawn --draws 2 --frames 2 --rounds 1 --no-validation-layers -o int.yaml \
+  # after the head, 10 rounds, keeps it timing well past the signal on any machine (one round of
+  # the head alone took 4.2 s here, and the signal at 4 s sometimes came after the end); the
+  # signal ends the rounds, so they cost nothing.
+  "$SG" calibrate "${DAWN[@]}" --meshes head,dawn --draws 2 --frames 2 --rounds 10 --no-validation-layers -o int.yaml \
     >int.out 2>int.err &
   pid=$!
   sleep 4
@@ -532,7 +533,7 @@ device_profile)
   # `timeout -s INT` (the bench scripts' time limits) signals the command and then its process
   # group: two SIGINTs a moment apart are one interrupt, not the second that ends the process
   # (ending on timeout's copy lost every timed sample, bench/data/h200-linear-blend13).
-  "$SG" calibrate "${DAWN[@]}" --meshes head,dawn --draws 2 --frames 2 --rounds 1 --no-validation-layers -o int2.yaml \
+  "$SG" calibrate "${DAWN[@]}" --meshes head,dawn --draws 2 --frames 2 --rounds 10 --no-validation-layers -o int2.yaml \
     >int2.out 2>int2.err &
   pid=$!
   sleep 4
