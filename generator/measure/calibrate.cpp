@@ -618,6 +618,7 @@ std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, cons
     optional("median round ns/vertex", s.medianRoundNs);
     optional("shaded vertices per vertex", s.shadedPerVertex);
     optional("fragments per vertex", s.workload.fragmentsPerVertex);
+    optional("palette entries per warp", s.workload.paletteEntriesPerWarp);
     s.validated = true;
     samples.push_back(s);
   }
@@ -675,7 +676,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
       s.vertices = double(m.mesh.vertexCount);
       // The palette probe at a uniform index reads one address per warp, whatever the mesh.
       s.workload = probeWorkload;
-      if (p.label.find("uniform index") != std::string::npos) s.workload.jointsPerWarp = 1;
+      if (p.label.find("uniform index") != std::string::npos) s.workload.jointsPerWarp = s.workload.paletteEntriesPerWarp = 1;
       s.amounts = p.amounts;
       try {
         GlslShader renderShader = compileProbe(Stage::Vertex, probeGlsl(p, false), p.label);
@@ -916,9 +917,9 @@ std::string formatCalibration(const CalibrationReport& r) {
   std::string s = fmt::format("device: {} (driver: {}); clock: {}\n\n| mesh | rig | program | ", r.device, r.driver, r.clock);
   for (int t = 0; t < kTermCount; ++t) s += fmt::format("{} | ", termName(t));
   s += "measured ns/vertex | predicted | joints per warp | vertices per draw | median round ns/vertex | "
-       "shaded vertices per vertex | fragments per vertex |\n|---|---|---|";
+       "shaded vertices per vertex | fragments per vertex | palette entries per warp |\n|---|---|---|";
   for (int t = 0; t < kTermCount; ++t) s += "---:|";
-  s += "---:|---:|---:|---:|---:|---:|---:|\n";
+  s += "---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const auto& x : r.samples) {
     s += fmt::format("| {} | {} | {} | ", x.mesh, x.rig.empty() ? "—" : x.rig, x.label);
     for (int t = 0; t < kTermCount; ++t) s += fmt::format("{} | ", x.amounts[size_t(t)]);
@@ -930,7 +931,9 @@ std::string formatCalibration(const CalibrationReport& r) {
     s += x.medianRoundNs >= 0 ? fmt::format("{:.4f} | ", x.medianRoundNs) : "— | ";
     // What the device shaded for one draw of its mesh (raster on): the harness's share of the time.
     s += x.shadedPerVertex >= 0 ? fmt::format("{:.4f} | ", x.shadedPerVertex) : "— | ";
-    s += x.workload.fragmentsPerVertex > 0 ? fmt::format("{:.4f} |\n", x.workload.fragmentsPerVertex) : "— |\n";
+    s += x.workload.fragmentsPerVertex > 0 ? fmt::format("{:.4f} | ", x.workload.fragmentsPerVertex) : "— | ";
+    // A warp's palette footprint (shown, not priced): a later fit's feature, kept with the timing.
+    s += x.workload.paletteEntriesPerWarp > 0 ? fmt::format("{:.4f} |\n", x.workload.paletteEntriesPerWarp) : "— |\n";
   }
   s += "\nfitted (ns per unit per vertex; draw weights: ns per unit per draw):\n" + weightLines(r.profile);
   for (const auto& f : r.fits) s += fitLine(f) + "\n";

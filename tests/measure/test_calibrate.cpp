@@ -504,10 +504,17 @@ TEST(Calibrate, TheLimbMeshTimesProbesAndPlansAtTheLimbsSize) {
   std::istringstream log(formatCalibration(r));
   const std::vector<CalibrationSample> back = parseCalibrationSamples(log, {}, "");
   ASSERT_EQ(back.size(), r.samples.size());
+  size_t wider = 0;  // samples whose warps read more palette entries over all slots than in one
   for (size_t i = 0; i < back.size(); ++i) {
     EXPECT_NEAR(back[i].shadedPerVertex, r.samples[i].shadedPerVertex, 1e-4) << back[i].label;
     EXPECT_NEAR(back[i].workload.fragmentsPerVertex, r.samples[i].workload.fragmentsPerVertex, 1e-4) << back[i].label;
+    // The palette footprint is logged with the timing (a later fit's feature), and no smaller
+    // than the joints one slot reads.
+    EXPECT_NEAR(back[i].workload.paletteEntriesPerWarp, r.samples[i].workload.paletteEntriesPerWarp, 1e-4) << back[i].label;
+    EXPECT_GE(r.samples[i].workload.paletteEntriesPerWarp, r.samples[i].workload.jointsPerWarp) << back[i].label;
+    wider += r.samples[i].workload.paletteEntriesPerWarp > r.samples[i].workload.jointsPerWarp + 0.5;
   }
+  EXPECT_GT(wider, 0u);  // the 16-influence limb: its slots index different joints
   // The log says how it was timed.
   EXPECT_NE(formatCalibration(r).find("over 1 draws per frame (a smaller mesh more: at least 0 vertices), median of 1 frames"),
             std::string::npos);
