@@ -343,6 +343,13 @@ std::string jsonString(const std::string& s) {
   return out + "\"";
 }
 
+// ["a", "b"]: the index's lists of names and paths.
+std::string jsonStringArray(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& item : items) out += (out.empty() ? "" : ", ") + jsonString(item);
+  return "[" + out + "]";
+}
+
 std::string relativeTo(const std::string& dir, const std::string& path) {
   return fs::path(path).lexically_relative(dir).generic_string();
 }
@@ -360,9 +367,9 @@ std::string indexJson(const Manifest& m, const std::vector<std::string>& entries
   if (!m.deviceProfile.empty() && m.portableProfiles.empty())  // then "cost" is femtoseconds per vertex on that device
     out += fmt::format("  \"device_profile\": {},\n", jsonString(m.deviceProfile));
   if (!m.portableProfiles.empty()) {  // then "cost" is the worst-case regret: predicted time over the device's best, times 10^9
-    std::string list = jsonString(m.deviceProfile);
-    for (const auto& p : m.portableProfiles) list += ", " + jsonString(p);
-    out += fmt::format("  \"device_profiles\": [{}],\n", list);
+    std::vector<std::string> profiles{m.deviceProfile};
+    profiles.insert(profiles.end(), m.portableProfiles.begin(), m.portableProfiles.end());
+    out += fmt::format("  \"device_profiles\": {},\n", jsonStringArray(profiles));
   }
   if (!m.maxError.empty()) {  // in each encoding's unit (degrees, or a fraction of the bounds diagonal)
     std::string budgets;
@@ -370,9 +377,7 @@ std::string indexJson(const Manifest& m, const std::vector<std::string>& entries
       budgets += fmt::format("{}{}: {:.17g}", budgets.empty() ? "" : ", ", jsonString(semantic), budget);
     out += fmt::format("  \"max_error\": {{{}}},\n", budgets);
   }
-  std::string rules;
-  for (const auto& f : m.rules) rules += (rules.empty() ? "" : ", ") + jsonString(f);
-  out += fmt::format("  \"rules\": [{}],\n", rules);
+  out += fmt::format("  \"rules\": {},\n", jsonStringArray(m.rules));
   out += fmt::format("  \"variants\": [\n");
   for (size_t i = 0; i < entries.size(); ++i) out += entries[i] + (i + 1 < entries.size() ? ",\n" : "\n");
   out += "  ]\n}\n";
@@ -394,14 +399,9 @@ std::string indexEntry(const Manifest& m, const BuiltVariant& b) {
   for (const auto& [k, val] : v.params) params += fmt::format("{}{}: {}", params.empty() ? "" : ", ", jsonString(k), val);
   out += fmt::format("      \"parameters\": {{{}}},\n", params);
   out += fmt::format("      \"cost\": {},\n", b.cost);
-  std::string rules;
-  for (const auto& rule : b.rules) rules += (rules.empty() ? "" : ", ") + jsonString(rule);
-  out += fmt::format("      \"rules\": [{}],\n", rules);
-  if (!v.rig->bans.empty()) {  // a pinned plan (docs/variants.md): what its search left out
-    std::string bans;
-    for (const auto& ban : v.rig->bans) bans += (bans.empty() ? "" : ", ") + jsonString(ban);
-    out += fmt::format("      \"bans\": [{}],\n", bans);
-  }
+  out += fmt::format("      \"rules\": {},\n", jsonStringArray(b.rules));
+  if (!v.rig->bans.empty())  // a pinned plan (docs/variants.md): what its search left out
+    out += fmt::format("      \"bans\": {},\n", jsonStringArray(v.rig->bans));
   out += fmt::format("      \"spirv_sha256\": {},\n", jsonString(b.spirvHash));
   out += fmt::format("      \"validated\": {},\n", b.validation ? "true" : "false");
   if (const auto& val = b.validation)  // where and when the result was made (cached with it)
