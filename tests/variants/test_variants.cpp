@@ -574,7 +574,11 @@ TEST(Build, AListOfProfilesBuildsThePortablePlan) {
   // One profile is another key; so is the second profile's content.
   Manifest single = manifest("device_profile: gpu.yaml\n");
   EXPECT_TRUE(single.portableProfiles.empty());
-  EXPECT_NE(buildVariants(single, expandVariants(single), bo).variants[0].key, r.variants[0].key);
+  const std::string singleKey = buildVariants(single, expandVariants(single), bo).variants[0].key;
+  EXPECT_NE(singleKey, r.variants[0].key);
+  Manifest listOfOne = manifest("device_profile: [gpu.yaml]\n");  // the single profile, key and all
+  EXPECT_TRUE(listOfOne.portableProfiles.empty());
+  EXPECT_EQ(buildVariants(listOfOne, expandVariants(listOfOne), bo).variants[0].key, singleKey);
   writeText(dir / "cpu.yaml", readAll(dir / "cpu.yaml") + "# edited\n");
   m = manifest("device_profile: [gpu.yaml, cpu.yaml]\n");
   EXPECT_NE(buildVariants(m, expandVariants(m), bo).variants[0].key, r.variants[0].key);
