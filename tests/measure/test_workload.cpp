@@ -39,6 +39,9 @@ TEST(Workload, JointsPerWarpCountsDistinctWeightedJointsPerGroupAndSlot) {
   EXPECT_DOUBLE_EQ(measureWorkload(m, {}, false, -1, "hand", 1).jointsPerWarp, 4.0);
   // A warp's palette footprint, every weighted slot together: {0,1,2,3,7} and {0,1,2,3}.
   EXPECT_DOUBLE_EQ(wl.paletteEntriesPerWarp, 4.5);
+  // What explain and bench print (docs/device-profiles.md reads the footprint from it).
+  EXPECT_NE(describeWorkload(wl).find("3.00 distinct joints per warp (4.5 over all its influences)"), std::string::npos)
+      << describeWorkload(wl);
   EXPECT_DOUBLE_EQ(measureWorkload(m, {}, false, -1, "hand", 1).paletteEntriesPerWarp, 4.0);
   for (size_t v = 0; v < 32; ++v) j[v].y = 3;  // slot 1 reads a joint slot 0 reads too: one entry
   EXPECT_DOUBLE_EQ(measureWorkload(m, {}, false, -1, "hand").paletteEntriesPerWarp, 4.0);
@@ -76,6 +79,7 @@ TEST(Workload, UnskinnedMeshesHaveNoJointsPerWarp) {
   rt::Mesh z = skinned(3);  // streams present, every weight 0
   EXPECT_EQ(measureWorkload(z, {0, 1, 2}, true, 0, "").jointsPerWarp, 0);
   EXPECT_EQ(measureWorkload(z, {0, 1, 2}, true, 0, "").paletteEntriesPerWarp, 0);
+  EXPECT_EQ(describeWorkload(measureWorkload(z, {0, 1, 2}, true, 0, "")).find("over all its influences"), std::string::npos);
 }
 
 TEST(Workload, InvocationsPerVertexCountTransformsPerShadedVertex) {
