@@ -53,6 +53,7 @@ Result generate(const Options& options) {
     o.workload.activeMorphTargets = w.activeMorphTargets;
     o.workload.invocationsPerVertex = w.invocationsPerVertex;
     o.workload.fragmentsPerVertex = w.fragmentsPerVertex;
+    o.workload.paletteEntriesPerWarp = w.paletteEntriesPerWarp;
     if (o.workload.known()) o.workload.source = "given by the caller";
     o.gltf.normalizeWeights = options.normalizeSkinWeights;
     o.gltf.warningsAsErrors = options.warningsAsErrors;

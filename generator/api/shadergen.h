@@ -26,6 +26,7 @@ struct Workload {
   double activeMorphTargets = -1;   // morph targets with a non-zero weight at once (-1: all)
   double invocationsPerVertex = 0;  // vertex-shader runs per vertex (post-transform cache)
   double fragmentsPerVertex = 0;    // fragments one draw covers, per vertex
+  double paletteEntriesPerWarp = 0; // distinct joints a warp reads over all its influences
 };
 
 struct Options {

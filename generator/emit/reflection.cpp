@@ -194,10 +194,13 @@ std::string reflectionJson(const Rig& rig, const EmittedGlsl& glsl, const SpirvM
     // What the prediction was priced for (search/workload.h; 0 or -1: unknown).
     if (workload)
       j += fmt::format("  \"workload\": {{\"vertices_per_draw\": {:g}, \"joints_per_warp\": {:.6g}, "
-                       "\"active_morph_targets\": {:g}, \"invocations_per_vertex\": {:.6g}, {}\"source\": {}}},\n",
+                       "\"active_morph_targets\": {:g}, \"invocations_per_vertex\": {:.6g}, {}{}\"source\": {}}},\n",
                        workload->verticesPerDraw, workload->jointsPerWarp, workload->activeMorphTargets,
                        workload->invocationsPerVertex,
                        workload->fragmentsPerVertex > 0 ? fmt::format("\"fragments_per_vertex\": {:.6g}, ", workload->fragmentsPerVertex) : "",
+                       workload->paletteEntriesPerWarp > 0
+                           ? fmt::format("\"palette_entries_per_warp\": {:.6g}, ", workload->paletteEntriesPerWarp)
+                           : "",
                        jsonQuote(workload->source));
   }
   if (hlsl) j += crossJson(*hlsl);

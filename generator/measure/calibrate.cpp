@@ -63,6 +63,10 @@ struct Probe {
   rt::ProgramInputs inputs;  // streams (location 0 first), uniform block, storage buffers
   std::vector<double> expected;  // per vertex: gl_Position then the outputs, 4 components each
   double tolerance = 1e-5;       // relative to max(1, |expected| of that output)
+  // A palette probe's addresses: load i's index per vertex in skin.joints[i / 4] component i % 4
+  // (weight 1), so measureWorkload counts the distinct entries its warps read, per load and over
+  // all loads, as it counts a skin's. Empty for probes that read no palette.
+  rt::Mesh addresses;
 };
 
 struct ProbeMesh {
@@ -224,9 +228,15 @@ Probe bufferProbe(const ProbeMesh& m, int n) {
 // indices, every vertex of a warp a different joint, took 29.6 ns per vertex for four
 // loads on the H200 at Dawn scale, 15x their uniform-index twin: a case no skinned mesh
 // has, which made the fit overprice a plan's palette loads.)
+// `apart`: load i reads palette[joint[i % 4] + 32 i] instead, so the loads share no entries: as
+// many distinct addresses per load as the skin's, and a warp's palette footprint the sum of its
+// loads' (on the head about 2.6x the shared form's), to time the constant cache's capacity apart
+// from its per-address price (docs/device-profiles.md, "The constant cache's capacity").
 // In a storage buffer (`inBuffer`), the same loads are gathers through the memory pipe.
-Probe paletteProbe(const ProbeMesh& m, int n, bool perVertex, bool inBuffer = false) {
-  Probe p = baseProbe(m, fmt::format("{}palette loads {} at a {} index", inBuffer ? "buffer " : "", n, perVertex ? "per-vertex" : "uniform"), 1);
+Probe paletteProbe(const ProbeMesh& m, int n, bool perVertex, bool inBuffer = false, bool apart = false) {
+  Probe p = baseProbe(m, fmt::format("{}palette loads {} at a {} index{}", inBuffer ? "buffer " : "", n, perVertex ? "per-vertex" : "uniform",
+                                     apart ? ", loads apart" : ""),
+                      1);
   constexpr uint32_t kEntries = 128;
   if (inBuffer)
     p.decl += "layout(std140, set = 0, binding = 0) uniform Block { uint base; } u;\n"
@@ -263,16 +273,27 @@ Probe paletteProbe(const ProbeMesh& m, int n, bool perVertex, bool inBuffer = fa
   std::memcpy(p.inputs.uniformData.data() + baseAt, &base, 4);
   const char* array = inBuffer ? "b.palette" : "u.palette";
   p.body = "  o0 = vec4(joint) * 0.001;\n";
+  auto offset = [&](int i) { return uint32_t(apart ? 32 * i : 7 * (i / 4)); };
   for (int i = 0; i < n; ++i)
-    p.body += perVertex ? fmt::format("  o0 += {}[(joint[{}] + {}u) & {}u] * a0;\n", array, i % 4, 7 * (i / 4), kEntries - 1)
+    p.body += perVertex ? fmt::format("  o0 += {}[(joint[{}] + {}u) & {}u] * a0;\n", array, i % 4, offset(i), kEntries - 1)
                         : fmt::format("  o0 += {}[(u.base + {}u) & {}u] * a0;\n", array, i, kEntries - 1);
   const auto& pos = m.mesh.streams.at("vertex.position");
+  p.addresses.vertexCount = m.mesh.vertexCount;
+  std::vector<std::vector<glm::vec4>*> addressJoints, addressWeights;
+  for (int k = 0; k < (n + 3) / 4; ++k) {
+    addressJoints.push_back(&p.addresses.streams[fmt::format("skin.joints[{}]", k)]);
+    addressWeights.push_back(&p.addresses.streams[fmt::format("skin.weights[{}]", k)]);
+    addressJoints.back()->resize(m.mesh.vertexCount, glm::vec4(0));
+    addressWeights.back()->resize(m.mesh.vertexCount, glm::vec4(0));
+  }
   for (size_t v = 0; v < m.mesh.vertexCount; ++v) {
     const uint8_t* j = &s.data[v * 4];
     glm::dvec4 o = glm::dvec4(j[0], j[1], j[2], j[3]) * 0.001;
     for (int i = 0; i < n; ++i) {
-      const uint32_t idx = perVertex ? (j[i % 4] + 7u * uint32_t(i / 4)) & (kEntries - 1) : (base + uint32_t(i)) & (kEntries - 1);
+      const uint32_t idx = perVertex ? (j[i % 4] + offset(i)) & (kEntries - 1) : (base + uint32_t(i)) & (kEntries - 1);
       o += palette[idx] * glm::dvec4(pos[v]);
+      (*addressJoints[size_t(i / 4)])[v][i % 4] = float(idx);
+      (*addressWeights[size_t(i / 4)])[v][i % 4] = 1.0f;
     }
     for (int c = 0; c < 4; ++c) expectedAt(p, v, 0, c) = o[c];
   }
@@ -314,6 +335,8 @@ std::vector<Probe> makeProbes(const ProbeMesh& m) {
   // stream (on the H200, 64 vec4s took 3.2 ns against 4.6 for 16 streamed), a case no plan has
   // that drove the fit to price elements and not vec4s (docs/device-profiles.md).
   for (int n : {4, 16}) probes.push_back(paletteProbe(m, n, true, true));
+  // The same loads with a larger footprint: the constant cache's capacity (from session 21).
+  for (int n : {2, 3, 4}) probes.push_back(paletteProbe(m, n, true, false, true));
   for (int n : {1, 4, 8, 15}) probes.push_back(outputProbe(m, n));
   return probes;
 }
@@ -366,11 +389,6 @@ std::string compareCapture(const Probe& p, const std::vector<uint8_t>& captured,
       }
     }
   return "";
-}
-
-double medianOf(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
 }  // namespace
@@ -674,9 +692,12 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
       s.label = p.label;
       s.mesh = meshName;
       s.vertices = double(m.mesh.vertexCount);
-      // The palette probe at a uniform index reads one address per warp, whatever the mesh.
       s.workload = probeWorkload;
-      if (p.label.find("uniform index") != std::string::npos) s.workload.jointsPerWarp = s.workload.paletteEntriesPerWarp = 1;
+      if (p.addresses.vertexCount) {  // a palette probe: the addresses it reads, counted as a skin's are
+        const Workload a = measureWorkload(p.addresses, m.indices, false, -1, "");
+        s.workload.jointsPerWarp = a.jointsPerWarp;
+        s.workload.paletteEntriesPerWarp = a.paletteEntriesPerWarp;
+      }
       s.amounts = p.amounts;
       try {
         GlslShader renderShader = compileProbe(Stage::Vertex, probeGlsl(p, false), p.label);
@@ -888,6 +909,10 @@ std::string rooflineLines(const DeviceProfile& p) {
       s += fmt::format("  {}: {:g}\n", featureName(f), p.workloadDefaults[size_t(f)]);
       defaults = true;
     }
+  if (p.constantCacheEntries > 0)
+    s += fmt::format("constant_cache:  # past this palette footprint per warp, a distinct address costs miss_factor times as much\n"
+                     "  entries: {:g}\n  miss_factor: {:.6g}\n",
+                     p.constantCacheEntries, p.constantCacheMissFactor);
   return s;
 }
 

@@ -52,7 +52,10 @@ struct Layout {
   std::vector<int> additive, perDraw;
   std::vector<std::pair<size_t, int>> pipeTerms;  // (pipe, term)
   size_t pipes = 0;
-  size_t size() const { return additive.size() + perDraw.size() + pipeTerms.size(); }
+  // The constant cache's miss factor, a last parameter: the terms it multiplies.
+  bool miss = false;
+  std::array<bool, kTermCount> missTerms{};
+  size_t size() const { return additive.size() + perDraw.size() + pipeTerms.size() + (miss ? 1 : 0); }
 };
 
 Layout layoutOf(const DeviceProfile& form, bool drawWeights) {
@@ -78,30 +81,45 @@ std::array<double, kTermCount> scaledAmounts(const DeviceProfile& form, const Fi
   return x;
 }
 
-// One row's weighted relative error and its (sub)gradient: the max picks the slowest pipe.
+// One row's weighted relative error and its (sub)gradient: the max picks the slowest pipe. With
+// a constant cache (`missTerms` not empty, the last parameter the miss factor M), a row past
+// the capacity pays M times its terms scaled by joints per warp.
 class RowCost : public ceres::CostFunction {
  public:
-  RowCost(const Layout& l, std::array<double, kTermCount> x, double vertices, double measured, double weight)
-      : l_(l), x_(x), vertices_(vertices), measured_(measured), scale_(std::sqrt(weight) / measured) {
+  RowCost(const Layout& l, std::array<double, kTermCount> x, double vertices, double measured, double weight, bool past)
+      : l_(l), x_(x), vertices_(vertices), measured_(measured), scale_(std::sqrt(weight) / measured), past_(past) {
     set_num_residuals(1);
     mutable_parameter_block_sizes()->push_back(static_cast<int32_t>(l.size()));
   }
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const double* w = parameters[0];
     std::vector<double> grad(l_.size(), 0.0);
-    double ns = 0;
+    const bool miss = l_.miss && past_;
+    const double m = miss ? w[l_.size() - 1] : 1.0;
+    auto factor = [&](int t) { return miss && l_.missTerms[static_cast<size_t>(t)] ? m : 1.0; };
+    double ns = 0, dm = 0;
     size_t i = 0;
-    for (int t : l_.additive) ns += w[i] * x_[t], grad[i] = x_[t], ++i;
+    for (int t : l_.additive) {
+      ns += w[i] * x_[t] * factor(t), grad[i] = x_[t] * factor(t);
+      if (factor(t) != 1.0) dm += w[i] * x_[t];
+      ++i;
+    }
     for (int t : l_.perDraw) ns += w[i] * x_[t] / vertices_, grad[i] = x_[t] / vertices_, ++i;
-    std::vector<double> pipe(l_.pipes, 0.0);
+    std::vector<double> pipe(l_.pipes, 0.0), pipeDm(l_.pipes, 0.0);
     const size_t pipeBegin = i;
-    for (const auto& [p, t] : l_.pipeTerms) pipe[p] += w[i++] * x_[t];
+    for (const auto& [p, t] : l_.pipeTerms) {
+      pipe[p] += w[i] * x_[t] * factor(t);
+      if (factor(t) != 1.0) pipeDm[p] += w[i] * x_[t];
+      ++i;
+    }
     if (l_.pipes) {
       const size_t slowest = static_cast<size_t>(std::max_element(pipe.begin(), pipe.end()) - pipe.begin());
       ns += pipe[slowest];
+      dm += pipeDm[slowest];
       i = pipeBegin;
-      for (const auto& [p, t] : l_.pipeTerms) grad[i++] = p == slowest ? x_[t] : 0.0;
+      for (const auto& [p, t] : l_.pipeTerms) grad[i++] = p == slowest ? x_[t] * factor(t) : 0.0;
     }
+    if (miss) grad[l_.size() - 1] = dm;
     residuals[0] = scale_ * (ns - measured_);
     if (jacobians && jacobians[0])
       for (size_t j = 0; j < l_.size(); ++j) jacobians[0][j] = scale_ * grad[j];
@@ -112,6 +130,7 @@ class RowCost : public ceres::CostFunction {
   const Layout& l_;
   std::array<double, kTermCount> x_;
   double vertices_, measured_, scale_;
+  bool past_;
 };
 
 DeviceProfile toProfile(const DeviceProfile& form, const Layout& l, const std::vector<double>& w, double vertices) {
@@ -121,32 +140,25 @@ DeviceProfile toProfile(const DeviceProfile& form, const Layout& l, const std::v
   for (int t : l.additive) p.nanoseconds[static_cast<size_t>(t)] = std::min(w[i++], kMaxProfileWeightNs);
   for (int t : l.perDraw) p.drawNanoseconds[static_cast<size_t>(t)] = std::min(w[i++], kMaxProfileDrawWeightNs);
   for (const auto& [pi, t] : l.pipeTerms) p.pipes[pi].nanoseconds[static_cast<size_t>(t)] = std::min(w[i++], kMaxProfileWeightNs);
+  if (l.miss) p.constantCacheMissFactor = w[i];
   if (p.hasDrawWeights()) p.verticesPerDraw = vertices;
   return p;
 }
 
-}  // namespace
+// The largest miss factor a fit may find (a miss costing 50x a hit is no cache at all).
+constexpr double kMaxMissFactor = 50;
 
-FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form) {
-  if (rows.empty()) throw std::runtime_error("calibration: no validated timing to fit");
-  std::set<double> sizes;
-  for (const FitRow& r : rows) sizes.insert(r.vertices);
-  DeviceProfile skeleton = profileForm(form);
-  // Where a row's fragments were not counted, and where a generation's are unknown: the median
-  // of the rows that were.
-  std::vector<double> fragments;
-  for (const FitRow& r : rows)
-    if (r.workload.fragmentsPerVertex > 0) fragments.push_back(r.workload.fragmentsPerVertex);
-  if (form == ProfileForm::Raster && !fragments.empty()) {
-    std::nth_element(fragments.begin(), fragments.begin() + static_cast<long>(fragments.size() / 2), fragments.end());
-    skeleton.workloadDefaults[kFeatureFragmentsPerVertex] = fragments[fragments.size() / 2];
-  }
-  const Layout l = layoutOf(skeleton, sizes.size() > 1);
-  std::vector<std::array<double, kTermCount>> xs;
-  for (const FitRow& r : rows) xs.push_back(scaledAmounts(skeleton, r));
+struct Solved {
+  double cost = INFINITY;
+  std::vector<double> w;
+  bool converged = false;
+};
 
-  // Starts: each parameter at the share of a typical row it would explain alone, scaled by
-  // 0.1, 0.5 and 1; the best converged fit wins (the max makes the problem non-convex).
+// Ceres from three starts: each parameter at the share of a typical row it would explain
+// alone, scaled by 0.1, 0.5 and 1; the best converged fit wins (the max makes the problem
+// non-convex). `past[i]`: row i's palette footprint is past the constant cache's capacity.
+Solved solve(const Layout& l, const std::vector<FitRow>& rows, const std::vector<std::array<double, kTermCount>>& xs,
+             const std::vector<bool>& past) {
   std::vector<double> typical(l.size(), 0.0);
   {
     std::vector<double> measured;
@@ -164,16 +176,20 @@ FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form) {
     for (int t : l.perDraw) typical[i++] = meanAmount(t, true) > 0 ? share / meanAmount(t, true) : 0;
     for (const auto& [p, t] : l.pipeTerms) typical[i++] = meanAmount(t, false) > 0 ? share / meanAmount(t, false) : 0;
   }
-  double bestCost = INFINITY;
-  std::vector<double> best;
-  bool converged = false;
+  Solved best;
   for (double start : {0.1, 0.5, 1.0}) {
     std::vector<double> w(l.size());
     for (size_t j = 0; j < w.size(); ++j) w[j] = start * typical[j];
+    if (l.miss) w.back() = 1.0 + start;  // a miss factor starts above 1: at 1 its gradient may vanish
     ceres::Problem problem;
     for (size_t i = 0; i < rows.size(); ++i)
-      problem.AddResidualBlock(new RowCost(l, xs[i], rows[i].vertices, rows[i].measuredNs, rows[i].weight), nullptr, w.data());
+      problem.AddResidualBlock(new RowCost(l, xs[i], rows[i].vertices, rows[i].measuredNs, rows[i].weight, past[i]), nullptr,
+                               w.data());
     for (size_t j = 0; j < w.size(); ++j) problem.SetParameterLowerBound(w.data(), static_cast<int>(j), 0.0);
+    if (l.miss) {
+      problem.SetParameterLowerBound(w.data(), static_cast<int>(l.size() - 1), 1.0);
+      problem.SetParameterUpperBound(w.data(), static_cast<int>(l.size() - 1), kMaxMissFactor);
+    }
     ceres::Solver::Options o;
     o.linear_solver_type = ceres::DENSE_QR;
     o.max_num_iterations = 500;
@@ -184,25 +200,91 @@ FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form) {
     o.logging_type = ceres::SILENT;
     ceres::Solver::Summary summary;
     ceres::Solve(o, &problem, &summary);
-    if (summary.final_cost < bestCost) {
-      bestCost = summary.final_cost;
-      best = w;
-      converged = summary.IsSolutionUsable();
+    if (summary.final_cost < best.cost) {
+      best.cost = summary.final_cost;
+      best.w = w;
+      best.converged = summary.IsSolutionUsable();
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+double medianOf(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+std::vector<double> constantCacheCandidates(const std::vector<FitRow>& rows, const DeviceProfile& form) {
+  // The footprints of rows that read a uniform at a per-vertex index (a term scaled by joints per warp).
+  std::vector<double> footprints;
+  for (const FitRow& r : rows) {
+    bool reads = false;
+    for (size_t t = 0; t < kTermCount; ++t) reads |= form.scaledBy[t] == kFeatureJointsPerWarp && r.amounts[t] > 0;
+    if (reads && r.workload.paletteEntriesPerWarp > 0) footprints.push_back(r.workload.paletteEntriesPerWarp);
+  }
+  std::sort(footprints.begin(), footprints.end());
+  std::vector<double> out;
+  for (size_t i = kMinRowsPerSideOfCapacity; i + kMinRowsPerSideOfCapacity <= footprints.size(); ++i)
+    if (footprints[i] > footprints[i - 1] * 1.001) {
+      const double mid = 0.5 * (footprints[i - 1] + footprints[i]);
+      out.push_back(std::round(mid * 100) / 100);
+    }
+  return out;
+}
+
+FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form) {
+  if (rows.empty()) throw std::runtime_error("calibration: no validated timing to fit");
+  std::set<double> sizes;
+  for (const FitRow& r : rows) sizes.insert(r.vertices);
+  DeviceProfile skeleton = profileForm(form);
+  // Where a row's fragments were not counted, and where a generation's are unknown: the median
+  // of the rows that were.
+  std::vector<double> fragments, entries, joints;
+  for (const FitRow& r : rows) {
+    if (r.workload.fragmentsPerVertex > 0) fragments.push_back(r.workload.fragmentsPerVertex);
+    if (r.workload.paletteEntriesPerWarp > 0) entries.push_back(r.workload.paletteEntriesPerWarp);
+    if (r.workload.jointsPerWarp > 0) joints.push_back(r.workload.jointsPerWarp);
+  }
+  if (form == ProfileForm::Raster && !fragments.empty()) skeleton.workloadDefaults[kFeatureFragmentsPerVertex] = medianOf(fragments);
+  Layout l = layoutOf(skeleton, sizes.size() > 1);
+  std::vector<std::array<double, kTermCount>> xs;
+  for (const FitRow& r : rows) xs.push_back(scaledAmounts(skeleton, r));
+
+  Solved best = solve(l, rows, xs, std::vector<bool>(rows.size(), false));
+  // The constant cache's capacity (docs/device-profiles.md, "The constant cache's capacity"):
+  // each threshold between the footprints the rows read, with a miss factor fitted beside the
+  // weights; the best threshold is kept where it explains kMinCapacityGain of the squared error.
+  double capacity = 0;
+  if (!skeleton.pipes.empty()) {
+    Layout withMiss = l;
+    withMiss.miss = true;
+    for (size_t t = 0; t < kTermCount; ++t) withMiss.missTerms[t] = skeleton.scaledBy[t] == kFeatureJointsPerWarp;
+    double bestWithMiss = INFINITY;
+    Solved chosen;
+    for (double c : constantCacheCandidates(rows, skeleton)) {
+      std::vector<bool> past;
+      for (const FitRow& r : rows) past.push_back(r.workload.paletteEntriesPerWarp > c);
+      Solved s = solve(withMiss, rows, xs, past);
+      if (s.cost < bestWithMiss) bestWithMiss = s.cost, chosen = s, capacity = c;
+    }
+    if (capacity > 0 && bestWithMiss < (1 - kMinCapacityGain) * best.cost) {
+      best = chosen;
+      l = withMiss;
+    } else {
+      capacity = 0;
     }
   }
   FitResult out;
-  out.converged = converged;
+  out.converged = best.converged;
   double workload = 0;
   for (const FitRow& r : rows) workload = std::max(workload, r.vertices);
-  out.profile = toProfile(skeleton, l, best, workload);
+  out.profile = toProfile(skeleton, l, best.w, workload);
+  out.profile.constantCacheEntries = capacity;
   // Where a generation's mesh is unknown, price it like the median mesh the fit saw.
-  std::vector<double> joints;
-  for (const FitRow& r : rows)
-    if (r.workload.jointsPerWarp > 0) joints.push_back(r.workload.jointsPerWarp);
-  if (!joints.empty()) {
-    std::nth_element(joints.begin(), joints.begin() + static_cast<long>(joints.size() / 2), joints.end());
-    out.profile.workloadDefaults[kFeatureJointsPerWarp] = joints[joints.size() / 2];
-  }
+  if (!joints.empty()) out.profile.workloadDefaults[kFeatureJointsPerWarp] = medianOf(joints);
+  if (capacity > 0 && !entries.empty()) out.profile.workloadDefaults[kFeaturePaletteEntriesPerWarp] = medianOf(entries);
   double sq = 0;
   for (const FitRow& r : rows) {
     DeviceProfile at = out.profile;

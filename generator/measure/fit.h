@@ -40,10 +40,24 @@ struct FitResult {
   bool converged = false;
 };
 
+// The constant cache (roofline and raster forms): where rows that read a uniform at a per-vertex
+// index have palette footprints (Workload::paletteEntriesPerWarp) on both sides of a threshold
+// C, kMinRowsPerSideOfCapacity rows at least on each, the fit tries each C between two such
+// footprints with a miss factor M >= 1 as one more parameter (a row past C pays M times its
+// terms scaled by joints per warp), and keeps the best C where it lowers the weighted squared
+// error by kMinCapacityGain of the fit without it; else the profile has no constant_cache.
+constexpr size_t kMinRowsPerSideOfCapacity = 3;
+constexpr double kMinCapacityGain = 0.02;
+// The thresholds tried: midpoints between consecutive distinct footprints, rounded to 0.01.
+std::vector<double> constantCacheCandidates(const std::vector<FitRow>& rows, const DeviceProfile& form);
+
 // Per-draw weights only when the rows' draws differ in size (else they cannot be told apart
 // from per-vertex ones). Deterministic: same rows, same weights. Throws std::runtime_error
 // without rows.
 FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form);
+
+// The upper median (of an even count, the larger middle value); 0 when empty.
+double medianOf(std::vector<double> v);
 
 // The form's skeleton: pipes (empty for additive) and the workload scaling, weights zero.
 DeviceProfile profileForm(ProfileForm form);

@@ -11,6 +11,7 @@
 #include <set>
 
 #include "analysis/cost.h"
+#include "measure/fit.h"
 #include "common/glsl_compile.h"
 #include "common/input_file.h"
 #include "measure/workload.h"
@@ -28,11 +29,6 @@ struct Program {
   GenerateResult render, capture;
   bool validate = true;  // the floors write constants on purpose
 };
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[v.size() / 2];
-}
 
 std::vector<double> ranks(const std::vector<double>& v) {
   std::vector<size_t> order(v.size());
@@ -463,7 +459,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
       t.frames = opts.frames + 1;
       auto perVertex = [&](const std::vector<double>& ns, uint32_t vertices) {
         std::vector<double> frames(ns.begin() + 1, ns.end());  // the first warms up
-        return median(frames) / (double(draws) * double(vertices));
+        return medianOf(frames) / (double(draws) * double(vertices));
       };
       if (opts.rasterOn) {
         rt::DrawRequest req = drawRequest(p.render, frag, textures, scene);

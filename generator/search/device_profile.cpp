@@ -58,7 +58,8 @@ void parseTermWeights(const YamlCtx& c, const YAML::Node& w, const char* section
 
 const char* featureName(int feature) {
   static const char* const names[] = {"none", "joints_per_warp", "invocations_per_vertex", "active_morph_targets",
-                                      "joints_per_warp_squared", "fragments_per_vertex"};
+                                      "joints_per_warp_squared", "fragments_per_vertex",
+                                      "palette_entries_per_warp"};
   return feature >= 0 && feature < kFeatureCount ? names[feature] : "?";
 }
 
@@ -66,19 +67,31 @@ double DeviceProfile::feature(int f) const {
   double v = -1;
   switch (f) {
     case kFeatureNone: return 1;
-    case kFeatureJointsPerWarp: v = workload.jointsPerWarp > 0 ? workload.jointsPerWarp : -1; break;
+    case kFeatureJointsPerWarp: {
+      // A warp's reads of distinct addresses, each priced as a miss past the cache's capacity.
+      const double j = workload.jointsPerWarp > 0 ? workload.jointsPerWarp : workloadDefaults[static_cast<size_t>(f)];
+      return (j > 0 ? j : 1.0) * constantCacheFactor();
+    }
+    case kFeaturePaletteEntriesPerWarp: v = workload.paletteEntriesPerWarp > 0 ? workload.paletteEntriesPerWarp : -1; break;
     case kFeatureInvocationsPerVertex: v = workload.invocationsPerVertex > 0 ? workload.invocationsPerVertex : -1; break;
     case kFeatureActiveMorphTargets: v = workload.activeMorphTargets; break;
     case kFeatureFragmentsPerVertex: v = workload.fragmentsPerVertex > 0 ? workload.fragmentsPerVertex : -1; break;
     case kFeatureJointsPerWarpSquared: {
-      const double j = feature(kFeatureJointsPerWarp);
-      return j * j;
+      const double j = workload.jointsPerWarp > 0 ? workload.jointsPerWarp : workloadDefaults[kFeatureJointsPerWarp];
+      return j > 0 ? j * j : 1.0;
     }
     default: break;
   }
   if (v >= 0) return v;
   const double d = workloadDefaults[static_cast<size_t>(f)];
   return d > 0 ? d : 1.0;
+}
+
+double DeviceProfile::constantCacheFactor() const {
+  if (constantCacheEntries <= 0) return 1.0;
+  const double entries = workload.paletteEntriesPerWarp > 0 ? workload.paletteEntriesPerWarp
+                                                            : workloadDefaults[kFeaturePaletteEntriesPerWarp];
+  return entries > constantCacheEntries ? constantCacheMissFactor : 1.0;
 }
 
 double DeviceProfile::perVertex(int term, double vertices) const {
@@ -106,7 +119,7 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
   YAML::Node root = parseYaml(text, file);
   c.expectMap(root, "device profile");
   c.checkKeys(root, {"device", "unit", "weights", "draw_weights", "vertices_per_draw", "pipes", "scaled_by",
-                     "workload_defaults", "notes"});
+                     "workload_defaults", "constant_cache", "notes"});
   DeviceProfile prof;
   prof.file = file;
   if (!root["device"]) c.fail(root, "device profile: missing 'device' (the device it was measured on)");
@@ -163,6 +176,20 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
       prof.workloadDefaults[static_cast<size_t>(f)] =
           parseNumber(c, it->second, fmt::format("workload default '{}'", featureName(f)), "units", "", 0, kMaxWorkloadFeature);
     }
+  }
+  if (const YAML::Node cache = root["constant_cache"]) {
+    c.expectMap(cache, "constant_cache");
+    c.checkKeys(cache, {"entries", "miss_factor"});
+    if (!cache["entries"] || !cache["miss_factor"])
+      c.fail(cache, "constant_cache: needs 'entries' (the palette entries a warp's footprint may reach) and 'miss_factor' "
+                    "(what a distinct address costs past them, times its price within)");
+    prof.constantCacheEntries =
+        parseNumber(c, cache["entries"], "constant_cache 'entries'", "palette entries", "entries", 1, kMaxWorkloadFeature);
+    prof.constantCacheMissFactor = parseNumber(c, cache["miss_factor"], "constant_cache 'miss_factor'", "times", "x", 1, 1000);
+    bool priced = false;
+    for (int t = 0; t < kTermCount; ++t) priced |= prof.scaledBy[static_cast<size_t>(t)] == kFeatureJointsPerWarp;
+    if (!priced)
+      c.fail(cache, "constant_cache: no term is scaled_by joints_per_warp, so the cache's misses would price nothing");
   }
   return prof;
 }

@@ -27,6 +27,7 @@ enum WorkloadFeature {
   kFeatureActiveMorphTargets,
   kFeatureJointsPerWarpSquared,
   kFeatureFragmentsPerVertex,
+  kFeaturePaletteEntriesPerWarp,
   kFeatureCount
 };
 // "joints_per_warp", ...: the keys of a profile's `scaled_by:` values and `workload_defaults:`.
@@ -51,6 +52,12 @@ struct DeviceProfile {
   std::array<int, kTermCount> scaledBy{};
   // Feature values used where the workload does not say (none stated: 1).
   std::array<double, kFeatureCount> workloadDefaults{};
+  // The constant cache's capacity (docs/device-profiles.md, "The constant cache's capacity"):
+  // where a warp's palette footprint (palette_entries_per_warp) exceeds `constantCacheEntries`,
+  // every weight scaled by joints_per_warp costs `constantCacheMissFactor` times as much (its
+  // per-address reads miss). 0 entries: no such term (every profile before session 21).
+  double constantCacheEntries = 0;
+  double constantCacheMissFactor = 1;
   // The workload priced for (search/workload.h): set by whoever generates for a known mesh.
   Workload workload;
 
@@ -61,6 +68,9 @@ struct DeviceProfile {
   // The value of a feature for this profile's workload (the workload's, else the stated
   // default, else 1); kFeatureNone is 1.
   double feature(int f) const;
+  // constantCacheMissFactor where the workload's palette footprint (else its default) is past
+  // the constant cache's capacity; else 1.
+  double constantCacheFactor() const;
   // Predicted ns per vertex of these amounts on a mesh drawn `vertices` at a time (unrounded
   // weights; the search's own figure is predictPlanCost's): the additive part plus the slowest pipe.
   double predictNanoseconds(const TermAmounts& amounts, double vertices) const;

@@ -28,12 +28,13 @@ struct Workload {
   double fragmentsPerVertex = 0;
   // Mean over jointsPerWarp's groups of the distinct joint indices a group reads over all its
   // influence slots together: the palette entries one warp's palette loads touch, its share
-  // of the constant cache (docs/device-profiles.md, "The constant cache's capacity"). Shown,
-  // not priced: no profile term is scaled by it. 0 = unknown or unskinned.
+  // of the constant cache (docs/device-profiles.md, "The constant cache's capacity"): a profile
+  // with a `constant_cache:` prices a warp past its capacity as missing. 0 = unknown or unskinned.
   double paletteEntriesPerWarp = 0;
 
   bool known() const {
-    return verticesPerDraw > 0 || jointsPerWarp > 0 || activeMorphTargets >= 0 || invocationsPerVertex > 0 || fragmentsPerVertex > 0;
+    return verticesPerDraw > 0 || jointsPerWarp > 0 || activeMorphTargets >= 0 || invocationsPerVertex > 0 || fragmentsPerVertex > 0 ||
+           paletteEntriesPerWarp > 0;
   }
 };
 

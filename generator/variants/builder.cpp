@@ -126,6 +126,7 @@ std::string cacheKey(const Manifest& m, const SharedInputs& s, const Variant& v,
     h.field("workload").field(fmt::format("{:.17g} {:.17g} {:.17g} {:.17g}", workload->verticesPerDraw, workload->jointsPerWarp,
                                           workload->activeMorphTargets, workload->invocationsPerVertex));
     if (workload->fragmentsPerVertex > 0) h.field(fmt::format("{:.17g}", workload->fragmentsPerVertex));
+    if (workload->paletteEntriesPerWarp > 0) h.field("palette").field(fmt::format("{:.17g}", workload->paletteEntriesPerWarp));
     h.field(workload->source);
   }
   if (const std::string& w = s.rigs.at(v.rig->path).skinWeights; !w.empty())  // the reflection records it

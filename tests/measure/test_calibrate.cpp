@@ -384,6 +384,89 @@ TEST(Calibrate, TheRasterFitPricesTheFragmentsADrawCovers) {
   }
 }
 
+// A device with a constant cache of `capacity` palette entries: a warp whose footprint is larger
+// pays `miss` times the constant pipe's per-address price (an LRU cache under a warp's cyclic
+// reuse misses every time). Footprints vary independently of joints per warp, as the head's do.
+std::vector<CalibrationSample> cacheRows(uint32_t seed, int n, double capacity, double miss) {
+  std::vector<CalibrationSample> out = rasterRows(seed, n, 0.05);
+  std::mt19937 rng(seed + 200);
+  roofline::Device d;
+  d.drawNs = 0;
+  for (auto& s : out) {
+    s.workload.paletteEntriesPerWarp = s.workload.jointsPerWarp * std::uniform_real_distribution<double>(1, 6)(rng);
+    const double j = s.workload.jointsPerWarp * (s.workload.paletteEntriesPerWarp > capacity ? miss : 1.0);
+    s.measuredNs = d.ns(s.amounts, s.vertices, j) + 0.05 * s.workload.fragmentsPerVertex;
+  }
+  return out;
+}
+
+TEST(Calibrate, TheFitFindsTheConstantCachesCapacityAndItsMissPrice) {
+  const double capacity = 30, miss = 2.5;
+  const std::vector<CalibrationSample> train = cacheRows(1, 200, capacity, miss);
+  std::vector<CalibrationSample> test = cacheRows(2, 80, capacity, miss);
+  auto heldOutRms = [&](const DeviceProfile& p) {
+    double sq = 0;
+    for (const auto& s : test) {
+      DeviceProfile at = p;
+      at.workload = s.workload;
+      const double e = at.predictNanoseconds(s.amounts, s.vertices) / s.measuredNs - 1;
+      sq += e * e;
+    }
+    return std::sqrt(sq / double(test.size()));
+  };
+  // What the rows can tell: the capacity lies between the largest footprint within it and the
+  // smallest past it, among the rows that read the palette at a per-vertex index.
+  double within = 0, past = 1e9;
+  for (const auto& s : train)
+    if (s.amounts[kTermIndexedUniformLoads] > 0) {
+      const double e = s.workload.paletteEntriesPerWarp;
+      if (e <= capacity) within = std::max(within, e);
+      else past = std::min(past, e);
+    }
+  ASSERT_LT(within, past);
+  // Held-out rows in that gap are priced by where the fit put the threshold: not checked.
+  test.erase(std::remove_if(test.begin(), test.end(),
+                            [&](const CalibrationSample& s) {
+                              return s.workload.paletteEntriesPerWarp > within && s.workload.paletteEntriesPerWarp <= past;
+                            }),
+             test.end());
+  ASSERT_GT(test.size(), 70u);
+  const DeviceProfile raster = fitDeviceProfile(train, "cached device", 180000, 0, ProfileForm::Raster);
+  EXPECT_GE(raster.constantCacheEntries, within);
+  EXPECT_LT(raster.constantCacheEntries, past);
+  EXPECT_NEAR(raster.constantCacheMissFactor, miss, 0.05);
+  EXPECT_NEAR(raster.pipes[2].nanoseconds[kTermIndexedUniformLoads], roofline::Device{}.address, 0.01);
+  EXPECT_LT(heldOutRms(raster), 0.01);
+  // Without the footprints the fit cannot see the cache, and prices every warp alike.
+  std::vector<CalibrationSample> blind = train;
+  for (auto& s : blind) s.workload.paletteEntriesPerWarp = 0;
+  const DeviceProfile without = fitDeviceProfile(blind, "cached device", 180000, 0, ProfileForm::Raster);
+  EXPECT_EQ(without.constantCacheEntries, 0);
+  EXPECT_GT(heldOutRms(without), 0.05);
+  // A device without the cliff gets no constant_cache from the same footprints.
+  const DeviceProfile flat = fitDeviceProfile(cacheRows(1, 200, capacity, 1.0), "flat device", 180000, 0, ProfileForm::Raster);
+  EXPECT_EQ(flat.constantCacheEntries, 0);
+  // Written and read back, it predicts the same; past the capacity a warp costs miss x as much.
+  CalibrationReport r;
+  r.profile = raster;
+  const std::string yaml = deviceProfileYaml(r);
+  EXPECT_NE(yaml.find("constant_cache:"), std::string::npos);
+  const DeviceProfile back = parseDeviceProfile(yaml, "cached.yaml");
+  EXPECT_EQ(back.constantCacheEntries, raster.constantCacheEntries);
+  for (const auto& s : test) {
+    DeviceProfile a = raster, b = back;
+    a.workload = b.workload = s.workload;
+    EXPECT_NEAR(b.predictNanoseconds(s.amounts, s.vertices), a.predictNanoseconds(s.amounts, s.vertices), 1e-5 * s.measuredNs);
+  }
+  DeviceProfile at = back;
+  at.workload.jointsPerWarp = 10;
+  at.workload.paletteEntriesPerWarp = back.constantCacheEntries - 1;
+  const double hit = at.feature(kFeatureJointsPerWarp);
+  at.workload.paletteEntriesPerWarp = back.constantCacheEntries + 1;
+  EXPECT_DOUBLE_EQ(at.feature(kFeatureJointsPerWarp), hit * back.constantCacheMissFactor);
+  EXPECT_DOUBLE_EQ(hit, 10);
+}
+
 TEST(Calibrate, AProfileWithoutPerDrawWeightsKeepsItsScalingWhenWritten) {
   // One mesh size fits no per-draw weight; the profile's workload scaling (a uniform load at a
   // per-vertex index costs per joint a warp reads) and its default must still be written, or
