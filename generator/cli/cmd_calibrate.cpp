@@ -62,9 +62,9 @@ struct CalibrateCommand {
     for (const auto& f : fromLogs) rep.clock += " " + std::filesystem::path(f).filename().string();
     rep.driver = "as recorded (see the device)";
     rep.nearBestPower = co.nearBestPower;
-    rep.profile = fitDeviceProfile(rep.samples, rep.device, 180000, co.nearBestPower, co.form);
+    rep.profile = fitDeviceProfile(rep.samples, rep.device, 180000, co.nearBestPower, co.form, co.constantCache);
     rep.fits = evaluateFit(rep.samples, rep.profile, {"dawn", "head"});
-    rep.heldOut = leaveOneRigOut(rep.samples, rep.device, 180000, co.nearBestPower, co.form);
+    rep.heldOut = leaveOneRigOut(rep.samples, rep.device, 180000, co.nearBestPower, co.form, co.constantCache);
     if (!checkLogs.empty()) rep.check = checkHeldOut(readLogs(checkLogs, nullptr), rep.profile);
     std::cout << formatCalibration(rep);
     if (!output.empty()) {
@@ -102,6 +102,8 @@ struct CalibrateCommand {
 
   int run() {
     co.form = chosenForm();
+    if (co.constantCache && co.form == ProfileForm::Additive)
+      throw CLI::ValidationError("--constant-cache", "needs --form roofline or raster (the cache's misses are priced in the constant pipe)");
     if (!writeCorpus.empty()) return writeCorpusFiles();
     if (!fromLogs.empty()) return refit();
     if (!evaluate.empty()) {
@@ -237,6 +239,10 @@ void registerCalibrate(CLI::App& app, CliState& state) {
   sub->add_flag("--no-probes", cmd->noProbes, "With --rig: time only the rigs' programs (samples for another fit)");
   sub->add_option("--form", cmd->form, "The model fitted: additive (default), roofline, or raster (the roofline with the fragments a draw covers priced instead of per-draw weights; docs/device-profiles.md)")
       ->check(CLI::IsMember({"additive", "roofline", "raster"}));
+  sub->add_flag("--constant-cache", cmd->co.constantCache,
+                "With --form roofline or raster: fit the constant cache's capacity (palette entries per warp past which "
+                "uniform loads at a per-vertex index miss) and its miss price; kept where it lowers the fit's error "
+                "(docs/device-profiles.md)");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer (use for timings)");
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }

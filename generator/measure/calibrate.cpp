@@ -394,7 +394,7 @@ std::string compareCapture(const Probe& p, const std::vector<uint8_t>& captured,
 }  // namespace
 
 DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
-                               double workloadVertices, double nearBestPower, ProfileForm form) {
+                               double workloadVertices, double nearBestPower, ProfileForm form, bool constantCache) {
   std::map<std::pair<std::string, std::string>, double> fastest;  // (rig, mesh) -> ns per vertex
   std::vector<const CalibrationSample*> used;
   for (const auto& s : samples)
@@ -412,7 +412,7 @@ DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, co
     if (!s->rig.empty() && nearBestPower > 0) r.weight = std::pow(fastest.at({s->rig, s->mesh}) / s->measuredNs, nearBestPower);
     rows.push_back(r);
   }
-  DeviceProfile profile = fitProfile(rows, form).profile;
+  DeviceProfile profile = fitProfile(rows, form, constantCache).profile;
   profile.device = deviceName;
   if (profile.hasDrawWeights()) profile.verticesPerDraw = workloadVertices;
   return profile;
@@ -529,7 +529,7 @@ LeaveOneRigOut summarise(std::vector<HeldOutRig> rows) {
 }  // namespace
 
 LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
-                              double workloadVertices, double nearBestPower, ProfileForm form) {
+                              double workloadVertices, double nearBestPower, ProfileForm form, bool constantCache) {
   std::set<std::string> rigs;
   for (const auto& s : samples)
     if (!s.rig.empty()) rigs.insert(s.rig);
@@ -539,7 +539,7 @@ LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, con
     std::vector<CalibrationSample> rest;
     for (const auto& s : samples)
       if (s.rig != rig) rest.push_back(s);
-    const DeviceProfile profile = fitDeviceProfile(rest, deviceName, workloadVertices, nearBestPower, form);
+    const DeviceProfile profile = fitDeviceProfile(rest, deviceName, workloadVertices, nearBestPower, form, constantCache);
     for (auto& h : predictRigs(samples, rig, profile)) rows.push_back(std::move(h));
   }
   return summarise(std::move(rows));
@@ -852,7 +852,8 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   rep.nearBestPower = rigs.empty() ? 0 : opts.nearBestPower;
   if (stopped() && std::none_of(rep.samples.begin(), rep.samples.end(), [](const CalibrationSample& s) { return s.validated; }))
     throw std::runtime_error("calibration: interrupted before anything was timed: nothing to fit");
-  rep.profile = fitDeviceProfile(rep.samples, rep.device + " (" + rep.driver + ")", workload, opts.nearBestPower, opts.form);
+  rep.profile =
+      fitDeviceProfile(rep.samples, rep.device + " (" + rep.driver + ")", workload, opts.nearBestPower, opts.form, opts.constantCache);
   // The check: each rig's plans under the fitted profile. The plans a profile chooses are
   // where its errors cost time, so each refit adds them to the fit; the last check's plans
   // are never fitted.
@@ -864,14 +865,14 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
     benchRigs(fitted, false, last ? "checked plan: " : fmt::format("plan under fit {}: ", round + 1));
     if (last) break;
     for (auto& s : rep.samples) s.fitted = true;
-    rep.profile = fitDeviceProfile(rep.samples, rep.profile.device, workload, opts.nearBestPower, opts.form);
+    rep.profile = fitDeviceProfile(rep.samples, rep.profile.device, workload, opts.nearBestPower, opts.form, opts.constantCache);
   }
   std::vector<std::string> fitMeshes = opts.meshes;
   for (const auto& rig : rigs)
     if (isGltfPath(rig) && std::find(fitMeshes.begin(), fitMeshes.end(), kOwnMesh) == fitMeshes.end())
       fitMeshes.push_back(kOwnMesh);
   rep.fits = evaluateFit(rep.samples, rep.profile, fitMeshes);
-  rep.heldOut = leaveOneRigOut(rep.samples, rep.profile.device, workload, rep.nearBestPower, opts.form);
+  rep.heldOut = leaveOneRigOut(rep.samples, rep.profile.device, workload, rep.nearBestPower, opts.form, opts.constantCache);
   if (stopped())
     rep.notes.push_back(fmt::format("interrupted: {} samples were timed and are fitted; the probes, rigs and checks after "
                                     "the interruption were not timed",

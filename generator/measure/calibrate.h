@@ -66,6 +66,9 @@ struct CalibrationOptions {
   // wrong order costs time (docs/device-profiles.md, "Where the fit looks"). 0: all alike.
   double nearBestPower = 4;
   ProfileForm form = ProfileForm::Additive;  // the model fitted (measure/fit.h)
+  // Fit the constant cache's capacity too (measure/fit.h; roofline and raster forms): kept only
+  // where it lowers the fit's error; compare the leave-one-rig-out tables with and without.
+  bool constantCache = false;
   // Set (by the CLI's SIGINT handler: a device call's time limit) to time nothing more: the
   // probe or rig being timed finishes, the rest are skipped, and what was timed is fitted and
   // reported, with a note saying so.
@@ -128,7 +131,8 @@ struct LeaveOneRigOut {
   double medianSpearman = NAN, worstChosenOverFastest = NAN, medianRms = NAN, maxRms = NAN;
 };
 LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
-                              double workloadVertices, double nearBestPower, ProfileForm form = ProfileForm::Additive);
+                              double workloadVertices, double nearBestPower, ProfileForm form = ProfileForm::Additive,
+                              bool constantCache = false);
 std::string formatLeaveOneRigOut(const LeaveOneRigOut& loo);
 // The held-out check: each (rig, mesh) of samples no fit saw, its plans predicted by `profile`
 // (same figures as leave-one-rig-out).
@@ -157,7 +161,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts);
 // `workloadVertices`.
 DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
                                double workloadVertices, double nearBestPower = 0,
-                               ProfileForm form = ProfileForm::Additive);
+                               ProfileForm form = ProfileForm::Additive, bool constantCache = false);
 // Fills predictedNs of every sample and the fit statistics per mesh.
 std::vector<CalibrationFit> evaluateFit(std::vector<CalibrationSample>& samples, const DeviceProfile& profile,
                                         const std::vector<std::string>& meshes);

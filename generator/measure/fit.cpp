@@ -234,7 +234,7 @@ std::vector<double> constantCacheCandidates(const std::vector<FitRow>& rows, con
   return out;
 }
 
-FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form) {
+FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form, bool constantCache) {
   if (rows.empty()) throw std::runtime_error("calibration: no validated timing to fit");
   std::set<double> sizes;
   for (const FitRow& r : rows) sizes.insert(r.vertices);
@@ -257,7 +257,7 @@ FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form) {
   // each threshold between the footprints the rows read, with a miss factor fitted beside the
   // weights; the best threshold is kept where it explains kMinCapacityGain of the squared error.
   double capacity = 0;
-  if (!skeleton.pipes.empty()) {
+  if (constantCache && !skeleton.pipes.empty()) {
     Layout withMiss = l;
     withMiss.miss = true;
     for (size_t t = 0; t < kTermCount; ++t) withMiss.missTerms[t] = skeleton.scaledBy[t] == kFeatureJointsPerWarp;

@@ -40,7 +40,7 @@ struct FitResult {
   bool converged = false;
 };
 
-// The constant cache (roofline and raster forms): where rows that read a uniform at a per-vertex
+// The constant cache (`constantCache`, roofline and raster forms): where rows that read a uniform at a per-vertex
 // index have palette footprints (Workload::paletteEntriesPerWarp) on both sides of a threshold
 // C, kMinRowsPerSideOfCapacity rows at least on each, the fit tries each C between two such
 // footprints with a miss factor M >= 1 as one more parameter (a row past C pays M times its
@@ -54,7 +54,7 @@ std::vector<double> constantCacheCandidates(const std::vector<FitRow>& rows, con
 // Per-draw weights only when the rows' draws differ in size (else they cannot be told apart
 // from per-vertex ones). Deterministic: same rows, same weights. Throws std::runtime_error
 // without rows.
-FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form);
+FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form, bool constantCache = false);
 
 // The upper median (of an even count, the larger middle value); 0 when empty.
 double medianOf(std::vector<double> v);

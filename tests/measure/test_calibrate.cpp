@@ -431,7 +431,7 @@ TEST(Calibrate, TheFitFindsTheConstantCachesCapacityAndItsMissPrice) {
                             }),
              test.end());
   ASSERT_GT(test.size(), 70u);
-  const DeviceProfile raster = fitDeviceProfile(train, "cached device", 180000, 0, ProfileForm::Raster);
+  const DeviceProfile raster = fitDeviceProfile(train, "cached device", 180000, 0, ProfileForm::Raster, true);
   EXPECT_GE(raster.constantCacheEntries, within);
   EXPECT_LT(raster.constantCacheEntries, past);
   EXPECT_NEAR(raster.constantCacheMissFactor, miss, 0.05);
@@ -440,11 +440,12 @@ TEST(Calibrate, TheFitFindsTheConstantCachesCapacityAndItsMissPrice) {
   // Without the footprints the fit cannot see the cache, and prices every warp alike.
   std::vector<CalibrationSample> blind = train;
   for (auto& s : blind) s.workload.paletteEntriesPerWarp = 0;
-  const DeviceProfile without = fitDeviceProfile(blind, "cached device", 180000, 0, ProfileForm::Raster);
+  const DeviceProfile without = fitDeviceProfile(blind, "cached device", 180000, 0, ProfileForm::Raster, true);
   EXPECT_EQ(without.constantCacheEntries, 0);
   EXPECT_GT(heldOutRms(without), 0.05);
-  // A device without the cliff gets no constant_cache from the same footprints.
-  const DeviceProfile flat = fitDeviceProfile(cacheRows(1, 200, capacity, 1.0), "flat device", 180000, 0, ProfileForm::Raster);
+  // Not asked for, the fit has none; a device without the cliff gets none from the same footprints.
+  EXPECT_EQ(fitDeviceProfile(train, "cached device", 180000, 0, ProfileForm::Raster).constantCacheEntries, 0);
+  const DeviceProfile flat = fitDeviceProfile(cacheRows(1, 200, capacity, 1.0), "flat device", 180000, 0, ProfileForm::Raster, true);
   EXPECT_EQ(flat.constantCacheEntries, 0);
   // Written and read back, it predicts the same; past the capacity a warp costs miss x as much.
   CalibrationReport r;
