@@ -294,6 +294,14 @@ std::string describePlanCost(const Plan& plan, const Problem& p, const DevicePro
     out += fmt::format("    {:<26} {:>8} {:>10} {:>9.3f}{}\n", "pipe " + profile.pipes[k].name, "", "", c.pipeNanoseconds[k],
                        static_cast<int>(k) == c.slowestPipe ? "  (slowest: counted)" : "");
   if (profile.workload.known()) out += fmt::format("    workload: {}\n", describeWorkload(profile.workload));
+  if (profile.constantCacheEntries > 0) {
+    const bool known = profile.workload.paletteEntriesPerWarp > 0;
+    const double entries = known ? profile.workload.paletteEntriesPerWarp : profile.workloadDefaults[kFeaturePaletteEntriesPerWarp];
+    out += fmt::format("    constant cache: {:.1f} palette entries per warp{} against its {:g}: {}\n", entries,
+                       known ? "" : " (the profile's default)", profile.constantCacheEntries,
+                       profile.constantCacheFactor() > 1 ? fmt::format("past it, each address priced {:.3g}x", profile.constantCacheMissFactor)
+                                                         : "within it");
+  }
   out += fmt::format("    {:<26} {:>8} {:>10} {:>9.3f}\n", "total", "", "", c.totalNanoseconds);
   return out;
 }

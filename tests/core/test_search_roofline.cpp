@@ -265,5 +265,42 @@ TEST(SearchRoofline, ThePredictionShowsEachTermInItsPipe) {
   EXPECT_DOUBLE_EQ(predictPlanCost(*plan, p, prof).totalNanoseconds, 2.5);
 }
 
+// A profile's constant cache: a warp whose palette footprint is past its capacity pays the miss
+// factor on every address, so the same two plans swap places across it, in every engine, and the
+// prediction says which side of the capacity the workload is on.
+TEST(SearchRoofline, TheConstantCacheMovesThePlanAcrossItsCapacity) {
+  DeviceProfile prof;
+  prof.device = "test";
+  DeviceProfile::Pipe memory, constant;
+  memory.name = "memory";
+  memory.nanoseconds[kTermBufferLoads] = 0.25;
+  constant.name = "constant";
+  constant.nanoseconds[kTermIndexedUniformLoads] = 0.06;
+  prof.pipes = {memory, constant};
+  prof.scaledBy[kTermIndexedUniformLoads] = kFeatureJointsPerWarp;
+  prof.constantCacheEntries = 29;
+  prof.constantCacheMissFactor = 2;
+  prof.workload.jointsPerWarp = 5;
+  for (double footprint : {20.0, 40.0}) {
+    Problem p = oneGoal();
+    addWay(p, "buffer_palette", 0, 6);  // 6 x 0.25 = 1.5 ns in memory
+    Action uniform{"uniform_palette", static_cast<int>(p.actions.size()), {0}, 1};
+    uniform.terms[kTermIndexedUniformLoads] = 4;  // 4 x 5 joints x 0.06 = 1.2 ns, or 2.4 past the cache
+    p.actions.push_back(uniform);
+    prof.workload.paletteEntriesPerWarp = footprint;
+    applyDeviceProfile(p, prof);
+    for (const char* engine : {"auto", "ip"}) {
+      auto plan = solveWith(p, engine);
+      ASSERT_TRUE(plan) << engine;
+      EXPECT_EQ(p.actions[plan->actions[0]].name, footprint < 29 ? "uniform_palette" : "buffer_palette") << engine;
+      EXPECT_DOUBLE_EQ(predictPlanCost(*plan, p, prof).totalNanoseconds, footprint < 29 ? 1.2 : 1.5) << engine;
+      const std::string text = describePlanCost(*plan, p, prof);
+      EXPECT_NE(text.find(footprint < 29 ? "against its 29: within it" : "against its 29: past it, each address priced 2x"),
+                std::string::npos)
+          << text;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace sg
