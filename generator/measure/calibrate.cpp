@@ -624,11 +624,13 @@ std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, cons
     } catch (const std::exception&) {
       continue;  // a row that failed ("FAILED, not timed")
     }
+    if (!std::isfinite(s.vertices) || !std::isfinite(s.workload.jointsPerWarp) || !std::isfinite(s.measuredNs)) continue;
     // Optional columns (later logs): "—" or absent reads as not recorded.
     auto optional = [&](const char* name, double& into) {
       if (const std::string* v = at(cells, name); v && *v != "—") {
-        try {
-          into = std::stod(*v);
+        try {  // a figure that is not a finite number reads as not recorded
+          const double x = std::stod(*v);
+          if (std::isfinite(x)) into = x;
         } catch (const std::exception&) {
         }
       }
