@@ -214,3 +214,25 @@ TEST(HeldOut, ARigUnderTwoRequestsIsTwoChoices) {
   EXPECT_EQ(together.rows.size(), checkHeldOut(world, profile).rows.size() + checkHeldOut(pbr, profile).rows.size());
 }
 }  // namespace sg
+
+// A log's figures are numbers a person or a script may have edited: one that is not finite
+// ("inf", "nan") is not recorded (an optional column) or drops its row (a time, vertices or joints
+// per warp), so no infinite footprint becomes a capacity that the written profile cannot state.
+namespace sg {
+TEST(HeldOut, FiguresThatAreNotFiniteAreNotRead) {
+  const std::string header =
+      "| mesh | rig | program | indexed_uniform_loads | measured ns/vertex | joints per warp | vertices per draw | palette entries per warp |\n"
+      "|---|---|---|---:|---:|---:|---:|---:|\n";
+  std::istringstream in(header +
+                        "| head | a.rig.yaml | plan: generated | 4 | 2.5 | 12 | 2009 | inf |\n"
+                        "| head | a.rig.yaml | plan: forced x | 4 | inf | 12 | 2009 | 30 |\n"
+                        "| head | a.rig.yaml | plan: forced y | 4 | 2.5 | nan | 2009 | 30 |\n"
+                        "| head | a.rig.yaml | plan: forced z | 4 | 2.5 | 12 | inf | 30 |\n"
+                        "| head | a.rig.yaml | plan: forced w | 4 | 3.5 | 12 | 2009 | 31.5 |\n");
+  const std::vector<CalibrationSample> samples = parseCalibrationSamples(in, {});
+  ASSERT_EQ(samples.size(), 2u);
+  EXPECT_EQ(samples[0].workload.paletteEntriesPerWarp, 0);  // inf: not recorded
+  EXPECT_EQ(samples[1].label, "plan: forced w");
+  EXPECT_DOUBLE_EQ(samples[1].workload.paletteEntriesPerWarp, 31.5);
+}
+}  // namespace sg
