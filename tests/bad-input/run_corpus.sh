@@ -10,6 +10,7 @@
 # leave its own directory byte-identical, and write nothing (no output, no temporary)
 # when it fails. The command runs in the fresh output directory @O.
 set -uo pipefail
+[ -z "${LD_PRELOAD-}" ] || SG_SHADERGEN_PRELOAD=$LD_PRELOAD LD_PRELOAD= exec bash "$0" "$@"  # tests/support/preload_only_shadergen.sh
 SG=$(realpath "$1") SRC=$(realpath "$2") AREA=$3
 shift 3
 SCALE=${SHADERGEN_CORPUS_TIME_SCALE:-1}
@@ -33,21 +34,25 @@ fi
 # Repo paths in `run` (examples/..., rules/..., tests/..., templates/...) are relative to
 # the source root; @D is the case directory, @O the output directory, @T a scratch
 # directory that the optional `setup` script (bash setup @T) prepares (FIFOs...).
-expand() {  # expand <token> <D> <O> <T>
+# Each case's bookkeeping runs in this shell (parameter expansion, read, $EPOCHREALTIME)
+# rather than in $(...) subshells and small processes: forks are most of the cost of a case
+# that shadergen refuses at once, above all under sanitizers.
+expand() {  # expand <token> <D> <O> <T>: sets $x
   local t=$1
   t=${t//@D/$2}
   t=${t//@O/$3}
   t=${t//@T/$4}
   case "$t" in examples/* | rules/* | tests/* | templates/*) t=$SRC/$t ;; esac
-  printf '%s' "$t"
+  x=$t
 }
-snapshot() {  # every entry's type and size, then every regular file's checksum
-  (cd "$1" && find . -printf '%y %s %p\n' | LC_ALL=C sort && find . -type f -print0 | LC_ALL=C sort -z | xargs -0 -r sha256sum)
+snapshot() {  # every entry's type and size and every regular file's checksum, sorted (called in $(...))
+  cd "$1" && find . -printf '%y %s %p\n' -type f -exec sha256sum {} + | LC_ALL=C sort
 }
+usecs() { local t=${EPOCHREALTIME//[!0-9]/}; printf -v "$1" '%s' "$((10#$t))"; }  # usecs VAR: now in microseconds
 
 fails=0 n=0
 for D in "${cases[@]}"; do
-  name="$AREA/$(basename "$D")"
+  name="$AREA/${D##*/}"
   n=$((n + 1))
   if [ ! -f "$D/expect" ]; then echo "FAIL $name: no 'expect' file"; fails=$((fails + 1)); continue; fi
   C=$WORK/$n
@@ -56,12 +61,15 @@ for D in "${cases[@]}"; do
   [ -f "$D/setup" ] && bash "$D/setup" "$T"
   before=$(snapshot "$D")
   # Tokens: shell-like words (quotes allowed, no expansion), then @-expansion per word.
-  mapfile -t raw < <(xargs -n1 printf '%s\n' < "$D/run")
+  mapfile -t raw < <(xargs printf '%s\n' < "$D/run")
   args=()
-  for w in "${raw[@]}"; do args+=("$(expand "$w" "$D" "$O" "$T")"); done
-  want=$(head -n1 "$D/expect" | tr -d '[:space:]')
+  for w in "${raw[@]}"; do expand "$w" "$D" "$O" "$T"; args+=("$x"); done
+  want= && read -r want < "$D/expect"
+  want=${want//[[:space:]]/}
   cwd=$O
-  [ -f "$D/cwd" ] && cwd=$(expand "$(tr -d '[:space:]' < "$D/cwd")" "$D" "$O" "$T")
+  if [ -f "$D/cwd" ]; then
+    cwd=$(<"$D/cwd") && expand "${cwd//[[:space:]]/}" "$D" "$O" "$T" && cwd=$x
+  fi
   # Killed at the limit: one more try, so that a load spike on a shared machine is not
   # taken for a hang (a real hang is killed twice).
   # Only the commands that open a Vulkan device need the driver preloaded (sanitizer runs):
@@ -70,31 +78,38 @@ for D in "${cases[@]}"; do
   sg=$SG_NO_DEVICE
   case "${args[0]-}" in validate | check | render | bench | calibrate | build) sg=$SG ;; esac
   for try in 1 2; do
-    rm -rf "$O" && mkdir -p "$O"
-    start=$(date +%s.%N)
+    [ "$try" -eq 1 ] || { rm -rf "$O" && mkdir -p "$O"; }  # the first try's $O is new and empty
+    usecs start
     (cd "$cwd" && exec timeout -s KILL "$LIMIT" "$sg" "${args[@]}" </dev/null >"$C/stdout" 2>"$C/stderr")
     got=$?
     [ "$got" -eq 137 ] || break
   done
-  secs=$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { printf "%.2f", b - a }')
+  usecs end
+  cs=$(((end - start + 5000) / 10000))
+  printf -v secs '%d.%02d' $((cs / 100)) $((cs % 100))
   problems=()
   if [ "$got" -eq 137 ]; then problems+=("killed after ${LIMIT}s (hang or too slow)")
   elif [ "$got" -ge 128 ]; then problems+=("died of signal $((got - 128))")
   elif [ "$got" != "$want" ]; then problems+=("exit $got, expected $want"); fi
-  while IFS= read -r line || [ -n "$line" ]; do
-    [ -z "$line" ] && continue
-    line=${line//@D/$D}
-    line=${line//@O/$O}
-    line=${line//@T/$T}
-    grep -qF -- "$line" "$C/stderr" || problems+=("stderr lacks: $line")
-  done < <(tail -n +2 "$D/expect")
+  {
+    read -r _  # the exit status
+    while IFS= read -r line || [ -n "$line" ]; do
+      [ -z "$line" ] && continue
+      line=${line//@D/$D}
+      line=${line//@O/$O}
+      line=${line//@T/$T}
+      grep -qF -- "$line" "$C/stderr" </dev/null || problems+=("stderr lacks: $line")
+    done
+  } < "$D/expect"
   grep -q 'runtime error:\|AddressSanitizer\|LeakSanitizer\|UndefinedBehaviorSanitizer' "$C/stderr" &&
     problems+=("sanitizer report")
   after=$(snapshot "$D")
   [ "$before" == "$after" ] || problems+=("the case directory changed: $(diff <(echo "$before") <(echo "$after") | grep '^[<>]' | head -3 | tr '\n' ' ')")
   if [ "$got" -ne 0 ]; then
-    left=$(cd "$O" && find . -mindepth 1 | head -5 | tr '\n' ' ')
-    [ -z "$left" ] || problems+=("failed but wrote: $left")
+    shopt -s nullglob dotglob
+    left=("$O"/*)
+    shopt -u nullglob dotglob
+    [ ${#left[@]} -eq 0 ] || problems+=("failed but wrote: $(cd "$O" && find . -mindepth 1 | head -5 | tr '\n' ' ')")
   fi
   if [ ${#problems[@]} -eq 0 ]; then
     echo "ok   $name (exit $got, ${secs}s)"

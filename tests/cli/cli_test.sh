@@ -4,6 +4,7 @@
 #
 #   cli_test.sh <case> <shadergen> <source dir> <c++ compiler> <version> [ninja]
 set -uo pipefail
+[ -z "${LD_PRELOAD-}" ] || SG_SHADERGEN_PRELOAD=$LD_PRELOAD LD_PRELOAD= exec bash "$0" "$@"  # tests/support/preload_only_shadergen.sh
 case_name=$1 SG=$2 SRC=$3 CXX=$4 VERSION=$5 NINJA=${6:-}
 E=$SRC/examples/dawn
 T=$(mktemp -d "${TMPDIR:-/tmp}/sg-cli-XXXXXX")

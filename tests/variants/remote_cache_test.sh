@@ -8,6 +8,7 @@
 # server_killed, corrupt, truncated, concurrent, killed_build, credentials, validate_dawn,
 # validate_model.
 set -uo pipefail
+[ -z "${LD_PRELOAD-}" ] || SG_SHADERGEN_PRELOAD=$LD_PRELOAD LD_PRELOAD= exec bash "$0" "$@"  # tests/support/preload_only_shadergen.sh
 case_name=$1 SG=$(realpath "$2") SRC=$3 MODELS=${4:-$SRC/../shared/models}
 E=$SRC/examples/dawn
 T=$(mktemp -d "${TMPDIR:-/tmp}/sg-remote-XXXXXX") || exit 1
