@@ -150,9 +150,9 @@ case "$what" in
     timed test product_test
     timed sanitize-build sanitize_build
     timed sanitize-test sanitize_test
-    # CI's share of fuzzing: the seeds replayed and 20 s of search per target (the `fuzz`
+    # CI's share of fuzzing: the seeds replayed and 10 s of search per target (the `fuzz`
     # job runs 60 s, and longer with SHADERGEN_FUZZ_SECONDS).
-    SHADERGEN_FUZZ_SECONDS=${SHADERGEN_FUZZ_SECONDS:-20} timed fuzz fuzz_run
+    SHADERGEN_FUZZ_SECONDS=${SHADERGEN_FUZZ_SECONDS:-10} timed fuzz fuzz_run
     ;;
   plain)
     timed build plain_build
