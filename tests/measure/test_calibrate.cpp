@@ -248,6 +248,20 @@ TEST(Calibrate, WeightingThePlansNearTheFastestOrdersTheH200PlansTheSearchCompar
 // per-vertex and a per-draw fixed cost, whose palette loads cost per distinct joint a warp
 // reads. Rows are drawn at random over two draw sizes and several meshes' joints per warp;
 // the roofline fit must predict rows it never saw, and the additive form cannot.
+// RMS relative error of `p`'s predictions over `rows`, each priced at its own workload (its
+// fragments unknown, priced at the profile's default, unless `fragmentsKnown`).
+double rmsRelativeError(const DeviceProfile& p, const std::vector<CalibrationSample>& rows, bool fragmentsKnown = true) {
+  double sq = 0;
+  for (const auto& s : rows) {
+    DeviceProfile at = p;
+    at.workload = s.workload;
+    if (!fragmentsKnown) at.workload.fragmentsPerVertex = 0;
+    const double e = at.predictNanoseconds(s.amounts, s.vertices) / s.measuredNs - 1;
+    sq += e * e;
+  }
+  return std::sqrt(sq / double(rows.size()));
+}
+
 namespace roofline {
 struct Device {
   double vertexNs = 0.3, drawNs = 400;
@@ -289,16 +303,7 @@ std::vector<CalibrationSample> rows(uint32_t seed, int n) {
 
 TEST(Calibrate, TheRooflineFitPredictsRowsItNeverSawWhereTheAdditiveCannot) {
   const std::vector<CalibrationSample> train = roofline::rows(1, 160), test = roofline::rows(2, 80);
-  auto heldOutRms = [&](const DeviceProfile& p) {
-    double sq = 0;
-    for (const auto& s : test) {
-      DeviceProfile at = p;
-      at.workload = s.workload;
-      const double e = at.predictNanoseconds(s.amounts, s.vertices) / s.measuredNs - 1;
-      sq += e * e;
-    }
-    return std::sqrt(sq / double(test.size()));
-  };
+  auto heldOutRms = [&](const DeviceProfile& p) { return rmsRelativeError(p, test); };
   const DeviceProfile roof = fitDeviceProfile(train, "roofline device", 180000, 0, ProfileForm::Roofline);
   const DeviceProfile sum = fitDeviceProfile(train, "roofline device", 180000, 0, ProfileForm::Additive);
   ASSERT_EQ(roof.pipes.size(), 5u);
@@ -346,17 +351,7 @@ std::vector<CalibrationSample> rasterRows(uint32_t seed, int n, double fragmentN
 TEST(Calibrate, TheRasterFitPricesTheFragmentsADrawCovers) {
   const double fragmentNs = 0.05;
   const std::vector<CalibrationSample> train = rasterRows(1, 160, fragmentNs), test = rasterRows(2, 80, fragmentNs);
-  auto heldOutRms = [&](const DeviceProfile& p, bool fragmentsKnown) {
-    double sq = 0;
-    for (const auto& s : test) {
-      DeviceProfile at = p;
-      at.workload = s.workload;
-      if (!fragmentsKnown) at.workload.fragmentsPerVertex = 0;
-      const double e = at.predictNanoseconds(s.amounts, s.vertices) / s.measuredNs - 1;
-      sq += e * e;
-    }
-    return std::sqrt(sq / double(test.size()));
-  };
+  auto heldOutRms = [&](const DeviceProfile& p, bool fragmentsKnown) { return rmsRelativeError(p, test, fragmentsKnown); };
   const DeviceProfile raster = fitDeviceProfile(train, "raster device", 180000, 0, ProfileForm::Raster);
   const DeviceProfile roof = fitDeviceProfile(train, "raster device", 180000, 0, ProfileForm::Roofline);
   EXPECT_FALSE(raster.hasDrawWeights());
@@ -404,16 +399,7 @@ TEST(Calibrate, TheFitFindsTheConstantCachesCapacityAndItsMissPrice) {
   const double capacity = 30, miss = 2.5;
   const std::vector<CalibrationSample> train = cacheRows(1, 200, capacity, miss);
   std::vector<CalibrationSample> test = cacheRows(2, 80, capacity, miss);
-  auto heldOutRms = [&](const DeviceProfile& p) {
-    double sq = 0;
-    for (const auto& s : test) {
-      DeviceProfile at = p;
-      at.workload = s.workload;
-      const double e = at.predictNanoseconds(s.amounts, s.vertices) / s.measuredNs - 1;
-      sq += e * e;
-    }
-    return std::sqrt(sq / double(test.size()));
-  };
+  auto heldOutRms = [&](const DeviceProfile& p) { return rmsRelativeError(p, test); };
   // What the rows can tell: the capacity lies between the largest footprint within it and the
   // smallest past it, among the rows that read the palette at a per-vertex index.
   double within = 0, past = 1e9;
