@@ -914,7 +914,7 @@ std::string rooflineLines(const DeviceProfile& p) {
     }
   if (p.constantCacheEntries > 0)
     s += fmt::format("constant_cache:  # past this palette footprint per warp, a distinct address costs miss_factor times as much\n"
-                     "  entries: {:g}\n  miss_factor: {:.6g}\n",
+                     "  entries: {:.10g}\n  miss_factor: {:.6g}\n",
                      p.constantCacheEntries, p.constantCacheMissFactor);
   return s;
 }

@@ -216,8 +216,14 @@ double medianOf(std::vector<double> v) {
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
+namespace {
+
+// The capacities tried: a threshold between each two consecutive distinct footprints of the
+// rows that read a uniform at a per-vertex index (a term scaled by joints per warp), with
+// kMinRowsPerSideOfCapacity footprints at least on each side. Each is the midpoint rounded to
+// 0.01 (to more digits where that would leave the gap), so the profile states it exactly and it
+// still parts the rows as tried.
 std::vector<double> constantCacheCandidates(const std::vector<FitRow>& rows, const DeviceProfile& form) {
-  // The footprints of rows that read a uniform at a per-vertex index (a term scaled by joints per warp).
   std::vector<double> footprints;
   for (const FitRow& r : rows) {
     bool reads = false;
@@ -226,13 +232,21 @@ std::vector<double> constantCacheCandidates(const std::vector<FitRow>& rows, con
   }
   std::sort(footprints.begin(), footprints.end());
   std::vector<double> out;
-  for (size_t i = kMinRowsPerSideOfCapacity; i + kMinRowsPerSideOfCapacity <= footprints.size(); ++i)
-    if (footprints[i] > footprints[i - 1] * 1.001) {
-      const double mid = 0.5 * (footprints[i - 1] + footprints[i]);
-      out.push_back(std::round(mid * 100) / 100);
-    }
+  for (size_t i = kMinRowsPerSideOfCapacity; i + kMinRowsPerSideOfCapacity <= footprints.size(); ++i) {
+    const double below = footprints[i - 1], above = footprints[i];
+    if (!(above > below * 1.001)) continue;
+    double c = 0.5 * (below + above);
+    for (double scale = 100; scale <= 1e9; scale *= 10)
+      if (const double r = std::round(0.5 * (below + above) * scale) / scale; r >= below && r < above) {
+        c = r;
+        break;
+      }
+    out.push_back(c);
+  }
   return out;
 }
+
+}  // namespace
 
 FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form, bool constantCache) {
   if (rows.empty()) throw std::runtime_error("calibration: no validated timing to fit");
@@ -263,9 +277,17 @@ FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form, bool con
     for (size_t t = 0; t < kTermCount; ++t) withMiss.missTerms[t] = skeleton.scaledBy[t] == kFeatureJointsPerWarp;
     double bestWithMiss = INFINITY;
     Solved chosen;
+    // A row is past a capacity by the profile's own rule (a footprint not recorded: the default).
+    DeviceProfile rule = skeleton;
+    rule.workloadDefaults[kFeaturePaletteEntriesPerWarp] = medianOf(entries);
+    rule.constantCacheMissFactor = 2;
     for (double c : constantCacheCandidates(rows, skeleton)) {
+      rule.constantCacheEntries = c;
       std::vector<bool> past;
-      for (const FitRow& r : rows) past.push_back(r.workload.paletteEntriesPerWarp > c);
+      for (const FitRow& r : rows) {
+        rule.workload = r.workload;
+        past.push_back(rule.constantCacheFactor() > 1);
+      }
       Solved s = solve(withMiss, rows, xs, past);
       if (s.cost < bestWithMiss) bestWithMiss = s.cost, chosen = s, capacity = c;
     }

@@ -48,8 +48,6 @@ struct FitResult {
 // error by kMinCapacityGain of the fit without it; else the profile has no constant_cache.
 constexpr size_t kMinRowsPerSideOfCapacity = 3;
 constexpr double kMinCapacityGain = 0.02;
-// The thresholds tried: midpoints between consecutive distinct footprints, rounded to 0.01.
-std::vector<double> constantCacheCandidates(const std::vector<FitRow>& rows, const DeviceProfile& form);
 
 // Per-draw weights only when the rows' draws differ in size (else they cannot be told apart
 // from per-vertex ones). Deterministic: same rows, same weights. Throws std::runtime_error

@@ -11,9 +11,9 @@
 #include <set>
 
 #include "analysis/cost.h"
-#include "measure/fit.h"
 #include "common/glsl_compile.h"
 #include "common/input_file.h"
+#include "measure/fit.h"
 #include "measure/workload.h"
 #include "rig/packed_fields.h"
 #include "rig/vertex_format.h"

@@ -63,35 +63,43 @@ const char* featureName(int feature) {
   return feature >= 0 && feature < kFeatureCount ? names[feature] : "?";
 }
 
-double DeviceProfile::feature(int f) const {
+namespace {
+
+// A feature's value as measured: the workload's, else the profile's stated default, else 1.
+double stated(const DeviceProfile& p, int f) {
+  const Workload& w = p.workload;
   double v = -1;
   switch (f) {
-    case kFeatureNone: return 1;
-    case kFeatureJointsPerWarp: {
-      // A warp's reads of distinct addresses, each priced as a miss past the cache's capacity.
-      const double j = workload.jointsPerWarp > 0 ? workload.jointsPerWarp : workloadDefaults[static_cast<size_t>(f)];
-      return (j > 0 ? j : 1.0) * constantCacheFactor();
-    }
-    case kFeaturePaletteEntriesPerWarp: v = workload.paletteEntriesPerWarp > 0 ? workload.paletteEntriesPerWarp : -1; break;
-    case kFeatureInvocationsPerVertex: v = workload.invocationsPerVertex > 0 ? workload.invocationsPerVertex : -1; break;
-    case kFeatureActiveMorphTargets: v = workload.activeMorphTargets; break;
-    case kFeatureFragmentsPerVertex: v = workload.fragmentsPerVertex > 0 ? workload.fragmentsPerVertex : -1; break;
-    case kFeatureJointsPerWarpSquared: {
-      const double j = workload.jointsPerWarp > 0 ? workload.jointsPerWarp : workloadDefaults[kFeatureJointsPerWarp];
-      return j > 0 ? j * j : 1.0;
-    }
+    case kFeatureJointsPerWarp: v = w.jointsPerWarp > 0 ? w.jointsPerWarp : -1; break;
+    case kFeatureInvocationsPerVertex: v = w.invocationsPerVertex > 0 ? w.invocationsPerVertex : -1; break;
+    case kFeatureActiveMorphTargets: v = w.activeMorphTargets; break;
+    case kFeatureFragmentsPerVertex: v = w.fragmentsPerVertex > 0 ? w.fragmentsPerVertex : -1; break;
+    case kFeaturePaletteEntriesPerWarp: v = w.paletteEntriesPerWarp > 0 ? w.paletteEntriesPerWarp : -1; break;
     default: break;
   }
   if (v >= 0) return v;
-  const double d = workloadDefaults[static_cast<size_t>(f)];
+  const double d = p.workloadDefaults[static_cast<size_t>(f)];
   return d > 0 ? d : 1.0;
+}
+
+}  // namespace
+
+double DeviceProfile::feature(int f) const {
+  switch (f) {
+    case kFeatureNone: return 1;
+    // A warp's reads of distinct addresses, each priced as a miss past the cache's capacity.
+    case kFeatureJointsPerWarp: return stated(*this, f) * constantCacheFactor();
+    case kFeatureJointsPerWarpSquared: {
+      const double j = stated(*this, kFeatureJointsPerWarp);
+      return j * j;
+    }
+    default: return stated(*this, f);
+  }
 }
 
 double DeviceProfile::constantCacheFactor() const {
   if (constantCacheEntries <= 0) return 1.0;
-  const double entries = workload.paletteEntriesPerWarp > 0 ? workload.paletteEntriesPerWarp
-                                                            : workloadDefaults[kFeaturePaletteEntriesPerWarp];
-  return entries > constantCacheEntries ? constantCacheMissFactor : 1.0;
+  return feature(kFeaturePaletteEntriesPerWarp) > constantCacheEntries ? constantCacheMissFactor : 1.0;
 }
 
 double DeviceProfile::perVertex(int term, double vertices) const {
@@ -295,10 +303,9 @@ std::string describePlanCost(const Plan& plan, const Problem& p, const DevicePro
                        static_cast<int>(k) == c.slowestPipe ? "  (slowest: counted)" : "");
   if (profile.workload.known()) out += fmt::format("    workload: {}\n", describeWorkload(profile.workload));
   if (profile.constantCacheEntries > 0) {
-    const bool known = profile.workload.paletteEntriesPerWarp > 0;
-    const double entries = known ? profile.workload.paletteEntriesPerWarp : profile.workloadDefaults[kFeaturePaletteEntriesPerWarp];
-    out += fmt::format("    constant cache: {:.1f} palette entries per warp{} against its {:g}: {}\n", entries,
-                       known ? "" : " (the profile's default)", profile.constantCacheEntries,
+    out += fmt::format("    constant cache: {:.1f} palette entries per warp{} against its {:g}: {}\n",
+                       profile.feature(kFeaturePaletteEntriesPerWarp),
+                       profile.workload.paletteEntriesPerWarp > 0 ? "" : " (the profile's default)", profile.constantCacheEntries,
                        profile.constantCacheFactor() > 1 ? fmt::format("past it, each address priced {:.3g}x", profile.constantCacheMissFactor)
                                                          : "within it");
   }

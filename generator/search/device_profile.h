@@ -66,7 +66,7 @@ struct DeviceProfile {
   double perVertex(int term, double vertices) const;
   bool hasDrawWeights() const;
   // The value of a feature for this profile's workload (the workload's, else the stated
-  // default, else 1); kFeatureNone is 1.
+  // default, else 1); kFeatureNone is 1; joints_per_warp times constantCacheFactor().
   double feature(int f) const;
   // constantCacheMissFactor where the workload's palette footprint (else its default) is past
   // the constant cache's capacity; else 1.
