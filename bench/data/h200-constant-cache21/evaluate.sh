@@ -23,9 +23,9 @@ python3 "$here/augment.py" "$A/train.log" "$tmp/blind" blind
 check=()
 for g in "${held[@]}" "${unseen[@]}"; do check+=(--check-log "$tmp/aug/$g.log"); done
 fit=(--form raster --near-best-weight 0)
-"$sg" calibrate --from-log "$tmp/aug/train.log" "${check[@]}" "${fit[@]}" --constant-cache -o "$tmp/c.yaml" > "$here/fit-capacity.txt"
-"$sg" calibrate --from-log "$tmp/aug/train.log" "${check[@]}" "${fit[@]}" -o "$tmp/w.yaml" > "$here/fit-without.txt"
-"$sg" calibrate --from-log "$tmp/blind/train.log" "${check[@]}" "${fit[@]}" --constant-cache -o "$tmp/b.yaml" > "$here/fit-blind.txt"
+"$sg" calibrate --from-log "$tmp/aug/train.log" "${check[@]}" "${fit[@]}" --constant-cache -o "$tmp/c.yaml" | grep -v ": device profile of" > "$here/fit-capacity.txt"
+"$sg" calibrate --from-log "$tmp/aug/train.log" "${check[@]}" "${fit[@]}" -o "$tmp/w.yaml" | grep -v ": device profile of" > "$here/fit-without.txt"
+"$sg" calibrate --from-log "$tmp/blind/train.log" "${check[@]}" "${fit[@]}" --constant-cache -o "$tmp/b.yaml" | grep -v ": device profile of" > "$here/fit-blind.txt"
 "$sg" calibrate --evaluate "$root/devices/nvidia-h200-raster.yaml" "${check[@]}" > "$here/shipped.txt"
 grep -v '^# held-out' "$tmp/c.yaml" > "$here/fit-capacity.yaml"
 grep -v '^# held-out' "$tmp/w.yaml" > "$here/fit-without.yaml"
