@@ -62,9 +62,9 @@ struct CalibrateCommand {
     for (const auto& f : fromLogs) rep.clock += " " + std::filesystem::path(f).filename().string();
     rep.driver = "as recorded (see the device)";
     rep.nearBestPower = co.nearBestPower;
-    rep.profile = fitDeviceProfile(rep.samples, rep.device, 180000, co.nearBestPower, co.form, co.constantCache);
+    rep.profile = fitDeviceProfile(rep.samples, rep.device, 180000, co.nearBestPower, co.fit);
     rep.fits = evaluateFit(rep.samples, rep.profile, {"dawn", "head"});
-    rep.heldOut = leaveOneRigOut(rep.samples, rep.device, 180000, co.nearBestPower, co.form, co.constantCache);
+    rep.heldOut = leaveOneRigOut(rep.samples, rep.device, 180000, co.nearBestPower, co.fit);
     if (!checkLogs.empty()) rep.check = checkHeldOut(readLogs(checkLogs, nullptr), rep.profile);
     std::cout << formatCalibration(rep);
     if (!output.empty()) {
@@ -101,9 +101,11 @@ struct CalibrateCommand {
   }
 
   int run() {
-    co.form = chosenForm();
-    if (co.constantCache && co.form == ProfileForm::Additive)
+    co.fit.form = chosenForm();
+    if (co.fit.constantCache && co.fit.form == ProfileForm::Additive)
       throw CLI::ValidationError("--constant-cache", "needs --form roofline or raster (the cache's misses are priced in the constant pipe)");
+    if (co.fit.drawSizes && co.fit.form != ProfileForm::Raster)
+      throw CLI::ValidationError("--draw-sizes", "needs --form raster (the other forms price a draw's size by their per-draw weights)");
     if (!writeCorpus.empty()) return writeCorpusFiles();
     if (!fromLogs.empty()) return refit();
     if (!evaluate.empty()) {
@@ -142,7 +144,7 @@ struct CalibrateCommand {
     co.rigs = rigs;
     co.check = !noCheck;
     co.probes = !noProbes;
-    co.form = chosenForm();
+    co.fit.form = chosenForm();
     if (!output.empty()) {
       std::vector<InputFile> inputs;
       for (const auto& r : co.rigs) inputs.push_back({isGltfPath(r) ? parseGltfRef(r).file : r, "a rig"});
@@ -239,10 +241,14 @@ void registerCalibrate(CLI::App& app, CliState& state) {
   sub->add_flag("--no-probes", cmd->noProbes, "With --rig: time only the rigs' programs (samples for another fit)");
   sub->add_option("--form", cmd->form, "The model fitted: additive (default), roofline, or raster (the roofline with the fragments a draw covers priced instead of per-draw weights; docs/device-profiles.md)")
       ->check(CLI::IsMember({"additive", "roofline", "raster"}));
-  sub->add_flag("--constant-cache", cmd->co.constantCache,
+  sub->add_flag("--constant-cache", cmd->co.fit.constantCache,
                 "With --form roofline or raster: fit the constant cache's capacity (palette entries per warp past which "
                 "uniform loads at a per-vertex index miss) and its miss price; kept where it lowers the fit's error "
                 "(docs/device-profiles.md)");
+  sub->add_flag("--draw-sizes", cmd->co.fit.drawSizes,
+                "With --form raster: fit one set of weights per mesh size the samples were timed at (vertices per "
+                "draw), a draw between two sizes priced by their weights interpolated in log(vertices); kept where it "
+                "lowers the fit's error (docs/device-profiles.md, \"Draw sizes\")");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer (use for timings)");
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }

@@ -394,7 +394,7 @@ std::string compareCapture(const Probe& p, const std::vector<uint8_t>& captured,
 }  // namespace
 
 DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
-                               double workloadVertices, double nearBestPower, ProfileForm form, bool constantCache) {
+                               double workloadVertices, double nearBestPower, const FitOptions& fit) {
   std::map<std::pair<std::string, std::string>, double> fastest;  // (rig, mesh) -> ns per vertex
   std::vector<const CalibrationSample*> used;
   for (const auto& s : samples)
@@ -412,8 +412,9 @@ DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, co
     if (!s->rig.empty() && nearBestPower > 0) r.weight = std::pow(fastest.at({s->rig, s->mesh}) / s->measuredNs, nearBestPower);
     rows.push_back(r);
   }
-  DeviceProfile profile = fitProfile(rows, form, constantCache).profile;
+  DeviceProfile profile = fitProfile(rows, fit).profile;
   profile.device = deviceName;
+  if (!profile.drawSizes.empty()) profile = profile.atDrawSize(workloadVertices);
   if (profile.hasDrawWeights()) profile.verticesPerDraw = workloadVertices;
   return profile;
 }
@@ -529,7 +530,7 @@ LeaveOneRigOut summarise(std::vector<HeldOutRig> rows) {
 }  // namespace
 
 LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
-                              double workloadVertices, double nearBestPower, ProfileForm form, bool constantCache) {
+                              double workloadVertices, double nearBestPower, const FitOptions& fit) {
   std::set<std::string> rigs;
   for (const auto& s : samples)
     if (!s.rig.empty()) rigs.insert(s.rig);
@@ -539,7 +540,7 @@ LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, con
     std::vector<CalibrationSample> rest;
     for (const auto& s : samples)
       if (s.rig != rig) rest.push_back(s);
-    const DeviceProfile profile = fitDeviceProfile(rest, deviceName, workloadVertices, nearBestPower, form, constantCache);
+    const DeviceProfile profile = fitDeviceProfile(rest, deviceName, workloadVertices, nearBestPower, fit);
     for (auto& h : predictRigs(samples, rig, profile)) rows.push_back(std::move(h));
   }
   return summarise(std::move(rows));
@@ -855,7 +856,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   if (stopped() && std::none_of(rep.samples.begin(), rep.samples.end(), [](const CalibrationSample& s) { return s.validated; }))
     throw std::runtime_error("calibration: interrupted before anything was timed: nothing to fit");
   rep.profile =
-      fitDeviceProfile(rep.samples, rep.device + " (" + rep.driver + ")", workload, opts.nearBestPower, opts.form, opts.constantCache);
+      fitDeviceProfile(rep.samples, rep.device + " (" + rep.driver + ")", workload, opts.nearBestPower, opts.fit);
   // The check: each rig's plans under the fitted profile. The plans a profile chooses are
   // where its errors cost time, so each refit adds them to the fit; the last check's plans
   // are never fitted.
@@ -867,14 +868,14 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
     benchRigs(fitted, false, last ? "checked plan: " : fmt::format("plan under fit {}: ", round + 1));
     if (last) break;
     for (auto& s : rep.samples) s.fitted = true;
-    rep.profile = fitDeviceProfile(rep.samples, rep.profile.device, workload, opts.nearBestPower, opts.form, opts.constantCache);
+    rep.profile = fitDeviceProfile(rep.samples, rep.profile.device, workload, opts.nearBestPower, opts.fit);
   }
   std::vector<std::string> fitMeshes = opts.meshes;
   for (const auto& rig : rigs)
     if (isGltfPath(rig) && std::find(fitMeshes.begin(), fitMeshes.end(), kOwnMesh) == fitMeshes.end())
       fitMeshes.push_back(kOwnMesh);
   rep.fits = evaluateFit(rep.samples, rep.profile, fitMeshes);
-  rep.heldOut = leaveOneRigOut(rep.samples, rep.profile.device, workload, rep.nearBestPower, opts.form, opts.constantCache);
+  rep.heldOut = leaveOneRigOut(rep.samples, rep.profile.device, workload, rep.nearBestPower, opts.fit);
   if (stopped())
     rep.notes.push_back(fmt::format("interrupted: {} samples were timed and are fitted; the probes, rigs and checks after "
                                     "the interruption were not timed",
@@ -919,7 +920,33 @@ std::string rooflineLines(const DeviceProfile& p) {
   return s;
 }
 
+// Each draw size's weights and pipes (DeviceProfile::drawSizes), then the shared lines.
+std::string drawSizeLines(const DeviceProfile& p) {
+  std::string s = fmt::format("vertices_per_draw: {:g}  # where a generation's mesh is unknown\n"
+                              "draw_sizes:  # weights fitted at each mesh size; between two, interpolated in log(vertices per draw)\n",
+                              p.verticesPerDraw);
+  for (const DeviceProfile::DrawSize& d : p.drawSizes) {
+    DeviceProfile at = p;
+    at.nanoseconds = d.nanoseconds;
+    at.pipes = d.pipes;
+    at.drawSizes.clear();
+    at.scaledBy = {};
+    at.workloadDefaults = {};
+    at.constantCacheEntries = 0;
+    std::string block = fmt::format("{:g}:\n", d.vertices) + "weights:\n";
+    for (int t = 0; t < kTermCount; ++t) block += fmt::format("  {}: {:.6g}\n", termName(t), d.nanoseconds[size_t(t)]);
+    block += rooflineLines(at);
+    // Indented under its size.
+    for (size_t start = block.find('\n') + 1; start < block.size(); start = block.find('\n', start) + 1) block.insert(start, "    ");
+    s += "  " + block;
+  }
+  DeviceProfile shared = p;
+  shared.pipes.clear();
+  return s + rooflineLines(shared);
+}
+
 std::string weightLines(const DeviceProfile& p) {
+  if (!p.drawSizes.empty()) return drawSizeLines(p);
   std::string s = "weights:\n";
   for (int t = 0; t < kTermCount; ++t) s += fmt::format("  {}: {:.6g}\n", termName(t), p.nanoseconds[size_t(t)]);
   // Pipes and the workload scaling are written whether or not the fit found per-draw costs

@@ -65,10 +65,10 @@ struct CalibrationOptions {
   // the search only compares plans of one rig, and the ones near the fastest are where a
   // wrong order costs time (docs/device-profiles.md, "Where the fit looks"). 0: all alike.
   double nearBestPower = 4;
-  ProfileForm form = ProfileForm::Additive;  // the model fitted (measure/fit.h)
-  // Fit the constant cache's capacity too (measure/fit.h; roofline and raster forms): kept only
-  // where it lowers the fit's error; compare the leave-one-rig-out tables with and without.
-  bool constantCache = false;
+  // The model fitted and its optional terms (measure/fit.h): the constant cache's capacity and
+  // draw sizes are kept only where they lower the fit's error; compare the leave-one-rig-out
+  // tables with and without.
+  FitOptions fit;
   // Set (by the CLI's SIGINT handler: a device call's time limit) to time nothing more: the
   // probe or rig being timed finishes, the rest are skipped, and what was timed is fitted and
   // reported, with a note saying so.
@@ -131,8 +131,7 @@ struct LeaveOneRigOut {
   double medianSpearman = NAN, worstChosenOverFastest = NAN, medianRms = NAN, maxRms = NAN;
 };
 LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
-                              double workloadVertices, double nearBestPower, ProfileForm form = ProfileForm::Additive,
-                              bool constantCache = false);
+                              double workloadVertices, double nearBestPower, const FitOptions& fit = {});
 std::string formatLeaveOneRigOut(const LeaveOneRigOut& loo);
 // The held-out check: each (rig, mesh) of samples no fit saw, its plans predicted by `profile`
 // (same figures as leave-one-rig-out).
@@ -161,7 +160,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts);
 // `workloadVertices`.
 DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
                                double workloadVertices, double nearBestPower = 0,
-                               ProfileForm form = ProfileForm::Additive, bool constantCache = false);
+                               const FitOptions& fit = {});
 // Fills predictedNs of every sample and the fit statistics per mesh.
 std::vector<CalibrationFit> evaluateFit(std::vector<CalibrationSample>& samples, const DeviceProfile& profile,
                                         const std::vector<std::string>& meshes);

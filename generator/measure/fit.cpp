@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 #include <stdexcept>
 
@@ -45,17 +46,24 @@ DeviceProfile profileForm(ProfileForm form) {
 
 namespace {
 
-// The parameters: per-vertex additive weights (the additive form: every term but `fragments`;
-// the roofline: `vertices` alone; the raster form: `vertices` and `fragments`), per-draw weights
-// (every term, when draws differ; not in the raster form), then each pipe's terms.
+// The parameters: a block of per-vertex additive weights (the additive form: every term but
+// `fragments`; the roofline: `vertices` alone; the raster form: `vertices` and `fragments`),
+// per-draw weights (every term, when draws differ; not in the raster form), then each pipe's
+// terms; one such block per draw size (`sizes`, none: one block for every size).
 struct Layout {
   std::vector<int> additive, perDraw;
   std::vector<std::pair<size_t, int>> pipeTerms;  // (pipe, term)
   size_t pipes = 0;
+  std::vector<double> sizes;  // ascending vertices per draw, two at least, or none
+  // With sizes: the parameters of a block every size shares, its first block's (a fragment's
+  // price: a large draw covers too few fragments to price one of its own).
+  std::vector<bool> shared;
   // The constant cache's miss factor, a last parameter: the terms it multiplies.
   bool miss = false;
   std::array<bool, kTermCount> missTerms{};
-  size_t size() const { return additive.size() + perDraw.size() + pipeTerms.size() + (miss ? 1 : 0); }
+  size_t block() const { return additive.size() + perDraw.size() + pipeTerms.size(); }
+  size_t blocks() const { return std::max<size_t>(1, sizes.size()); }
+  size_t size() const { return block() * blocks() + (miss ? 1 : 0); }
 };
 
 Layout layoutOf(const DeviceProfile& form, bool drawWeights) {
@@ -83,19 +91,25 @@ std::array<double, kTermCount> scaledAmounts(const DeviceProfile& form, const Fi
 
 // One row's weighted relative error and its (sub)gradient: the max picks the slowest pipe. With
 // a constant cache (`missTerms` not empty, the last parameter the miss factor M), a row past
-// the capacity pays M times its terms scaled by joints per warp.
+// the capacity pays M times its terms scaled by joints per warp. With draw sizes, the row's
+// weights are its two sizes' blocks blended as the profile blends them.
 class RowCost : public ceres::CostFunction {
  public:
   RowCost(const Layout& l, std::array<double, kTermCount> x, double vertices, double measured, double weight, bool past)
-      : l_(l), x_(x), vertices_(vertices), measured_(measured), scale_(std::sqrt(weight) / measured), past_(past) {
+      : l_(l), x_(x), vertices_(vertices), measured_(measured), scale_(std::sqrt(weight) / measured), past_(past),
+        blend_(blendDrawSizes(l.sizes, vertices)) {
     set_num_residuals(1);
     mutable_parameter_block_sizes()->push_back(static_cast<int32_t>(l.size()));
   }
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const double* w = parameters[0];
-    std::vector<double> grad(l_.size(), 0.0);
+    const size_t n = l_.block(), below = blend_.below * n, above = blend_.above * n;
+    const double share = blend_.share;
+    std::vector<double> w(n);
+    for (size_t j = 0; j < n; ++j)
+      w[j] = isShared(j) ? parameters[0][j] : (1 - share) * parameters[0][below + j] + share * parameters[0][above + j];
+    std::vector<double> grad(n, 0.0);
     const bool miss = l_.miss && past_;
-    const double m = miss ? w[l_.size() - 1] : 1.0;
+    const double m = miss ? parameters[0][l_.size() - 1] : 1.0;
     auto factor = [&](int t) { return miss && l_.missTerms[static_cast<size_t>(t)] ? m : 1.0; };
     double ns = 0, dm = 0;
     size_t i = 0;
@@ -119,10 +133,17 @@ class RowCost : public ceres::CostFunction {
       i = pipeBegin;
       for (const auto& [p, t] : l_.pipeTerms) grad[i++] = p == slowest ? x_[t] * factor(t) : 0.0;
     }
-    if (miss) grad[l_.size() - 1] = dm;
     residuals[0] = scale_ * (ns - measured_);
-    if (jacobians && jacobians[0])
-      for (size_t j = 0; j < l_.size(); ++j) jacobians[0][j] = scale_ * grad[j];
+    if (jacobians && jacobians[0]) {
+      double* J = jacobians[0];
+      std::fill(J, J + l_.size(), 0.0);
+      for (size_t j = 0; j < n; ++j)
+        if (isShared(j))
+          J[j] += scale_ * grad[j];
+        else
+          J[below + j] += scale_ * (1 - share) * grad[j], J[above + j] += scale_ * share * grad[j];
+      if (miss) J[l_.size() - 1] = scale_ * dm;
+    }
     return true;
   }
 
@@ -131,18 +152,26 @@ class RowCost : public ceres::CostFunction {
   std::array<double, kTermCount> x_;
   double vertices_, measured_, scale_;
   bool past_;
+  DrawSizeBlend blend_;
+  bool isShared(size_t j) const { return j < l_.shared.size() && l_.shared[j]; }
 };
 
 DeviceProfile toProfile(const DeviceProfile& form, const Layout& l, const std::vector<double>& w, double vertices) {
   DeviceProfile p = form;
   for (auto& pipe : p.pipes) pipe.nanoseconds = {};
-  size_t i = 0;
-  for (int t : l.additive) p.nanoseconds[static_cast<size_t>(t)] = std::min(w[i++], kMaxProfileWeightNs);
-  for (int t : l.perDraw) p.drawNanoseconds[static_cast<size_t>(t)] = std::min(w[i++], kMaxProfileDrawWeightNs);
-  for (const auto& [pi, t] : l.pipeTerms) p.pipes[pi].nanoseconds[static_cast<size_t>(t)] = std::min(w[i++], kMaxProfileWeightNs);
-  if (l.miss) p.constantCacheMissFactor = w[i];
-  if (p.hasDrawWeights()) p.verticesPerDraw = vertices;
-  return p;
+  for (size_t b = 0; b < l.blocks(); ++b) {
+    std::vector<double> block(w.begin() + long(b * l.block()), w.begin() + long((b + 1) * l.block()));
+    for (size_t j = 0; j < l.shared.size(); ++j)
+      if (l.shared[j]) block[j] = w[j];
+    size_t i = 0;
+    for (int t : l.additive) p.nanoseconds[static_cast<size_t>(t)] = std::min(block[i++], kMaxProfileWeightNs);
+    for (int t : l.perDraw) p.drawNanoseconds[static_cast<size_t>(t)] = std::min(block[i++], kMaxProfileDrawWeightNs);
+    for (const auto& [pi, t] : l.pipeTerms) p.pipes[pi].nanoseconds[static_cast<size_t>(t)] = std::min(block[i++], kMaxProfileWeightNs);
+    if (!l.sizes.empty()) p.drawSizes.push_back({l.sizes[b], p.nanoseconds, p.pipes});
+  }
+  if (l.miss) p.constantCacheMissFactor = w.back();
+  if (p.hasDrawWeights() || !p.drawSizes.empty()) p.verticesPerDraw = vertices;
+  return p.atDrawSize(p.verticesPerDraw);
 }
 
 // The largest miss factor a fit may find (a miss costing 50x a hit is no cache at all).
@@ -171,10 +200,11 @@ Solved solve(const Layout& l, const std::vector<FitRow>& rows, const std::vector
       return s / double(rows.size());
     };
     size_t i = 0;
-    const double share = median / double(std::max<size_t>(1, l.size()));
+    const double share = median / double(std::max<size_t>(1, l.block()));
     for (int t : l.additive) typical[i++] = meanAmount(t, false) > 0 ? share / meanAmount(t, false) : 0;
     for (int t : l.perDraw) typical[i++] = meanAmount(t, true) > 0 ? share / meanAmount(t, true) : 0;
     for (const auto& [p, t] : l.pipeTerms) typical[i++] = meanAmount(t, false) > 0 ? share / meanAmount(t, false) : 0;
+    for (size_t b = 1; b < l.blocks(); ++b) std::copy_n(typical.begin(), l.block(), typical.begin() + long(b * l.block()));
   }
   Solved best;
   for (double start : {0.1, 0.5, 1.0}) {
@@ -248,7 +278,8 @@ std::vector<double> constantCacheCandidates(const std::vector<FitRow>& rows, con
 
 }  // namespace
 
-FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form, bool constantCache) {
+FitResult fitProfile(const std::vector<FitRow>& rows, const FitOptions& options) {
+  const ProfileForm form = options.form;
   if (rows.empty()) throw std::runtime_error("calibration: no validated timing to fit");
   std::set<double> sizes;
   for (const FitRow& r : rows) sizes.insert(r.vertices);
@@ -266,12 +297,26 @@ FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form, bool con
   std::vector<std::array<double, kTermCount>> xs;
   for (const FitRow& r : rows) xs.push_back(scaledAmounts(skeleton, r));
 
-  Solved best = solve(l, rows, xs, std::vector<bool>(rows.size(), false));
+  const std::vector<bool> within(rows.size(), false);
+  Solved best = solve(l, rows, xs, within);
+  // Draw sizes (docs/device-profiles.md, "Draw sizes"): a block of weights per mesh size with
+  // enough rows, kept where it explains kMinTermGain of the squared error.
+  if (options.drawSizes && form == ProfileForm::Raster) {
+    std::map<double, size_t> rowsPerSize;
+    for (const FitRow& r : rows) ++rowsPerSize[r.vertices];
+    Layout sized = l;
+    for (const auto& [vertices, n] : rowsPerSize)
+      if (n >= kMinRowsPerDrawSize) sized.sizes.push_back(vertices);
+    sized.shared.assign(l.block(), false);
+    for (size_t j = 0; j < l.additive.size(); ++j) sized.shared[j] = l.additive[j] == kTermFragments;
+    if (sized.sizes.size() >= 2)
+      if (Solved s = solve(sized, rows, xs, within); s.cost < (1 - kMinTermGain) * best.cost) best = std::move(s), l = sized;
+  }
   // The constant cache's capacity (docs/device-profiles.md, "The constant cache's capacity"):
   // each threshold between the footprints the rows read, with a miss factor fitted beside the
-  // weights; the best threshold is kept where it explains kMinCapacityGain of the squared error.
+  // weights; the best threshold is kept where it explains kMinTermGain of the squared error.
   double capacity = 0;
-  if (constantCache && !skeleton.pipes.empty()) {
+  if (options.constantCache && !skeleton.pipes.empty()) {
     Layout withMiss = l;
     withMiss.miss = true;
     for (size_t t = 0; t < kTermCount; ++t) withMiss.missTerms[t] = skeleton.scaledBy[t] == kFeatureJointsPerWarp;
@@ -291,7 +336,7 @@ FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form, bool con
       Solved s = solve(withMiss, rows, xs, past);
       if (s.cost < bestWithMiss) bestWithMiss = s.cost, chosen = s, capacity = c;
     }
-    if (capacity > 0 && bestWithMiss < (1 - kMinCapacityGain) * best.cost) {
+    if (capacity > 0 && bestWithMiss < (1 - kMinTermGain) * best.cost) {
       best = chosen;
       l = withMiss;
     } else {

@@ -33,6 +33,15 @@ struct FitRow {
 enum class ProfileForm { Additive, Roofline, Raster };
 const char* profileFormName(ProfileForm form);  // "additive", "roofline", "raster"
 
+// What a fit fits: the form, and the optional terms below (each kept only where it lowers the error).
+struct FitOptions {
+  ProfileForm form = ProfileForm::Additive;
+  bool constantCache = false;  // roofline and raster forms
+  bool drawSizes = false;      // raster form
+  FitOptions() = default;
+  FitOptions(ProfileForm f, bool cache = false, bool sizes = false) : form(f), constantCache(cache), drawSizes(sizes) {}
+};
+
 struct FitResult {
   DeviceProfile profile;       // device and file left empty
   double rmsRelativeError = 0;  // over the rows, unweighted
@@ -45,14 +54,21 @@ struct FitResult {
 // C, kMinRowsPerSideOfCapacity rows at least on each, the fit tries each C between two such
 // footprints with a miss factor M >= 1 as one more parameter (a row past C pays M times its
 // terms scaled by joints per warp), and keeps the best C where it lowers the weighted squared
-// error by kMinCapacityGain of the fit without it; else the profile has no constant_cache.
+// error by kMinTermGain of the fit without it; else the profile has no constant_cache.
 constexpr size_t kMinRowsPerSideOfCapacity = 3;
-constexpr double kMinCapacityGain = 0.02;
+constexpr double kMinTermGain = 0.02;  // of the weighted squared error, for a term to be kept
 
 // Per-draw weights only when the rows' draws differ in size (else they cannot be told apart
 // from per-vertex ones). Deterministic: same rows, same weights. Throws std::runtime_error
 // without rows.
-FitResult fitProfile(const std::vector<FitRow>& rows, ProfileForm form, bool constantCache = false);
+//
+// Draw sizes (`drawSizes`, raster form; docs/device-profiles.md, "Draw sizes"): where the rows
+// hold kMinRowsPerDrawSize rows at each of two vertex counts per draw or more, one set of
+// weights per such size, a row between two sizes priced by their weights interpolated in
+// log(vertices) as the profile prices it (DeviceProfile::atDrawSize); kept where it lowers the
+// weighted squared error by kMinTermGain. The constant cache's miss factor is shared.
+constexpr size_t kMinRowsPerDrawSize = 24;
+FitResult fitProfile(const std::vector<FitRow>& rows, const FitOptions& options);
 
 // The upper median (of an even count, the larger middle value); 0 when empty.
 double medianOf(std::vector<double> v);

@@ -263,6 +263,7 @@ Plan searchUnderOptions(LoadedInputs& in, const GenerateOptions& opts, SearchSta
 DeviceProfile pricedFor(DeviceProfile d, const GenerateOptions& opts) {
   d.workload = opts.workload;
   const double vertices = opts.maxVertices > 0 ? double(opts.maxVertices) : opts.workload.verticesPerDraw;
+  if (vertices > 0 && !d.drawSizes.empty()) return d.atDrawSize(vertices);  // the weights at the draw's size
   if (d.hasDrawWeights() && vertices > 0) d.verticesPerDraw = vertices;
   return d;
 }

@@ -102,7 +102,51 @@ double DeviceProfile::constantCacheFactor() const {
   return feature(kFeaturePaletteEntriesPerWarp) > constantCacheEntries ? constantCacheMissFactor : 1.0;
 }
 
+DrawSizeBlend blendDrawSizes(const std::vector<double>& sizes, double vertices) {
+  DrawSizeBlend b;
+  if (sizes.empty()) return b;
+  while (b.below + 1 < sizes.size() && sizes[b.below + 1] <= vertices) ++b.below;
+  b.above = std::min(b.below + 1, sizes.size() - 1);
+  // A draw's cost changes over orders of magnitude of its size, so the share grows with log(vertices).
+  if (b.above != b.below && vertices > sizes[b.below])
+    b.share = std::log(vertices / sizes[b.below]) / std::log(sizes[b.above] / sizes[b.below]);
+  return b;
+}
+
+DeviceProfile DeviceProfile::atDrawSize(double vertices) const {
+  DeviceProfile p = *this;
+  if (drawSizes.empty()) return p;
+  if (vertices > 0) p.verticesPerDraw = vertices;
+  vertices = p.verticesPerDraw;
+  std::vector<double> sizes;
+  for (const DrawSize& d : drawSizes) sizes.push_back(d.vertices);
+  const DrawSizeBlend blend = blendDrawSizes(sizes, vertices);
+  const DrawSize& a = drawSizes[blend.below];
+  const DrawSize& b = drawSizes[blend.above];
+  const double t = blend.share;
+  for (size_t k = 0; k < kTermCount; ++k) p.nanoseconds[k] = (1 - t) * a.nanoseconds[k] + t * b.nanoseconds[k];
+  p.pipes = a.pipes;
+  for (size_t j = 0; j < p.pipes.size(); ++j)
+    for (size_t k = 0; k < kTermCount; ++k) p.pipes[j].nanoseconds[k] = (1 - t) * a.pipes[j].nanoseconds[k] + t * b.pipes[j].nanoseconds[k];
+  return p;
+}
+
+namespace {
+
+// What pricing reads (`nanoseconds`, `pipes`): with draw sizes, the weights at a draw of
+// `vertices` (0: the profile's own), resolved into `scratch`.
+const DeviceProfile& pricedAt(const DeviceProfile& p, double vertices, DeviceProfile& scratch) {
+  if (p.drawSizes.empty()) return p;
+  scratch = p.atDrawSize(vertices);
+  scratch.drawSizes.clear();
+  return scratch;
+}
+
+}  // namespace
+
 double DeviceProfile::perVertex(int term, double vertices) const {
+  DeviceProfile scratch;
+  if (!drawSizes.empty()) return pricedAt(*this, vertices, scratch).perVertex(term, vertices);
   const size_t t = static_cast<size_t>(term);
   return (nanoseconds[t] + (drawNanoseconds[t] > 0 ? drawNanoseconds[t] / vertices : 0.0)) * feature(scaledBy[t]);
 }
@@ -112,6 +156,8 @@ bool DeviceProfile::hasDrawWeights() const {
 }
 
 double DeviceProfile::predictNanoseconds(const TermAmounts& amounts, double vertices) const {
+  DeviceProfile scratch;
+  if (!drawSizes.empty()) return pricedAt(*this, vertices, scratch).predictNanoseconds(amounts, vertices);
   double ns = 0, slowest = 0;
   for (int t = 0; t < kTermCount; ++t) ns += perVertex(t, vertices) * double(amounts[static_cast<size_t>(t)]);
   for (const Pipe& pipe : pipes) {
@@ -127,7 +173,7 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
   YAML::Node root = parseYaml(text, file);
   c.expectMap(root, "device profile");
   c.checkKeys(root, {"device", "unit", "weights", "draw_weights", "vertices_per_draw", "pipes", "scaled_by",
-                     "workload_defaults", "constant_cache", "notes"});
+                     "workload_defaults", "constant_cache", "draw_sizes", "notes"});
   DeviceProfile prof;
   prof.file = file;
   if (!root["device"]) c.fail(root, "device profile: missing 'device' (the device it was measured on)");
@@ -136,8 +182,36 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
     c.fail(root["unit"], fmt::format("unit '{}' is not supported: weights are nanoseconds per vertex ('ns')",
                                      c.scalar(root["unit"], "unit")));
   if (root["notes"]) c.scalar(root["notes"], "notes");
-  if (!root["weights"]) c.fail(root, "device profile: missing 'weights' (nanoseconds per unit of each term)");
-  parseTermWeights(c, root["weights"], "weights", "weight", kMaxProfileWeightNs, prof.nanoseconds);
+  // weights: and pipes: of the profile, or of one of its draw sizes.
+  auto parseWeightsAndPipes = [&](const YAML::Node& weights, const YAML::Node& pipes, std::array<double, kTermCount>& ns,
+                                  std::vector<DeviceProfile::Pipe>& out) {
+    parseTermWeights(c, weights, "weights", "weight", kMaxProfileWeightNs, ns);
+    if (!pipes) return;
+    c.expectMap(pipes, "pipes");
+    for (auto it = pipes.begin(); it != pipes.end(); ++it) {
+      DeviceProfile::Pipe pipe;
+      pipe.name = c.scalar(it->first, "pipe name");
+      parseTermWeights(c, it->second, "pipe", fmt::format("pipe '{}' weight", pipe.name).c_str(), kMaxProfileWeightNs,
+                       pipe.nanoseconds);
+      out.push_back(std::move(pipe));
+    }
+    if (out.size() > kMaxProfilePipes)
+      c.fail(pipes, fmt::format("device profile: {} pipes, more than the {} a profile may have", out.size(), kMaxProfilePipes));
+  };
+  const YAML::Node sizes = root["draw_sizes"];
+  if (sizes) {
+    for (const char* key : {"weights", "pipes", "draw_weights"})
+      if (root[key])
+        c.fail(root[key], fmt::format("device profile: '{}' beside 'draw_sizes': a profile with draw sizes states its "
+                                      "weights and pipes under each size",
+                                      key));
+    if (!root["vertices_per_draw"])
+      c.fail(sizes, "device profile: 'draw_sizes' needs 'vertices_per_draw' (the draw priced where a generation's mesh is unknown)");
+  } else if (!root["weights"]) {
+    c.fail(root, "device profile: missing 'weights' (nanoseconds per unit of each term)");
+  } else {
+    parseWeightsAndPipes(root["weights"], root["pipes"], prof.nanoseconds, prof.pipes);
+  }
   if (root["vertices_per_draw"])
     prof.verticesPerDraw = parseNumber(c, root["vertices_per_draw"], "'vertices_per_draw'", "vertices", "vertices", 1, kMaxVerticesPerDraw);
   if (root["draw_weights"]) {
@@ -145,17 +219,34 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
     if (!root["vertices_per_draw"])
       c.fail(root["draw_weights"], "device profile: 'draw_weights' needs 'vertices_per_draw' (the workload they are spread over)");
   }
-  if (const YAML::Node pipes = root["pipes"]) {
-    c.expectMap(pipes, "pipes");
-    for (auto it = pipes.begin(); it != pipes.end(); ++it) {
-      DeviceProfile::Pipe pipe;
-      pipe.name = c.scalar(it->first, "pipe name");
-      parseTermWeights(c, it->second, "pipe", fmt::format("pipe '{}' weight", pipe.name).c_str(), kMaxProfileWeightNs,
-                       pipe.nanoseconds);
-      prof.pipes.push_back(std::move(pipe));
+  if (sizes) {
+    c.expectMap(sizes, "draw_sizes");
+    for (auto it = sizes.begin(); it != sizes.end(); ++it) {
+      DeviceProfile::DrawSize d;
+      d.vertices = parseNumber(c, it->first, "a draw size", "vertices per draw", "vertices", 1, kMaxVerticesPerDraw);
+      c.expectMap(it->second, "draw size");
+      c.checkKeys(it->second, {"weights", "pipes"});
+      if (!it->second["weights"])
+        c.fail(it->second, fmt::format("draw size {:g}: missing 'weights' (nanoseconds per unit of each term at that size)", d.vertices));
+      parseWeightsAndPipes(it->second["weights"], it->second["pipes"], d.nanoseconds, d.pipes);
+      for (const DeviceProfile::DrawSize& e : prof.drawSizes)
+        if (e.vertices == d.vertices) c.fail(it->first, fmt::format("draw size {:g} is stated twice", d.vertices));
+      // Sizes are interpolated pipe by pipe: every size names the same pipes in the same order.
+      if (!prof.drawSizes.empty()) {
+        std::string want, got;
+        for (const auto& q : prof.drawSizes.front().pipes) want += " " + q.name;
+        for (const auto& q : d.pipes) got += " " + q.name;
+        if (want != got)
+          c.fail(it->first, fmt::format("draw size {:g} has the pipes [{} ] where the first size has [{} ]: every size "
+                                        "names the same pipes in the same order",
+                                        d.vertices, got, want));
+      }
+      prof.drawSizes.push_back(std::move(d));
     }
-    if (prof.pipes.size() > kMaxProfilePipes)
-      c.fail(pipes, fmt::format("device profile: {} pipes, more than the {} a profile may have", prof.pipes.size(), kMaxProfilePipes));
+    if (prof.drawSizes.size() < 2)
+      c.fail(sizes, "draw_sizes: one size is no interpolation; state its weights and pipes as 'weights' and 'pipes'");
+    std::sort(prof.drawSizes.begin(), prof.drawSizes.end(),
+              [](const DeviceProfile::DrawSize& a, const DeviceProfile::DrawSize& b) { return a.vertices < b.vertices; });
   }
   auto featureOf = [&](const YAML::Node& n) {
     const std::string name = c.scalar(n, "workload feature");
@@ -199,17 +290,21 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
     if (!priced)
       c.fail(cache, "constant_cache: no term is scaled_by joints_per_warp, so the cache's misses would price nothing");
   }
-  return prof;
+  return prof.atDrawSize(prof.verticesPerDraw);
 }
 
-TermWeights profileWeights(const DeviceProfile& profile) {
+TermWeights profileWeights(const DeviceProfile& priced) {
+  DeviceProfile scratch;
+  const DeviceProfile& profile = pricedAt(priced, priced.verticesPerDraw, scratch);
   TermWeights w{};
   for (int t = 0; t < kTermCount; ++t)
     w[static_cast<size_t>(t)] = std::llround(profile.perVertex(t, profile.verticesPerDraw) * kFemtosecondsPerNanosecond);
   return w;
 }
 
-std::vector<TermWeights> profileComponents(const DeviceProfile& profile) {
+std::vector<TermWeights> profileComponents(const DeviceProfile& priced) {
+  DeviceProfile scratch;
+  const DeviceProfile& profile = pricedAt(priced, priced.verticesPerDraw, scratch);
   const TermWeights additive = profileWeights(profile);
   if (profile.pipes.empty()) return {additive};
   std::vector<TermWeights> out;
@@ -280,12 +375,17 @@ std::string describePortable(const Plan& plan, const Problem& p, const std::vect
   return out;
 }
 
-std::string describePlanCost(const Plan& plan, const Problem& p, const DeviceProfile& profile) {
+std::string describePlanCost(const Plan& plan, const Problem& p, const DeviceProfile& priced) {
+  DeviceProfile scratch;
+  const DeviceProfile& profile = pricedAt(priced, priced.verticesPerDraw, scratch);
   const PlanCostPrediction c = predictPlanCost(plan, p, profile);
   const TermWeights w = profileWeights(profile);
-  std::string out = fmt::format("  predicted per vertex on '{}'{}{}:\n", profile.device,
+  std::string sizes;
+  for (const DeviceProfile::DrawSize& d : priced.drawSizes) sizes += fmt::format("{}{:g}", sizes.empty() ? "" : ", ", d.vertices);
+  std::string out = fmt::format("  predicted per vertex on '{}'{}{}{}:\n", profile.device,
                                 profile.file.empty() ? "" : fmt::format(" ({})", profile.file),
-                                profile.hasDrawWeights() ? fmt::format(" at {:g} vertices per draw", profile.verticesPerDraw) : "");
+                                profile.hasDrawWeights() || !sizes.empty() ? fmt::format(" at {:g} vertices per draw", profile.verticesPerDraw) : "",
+                                sizes.empty() ? "" : fmt::format(" (weights fitted at {} vertices per draw)", sizes));
   out += fmt::format("    {:<26} {:>8} {:>10} {:>9}\n", "term", "amount", "ns/unit", "ns");
   for (size_t t = 0; t < kTermCount; ++t) {
     out += fmt::format("    {:<26} {:>8} {:>10.6f} {:>9.3f}", termName(static_cast<int>(t)), c.amounts[t],

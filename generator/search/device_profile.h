@@ -60,9 +60,24 @@ struct DeviceProfile {
   double constantCacheMissFactor = 1;
   // The workload priced for (search/workload.h): set by whoever generates for a known mesh.
   Workload workload;
+  // Weights fitted on meshes of several sizes (docs/device-profiles.md, "Draw sizes"): each
+  // size's additive weights and pipes (the pipes named and ordered as `pipes`). A draw of V
+  // vertices is priced by the two sizes around V, interpolated in log(V), or by the nearest
+  // size outside them; `nanoseconds` and `pipes` hold the weights at `verticesPerDraw`.
+  // Empty: the weights above at every size (every profile before session 22).
+  struct DrawSize {
+    double vertices = 0;
+    std::array<double, kTermCount> nanoseconds{};
+    std::vector<Pipe> pipes;
+  };
+  std::vector<DrawSize> drawSizes;  // ascending in vertices; none or two at least
+
+  // This profile priced at draws of `vertices`: its draw sizes interpolated into `nanoseconds`
+  // and `pipes` (and `verticesPerDraw` set), `drawSizes` kept. Without draw sizes: itself.
+  DeviceProfile atDrawSize(double vertices) const;
 
   // ns per unit of `term` per vertex when a draw has `vertices`: nanoseconds + drawNanoseconds / vertices,
-  // times the term's workload feature.
+  // times the term's workload feature (with draw sizes: the weights at `vertices`).
   double perVertex(int term, double vertices) const;
   bool hasDrawWeights() const;
   // The value of a feature for this profile's workload (the workload's, else the stated
@@ -75,6 +90,16 @@ struct DeviceProfile {
   // weights; the search's own figure is predictPlanCost's): the additive part plus the slowest pipe.
   double predictNanoseconds(const TermAmounts& amounts, double vertices) const;
 };
+// Where a draw of `vertices` falls among ascending draw sizes: the last size at or below it
+// (the first where none is), the next, and the next's share, log(vertices / below) /
+// log(above / below); outside the sizes, the nearest alone (share 0). DeviceProfile::atDrawSize
+// and the fit (measure/fit.h) blend by it.
+struct DrawSizeBlend {
+  size_t below = 0, above = 0;
+  double share = 0;
+};
+DrawSizeBlend blendDrawSizes(const std::vector<double>& sizes, double vertices);
+
 // Largest workload a profile may state (vertices per draw), and largest draw weight (a
 // millisecond per unit per draw).
 constexpr double kMaxVerticesPerDraw = 1e9;

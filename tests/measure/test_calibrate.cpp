@@ -417,7 +417,7 @@ TEST(Calibrate, TheFitFindsTheConstantCachesCapacityAndItsMissPrice) {
                             }),
              test.end());
   ASSERT_GT(test.size(), 70u);
-  const DeviceProfile raster = fitDeviceProfile(train, "cached device", 180000, 0, ProfileForm::Raster, true);
+  const DeviceProfile raster = fitDeviceProfile(train, "cached device", 180000, 0, FitOptions(ProfileForm::Raster, true));
   EXPECT_GE(raster.constantCacheEntries, within);
   EXPECT_LT(raster.constantCacheEntries, past);
   EXPECT_NEAR(raster.constantCacheMissFactor, miss, 0.05);
@@ -426,12 +426,12 @@ TEST(Calibrate, TheFitFindsTheConstantCachesCapacityAndItsMissPrice) {
   // Without the footprints the fit cannot see the cache, and prices every warp alike.
   std::vector<CalibrationSample> blind = train;
   for (auto& s : blind) s.workload.paletteEntriesPerWarp = 0;
-  const DeviceProfile without = fitDeviceProfile(blind, "cached device", 180000, 0, ProfileForm::Raster, true);
+  const DeviceProfile without = fitDeviceProfile(blind, "cached device", 180000, 0, FitOptions(ProfileForm::Raster, true));
   EXPECT_EQ(without.constantCacheEntries, 0);
   EXPECT_GT(heldOutRms(without), 0.05);
   // Not asked for, the fit has none; a device without the cliff gets none from the same footprints.
   EXPECT_EQ(fitDeviceProfile(train, "cached device", 180000, 0, ProfileForm::Raster).constantCacheEntries, 0);
-  const DeviceProfile flat = fitDeviceProfile(cacheRows(1, 200, capacity, 1.0), "flat device", 180000, 0, ProfileForm::Raster, true);
+  const DeviceProfile flat = fitDeviceProfile(cacheRows(1, 200, capacity, 1.0), "flat device", 180000, 0, FitOptions(ProfileForm::Raster, true));
   EXPECT_EQ(flat.constantCacheEntries, 0);
   // Written and read back, it predicts the same; past the capacity a warp costs miss x as much.
   CalibrationReport r;
@@ -452,6 +452,71 @@ TEST(Calibrate, TheFitFindsTheConstantCachesCapacityAndItsMissPrice) {
   at.workload.paletteEntriesPerWarp = back.constantCacheEntries + 1;
   EXPECT_DOUBLE_EQ(at.feature(kFeatureJointsPerWarp), hit * back.constantCacheMissFactor);
   EXPECT_DOUBLE_EQ(hit, 10);
+}
+
+// A device whose large draws pay more per location and per vertex than its small ones (its
+// attributes stream from memory instead of a cache), with one price per fragment at every size.
+std::vector<CalibrationSample> twoSizeRows(uint32_t seed, int n) {
+  std::vector<CalibrationSample> out = rasterRows(seed, n, 0.05);
+  for (auto& s : out) {
+    roofline::Device d;
+    d.drawNs = 0;
+    if (s.vertices > 10000) d.location = 0.5, d.vertexNs = 0.5;
+    else d.location = 0.25, d.vertexNs = 0.3;
+    s.measuredNs = d.ns(s.amounts, s.vertices, s.workload.jointsPerWarp) + 0.05 * s.workload.fragmentsPerVertex;
+  }
+  return out;
+}
+
+TEST(Calibrate, DrawSizesFitEachMeshSizesWeightsAndBlendThemInLogVertices) {
+  const std::vector<CalibrationSample> train = twoSizeRows(1, 200), test = twoSizeRows(2, 80);
+  const DeviceProfile sized = fitDeviceProfile(train, "two-size device", 180000, 0, FitOptions(ProfileForm::Raster, false, true));
+  const DeviceProfile plain = fitDeviceProfile(train, "two-size device", 180000, 0, ProfileForm::Raster);
+  ASSERT_EQ(sized.drawSizes.size(), 2u);
+  EXPECT_TRUE(plain.drawSizes.empty());
+  EXPECT_EQ(sized.drawSizes[0].vertices, 2009);
+  EXPECT_EQ(sized.drawSizes[1].vertices, 180000);
+  EXPECT_NEAR(sized.drawSizes[0].pipes[0].nanoseconds[kTermLocations], 0.25, 0.01);
+  EXPECT_NEAR(sized.drawSizes[1].pipes[0].nanoseconds[kTermLocations], 0.5, 0.01);
+  EXPECT_NEAR(sized.drawSizes[0].nanoseconds[kTermVertices], 0.3, 0.03);
+  EXPECT_NEAR(sized.drawSizes[1].nanoseconds[kTermVertices], 0.5, 0.03);
+  // A fragment's price is one at every size (a large draw covers too few to price its own).
+  EXPECT_EQ(sized.drawSizes[0].nanoseconds[kTermFragments], sized.drawSizes[1].nanoseconds[kTermFragments]);
+  EXPECT_NEAR(sized.drawSizes[0].nanoseconds[kTermFragments], 0.05, 0.002);
+  EXPECT_LT(rmsRelativeError(sized, test), 0.01);
+  EXPECT_GT(rmsRelativeError(plain, test), 0.05);
+  // Between the sizes a weight is the log-vertices blend of the two; outside, the nearest size's.
+  const double t = std::log(18000.0 / 2009) / std::log(180000.0 / 2009);
+  const DeviceProfile mid = sized.atDrawSize(18000);
+  EXPECT_EQ(mid.verticesPerDraw, 18000);
+  for (int k : {kTermVertices, kTermFragments})
+    EXPECT_NEAR(mid.nanoseconds[size_t(k)], (1 - t) * sized.drawSizes[0].nanoseconds[size_t(k)] + t * sized.drawSizes[1].nanoseconds[size_t(k)], 1e-12);
+  EXPECT_NEAR(mid.pipes[0].nanoseconds[kTermLocations],
+              (1 - t) * sized.drawSizes[0].pipes[0].nanoseconds[kTermLocations] + t * sized.drawSizes[1].pipes[0].nanoseconds[kTermLocations], 1e-12);
+  EXPECT_EQ(sized.atDrawSize(500).pipes[0].nanoseconds[kTermLocations], sized.drawSizes[0].pipes[0].nanoseconds[kTermLocations]);
+  EXPECT_EQ(sized.atDrawSize(1e6).pipes[0].nanoseconds[kTermLocations], sized.drawSizes[1].pipes[0].nanoseconds[kTermLocations]);
+  // The search prices a generation at its draw's size: the components are that size's weights.
+  const std::vector<TermWeights> small = profileComponents(sized.atDrawSize(2009));
+  EXPECT_EQ(small[0][kTermLocations], std::llround(sized.drawSizes[0].pipes[0].nanoseconds[kTermLocations] * kFemtosecondsPerNanosecond));
+  // Written and read back, it predicts the same at every size, the blend included.
+  CalibrationReport r;
+  r.profile = sized;
+  const std::string yaml = deviceProfileYaml(r);
+  EXPECT_NE(yaml.find("draw_sizes:"), std::string::npos);
+  const DeviceProfile back = parseDeviceProfile(yaml, "sized.yaml");
+  ASSERT_EQ(back.drawSizes.size(), 2u);
+  EXPECT_EQ(back.verticesPerDraw, 180000);
+  for (const auto& s : test)
+    for (double v : {s.vertices, 18000.0}) {
+      DeviceProfile a = sized, b = back;
+      a.workload = b.workload = s.workload;
+      EXPECT_NEAR(b.predictNanoseconds(s.amounts, v), a.predictNanoseconds(s.amounts, v), 1e-5 * s.measuredNs);
+    }
+  // One mesh size has nothing to blend: no draw sizes.
+  std::vector<CalibrationSample> one;
+  for (const auto& s : train)
+    if (s.vertices == 2009) one.push_back(s);
+  EXPECT_TRUE(fitDeviceProfile(one, "one size", 2009, 0, FitOptions(ProfileForm::Raster, false, true)).drawSizes.empty());
 }
 
 TEST(Calibrate, AProfileWithoutPerDrawWeightsKeepsItsScalingWhenWritten) {
