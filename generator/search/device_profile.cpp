@@ -145,8 +145,10 @@ const DeviceProfile& pricedAt(const DeviceProfile& p, double vertices, DevicePro
 }  // namespace
 
 double DeviceProfile::perVertex(int term, double vertices) const {
-  DeviceProfile scratch;
-  if (!drawSizes.empty()) return pricedAt(*this, vertices, scratch).perVertex(term, vertices);
+  if (!drawSizes.empty()) {
+    DeviceProfile scratch;
+    return pricedAt(*this, vertices, scratch).perVertex(term, vertices);
+  }
   const size_t t = static_cast<size_t>(term);
   return (nanoseconds[t] + (drawNanoseconds[t] > 0 ? drawNanoseconds[t] / vertices : 0.0)) * feature(scaledBy[t]);
 }
@@ -156,8 +158,10 @@ bool DeviceProfile::hasDrawWeights() const {
 }
 
 double DeviceProfile::predictNanoseconds(const TermAmounts& amounts, double vertices) const {
-  DeviceProfile scratch;
-  if (!drawSizes.empty()) return pricedAt(*this, vertices, scratch).predictNanoseconds(amounts, vertices);
+  if (!drawSizes.empty()) {
+    DeviceProfile scratch;
+    return pricedAt(*this, vertices, scratch).predictNanoseconds(amounts, vertices);
+  }
   double ns = 0, slowest = 0;
   for (int t = 0; t < kTermCount; ++t) ns += perVertex(t, vertices) * double(amounts[static_cast<size_t>(t)]);
   for (const Pipe& pipe : pipes) {

@@ -124,6 +124,38 @@ TEST(DawnProfile, TheMeasuredH200ProfileReadsFewLocations) {
   }
 }
 
+// A profile with draw sizes (docs/device-profiles.md, "Draw sizes") prices each generation at
+// its draw's size: at each stated size the plan and its cost are those of a plain profile with
+// that size's weights; the sizes here disagree on locations against storage-buffer loads, so the
+// face's plan moves; between them the blend is searched exactly (the IP oracle agrees).
+TEST(DawnProfile, DrawSizesPriceEachGenerationAtItsDrawsSize) {
+  const std::string sized = writeProfile("sized",
+                                         "device: d\nvertices_per_draw: 200000\ndraw_sizes:\n"
+                                         "  2000:\n    weights: {arithmetic: 0.01, locations: 1, buffer_loads: 0.001}\n"
+                                         "  200000:\n    weights: {arithmetic: 0.01, locations: 0.001, buffer_loads: 1}\n");
+  const std::string small = writeProfile("small", "device: d\nweights: {arithmetic: 0.01, locations: 1, buffer_loads: 0.001}\n");
+  const std::string large = writeProfile("large", "device: d\nweights: {arithmetic: 0.01, locations: 0.001, buffer_loads: 1}\n");
+  auto at = [&](const std::string& profile, double vertices) {
+    GenerateOptions g = faceOptions(profile);
+    g.workload.verticesPerDraw = vertices;
+    return generate(g);
+  };
+  const GenerateResult s = at(sized, 2000), l = at(sized, 0), unsized = at(small, 0), unsizedLarge = at(large, 0);
+  EXPECT_EQ(ruleNames(s), ruleNames(unsized));
+  EXPECT_EQ(s.plan.cost, unsized.plan.cost);
+  EXPECT_EQ(ruleNames(l), ruleNames(unsizedLarge));  // unknown: the profile's 200,000
+  EXPECT_EQ(l.plan.cost, unsizedLarge.plan.cost);
+  EXPECT_NE(ruleNames(s), ruleNames(l));
+  EXPECT_LT(planTermAmounts(s.plan, s.in.problem)[kTermLocations], planTermAmounts(l.plan, l.in.problem)[kTermLocations]);
+  const GenerateResult mid = at(sized, 20000);
+  EXPECT_EQ(mid.in.profile->verticesPerDraw, 20000);
+  SearchOptions o;
+  o.engine = "ip";
+  auto plan = findPlan(mid.in.problem, o);
+  ASSERT_TRUE(plan);
+  EXPECT_EQ(plan->cost, mid.plan.cost);
+}
+
 // The face's palette (skin.bones in the uniform block) priced by `profile` for a mesh of
 // `jointsPerWarp` (0: unknown), inputs prepared as `build` prepares each variant: its resource
 // item carries the loads its readers make at a per-vertex index (shareIndexedUniformLoads).
