@@ -154,8 +154,10 @@ TEST(GpuBench, ASmallMeshIsDrawnOftenEnoughThatEachFrameDrawsTheMinimum) {
   ASSERT_GT(once.rows[0].rasterOnWallNsPerVertex, 0);
   const double ratio = many.rows[0].rasterOnWallNsPerVertex / once.rows[0].rasterOnWallNsPerVertex;
   // Host time is a submit overhead o plus d per draw: (o + 8d) / 8(o + d) <= 1 when divided by the
-  // 8 draws taken, (o + 8d) / (o + d) >= 1 when not.
-  EXPECT_LT(ratio, 1.3) << "per-vertex time not divided by the draws taken";
+  // 8 draws taken, (o + 8d) / (o + d) when not, above 2 wherever a draw costs a sixth of the
+  // overhead (lavapipe's head draw costs more than the submit). The margin is for a busy machine:
+  // a sanitized run beside a build measured 1.51.
+  EXPECT_LT(ratio, 2.0) << "per-vertex time not divided by the draws taken";
 }
 
 TEST(GpuBench, BufferFedAlternativesAreValidatedAndTimed) {
