@@ -885,20 +885,30 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
 
 namespace {
 
-// A roofline's pipes, the workload scaling and its defaults (none for an additive profile
-// without scaling: the file then reads as every profile before them).
-std::string rooflineLines(const DeviceProfile& p) {
-  std::string s;
-  if (!p.pipes.empty()) {
-    s += "pipes:  # overlapped: a program takes the additive part plus its slowest pipe\n";
-    for (const auto& pipe : p.pipes) {
-      s += fmt::format("  {}:\n", pipe.name);
-      bool any = false;
-      for (int t = 0; t < kTermCount; ++t)
-        if (pipe.nanoseconds[size_t(t)] > 0) s += fmt::format("    {}: {:.6g}\n", termName(t), pipe.nanoseconds[size_t(t)]), any = true;
-      if (!any) s.replace(s.size() - 1, 1, " {}\n");
-    }
+// A roofline's pipes (none for an additive profile).
+std::string pipeLines(const std::vector<DeviceProfile::Pipe>& pipes) {
+  if (pipes.empty()) return "";
+  std::string s = "pipes:  # overlapped: a program takes the additive part plus its slowest pipe\n";
+  for (const auto& pipe : pipes) {
+    s += fmt::format("  {}:\n", pipe.name);
+    bool any = false;
+    for (int t = 0; t < kTermCount; ++t)
+      if (pipe.nanoseconds[size_t(t)] > 0) s += fmt::format("    {}: {:.6g}\n", termName(t), pipe.nanoseconds[size_t(t)]), any = true;
+    if (!any) s.replace(s.size() - 1, 1, " {}\n");
   }
+  return s;
+}
+
+std::string additiveLines(const std::array<double, kTermCount>& nanoseconds) {
+  std::string s = "weights:\n";
+  for (int t = 0; t < kTermCount; ++t) s += fmt::format("  {}: {:.6g}\n", termName(t), nanoseconds[size_t(t)]);
+  return s;
+}
+
+// The workload scaling, its defaults and the constant cache, shared by every draw size (none
+// for an additive profile without scaling: the file then reads as every profile before them).
+std::string workloadLines(const DeviceProfile& p) {
+  std::string s;
   bool scaled = false;
   for (int t = 0; t < kTermCount; ++t)
     if (p.scaledBy[size_t(t)] != kFeatureNone) {
@@ -920,42 +930,33 @@ std::string rooflineLines(const DeviceProfile& p) {
   return s;
 }
 
-// Each draw size's weights and pipes (DeviceProfile::drawSizes), then the shared lines.
+// Each draw size's weights and pipes (DeviceProfile::drawSizes), indented under it.
 std::string drawSizeLines(const DeviceProfile& p) {
   std::string s = fmt::format("vertices_per_draw: {:g}  # where a generation's mesh is unknown\n"
                               "draw_sizes:  # weights fitted at each mesh size; between two, interpolated in log(vertices per draw)\n",
                               p.verticesPerDraw);
   for (const DeviceProfile::DrawSize& d : p.drawSizes) {
-    DeviceProfile at = p;
-    at.nanoseconds = d.nanoseconds;
-    at.pipes = d.pipes;
-    at.drawSizes.clear();
-    at.scaledBy = {};
-    at.workloadDefaults = {};
-    at.constantCacheEntries = 0;
-    std::string block = fmt::format("{:g}:\n", d.vertices) + "weights:\n";
-    for (int t = 0; t < kTermCount; ++t) block += fmt::format("  {}: {:.6g}\n", termName(t), d.nanoseconds[size_t(t)]);
-    block += rooflineLines(at);
-    // Indented under its size.
-    for (size_t start = block.find('\n') + 1; start < block.size(); start = block.find('\n', start) + 1) block.insert(start, "    ");
-    s += "  " + block;
+    s += fmt::format("  {:g}:\n", d.vertices);
+    const std::string lines = additiveLines(d.nanoseconds) + pipeLines(d.pipes);
+    for (size_t start = 0, end; start < lines.size(); start = end + 1) {
+      end = lines.find('\n', start);
+      s += "    " + lines.substr(start, end - start + 1);
+    }
   }
-  DeviceProfile shared = p;
-  shared.pipes.clear();
-  return s + rooflineLines(shared);
+  return s;
 }
 
 std::string weightLines(const DeviceProfile& p) {
-  if (!p.drawSizes.empty()) return drawSizeLines(p);
-  std::string s = "weights:\n";
-  for (int t = 0; t < kTermCount; ++t) s += fmt::format("  {}: {:.6g}\n", termName(t), p.nanoseconds[size_t(t)]);
+  if (!p.drawSizes.empty()) return drawSizeLines(p) + workloadLines(p);
+  std::string s = additiveLines(p.nanoseconds);
+  if (p.hasDrawWeights()) {
+    s += fmt::format("vertices_per_draw: {:g}\ndraw_weights:\n", p.verticesPerDraw);
+    for (int t = 0; t < kTermCount; ++t)
+      if (p.drawNanoseconds[size_t(t)] > 0) s += fmt::format("  {}: {:.6g}\n", termName(t), p.drawNanoseconds[size_t(t)]);
+  }
   // Pipes and the workload scaling are written whether or not the fit found per-draw costs
   // (before session 17 a profile without them lost its pipes and scaled_by lines).
-  if (!p.hasDrawWeights()) return s + rooflineLines(p);
-  s += fmt::format("vertices_per_draw: {:g}\ndraw_weights:\n", p.verticesPerDraw);
-  for (int t = 0; t < kTermCount; ++t)
-    if (p.drawNanoseconds[size_t(t)] > 0) s += fmt::format("  {}: {:.6g}\n", termName(t), p.drawNanoseconds[size_t(t)]);
-  return s + rooflineLines(p);
+  return s + pipeLines(p.pipes) + workloadLines(p);
 }
 
 std::string fitLine(const CalibrationFit& f) {

@@ -200,7 +200,8 @@ Solved solve(const Layout& l, const std::vector<FitRow>& rows, const std::vector
       return s / double(rows.size());
     };
     size_t i = 0;
-    const double share = median / double(std::max<size_t>(1, l.block()));
+    // Shared over one block's parameters and the miss factor (as many as without draw sizes).
+    const double share = median / double(std::max<size_t>(1, l.block() + (l.miss ? 1 : 0)));
     for (int t : l.additive) typical[i++] = meanAmount(t, false) > 0 ? share / meanAmount(t, false) : 0;
     for (int t : l.perDraw) typical[i++] = meanAmount(t, true) > 0 ? share / meanAmount(t, true) : 0;
     for (const auto& [p, t] : l.pipeTerms) typical[i++] = meanAmount(t, false) > 0 ? share / meanAmount(t, false) : 0;
