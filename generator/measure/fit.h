@@ -66,7 +66,8 @@ constexpr double kMinTermGain = 0.02;  // of the weighted squared error, for a t
 // hold kMinRowsPerDrawSize rows at each of two vertex counts per draw or more, one set of
 // weights per such size, a row between two sizes priced by their weights interpolated in
 // log(vertices) as the profile prices it (DeviceProfile::atDrawSize); kept where it lowers the
-// weighted squared error by kMinTermGain. The constant cache's miss factor is shared.
+// weighted squared error by kMinTermGain. A fragment's price and the constant cache's miss factor
+// are shared by every size.
 constexpr size_t kMinRowsPerDrawSize = 24;
 FitResult fitProfile(const std::vector<FitRow>& rows, const FitOptions& options);
 
