@@ -463,9 +463,16 @@ double medianOfFinite(std::vector<double> v) {
 
 std::string heldOutSummary(const LeaveOneRigOut& loo, const char* what = "leave-one-rig-out") {
   return fmt::format("{} over {} (rig, mesh) pairs: median Spearman {:.3f}, worst chosen / fastest {:.3f}, "
-                     "RMS relative error median {:.1f} %, max {:.1f} %",
-                     what, loo.rows.size(), loo.medianSpearman, loo.worstChosenOverFastest, 100 * loo.medianRms, 100 * loo.maxRms);
+                     "RMS relative error median {:.1f} %, max {:.1f} %{}",
+                     what, loo.rows.size(), loo.medianSpearman, loo.worstChosenOverFastest, 100 * loo.medianRms, 100 * loo.maxRms,
+                     loo.pairsDecidedByATie == 0 ? ""
+                                                 : fmt::format("; in {} the least prediction is shared (the slowest of those "
+                                                               "plans counted)",
+                                                               loo.pairsDecidedByATie));
 }
+
+// Predicted times this close (relative) are one time: sums of the same prices in another order.
+constexpr double kPredictedTie = 1e-9;
 
 // Each (rig, mesh) of `rig` ("" = every rig) in `samples`: its plans predicted by `profile`.
 std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& samples, const std::string& rig,
@@ -498,14 +505,20 @@ std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& sample
     h.plans = h.measured.size();
     if (h.plans == 0) continue;
     double sq = 0;
-    size_t best = 0;
     for (size_t i = 0; i < h.plans; ++i) {
       const double rel = (h.predicted[i] - h.measured[i]) / h.measured[i];
       sq += rel * rel;
-      if (h.predicted[i] < h.predicted[best]) best = i;
     }
     h.rmsRelativeError = std::sqrt(sq / double(h.plans));
-    h.chosenOverFastest = h.measured[best] / *std::min_element(h.measured.begin(), h.measured.end());
+    // The chosen plan: the least predicted; where several share it, the slowest of them (which
+    // one the search returns depends on the order it meets them, not on the profile).
+    const double least = *std::min_element(h.predicted.begin(), h.predicted.end());
+    size_t chosen = 0;
+    for (size_t i = 0; i < h.plans; ++i)
+      if (h.predicted[i] <= least * (1 + kPredictedTie)) {
+        if (h.tiedForLeast++ == 0 || h.measured[i] > h.measured[chosen]) chosen = i;
+      }
+    h.chosenOverFastest = h.measured[chosen] / *std::min_element(h.measured.begin(), h.measured.end());
     h.spearman = spearmanWithinSpread(h.predicted, h.measured, 0.005);
     rows.push_back(std::move(h));
   }
@@ -517,6 +530,7 @@ LeaveOneRigOut summarise(std::vector<HeldOutRig> rows) {
   out.rows = std::move(rows);
   std::vector<double> rho, rms;
   for (const auto& h : out.rows) {
+    if (h.tiedForLeast > 1) ++out.pairsDecidedByATie;
     rho.push_back(h.spearman);
     rms.push_back(h.rmsRelativeError);
     if (!(out.worstChosenOverFastest >= h.chosenOverFastest)) out.worstChosenOverFastest = h.chosenOverFastest;
@@ -559,8 +573,8 @@ std::string heldOutTable(const LeaveOneRigOut& t, const char* what, const char* 
                               "|---|---|---:|---:|---:|---:|\n",
                               what, meaning, rigColumn);
   for (const auto& h : t.rows)
-    s += fmt::format("| {} | {} | {} | {:.3f} | {:.3f} | {:.1f} % |\n", h.rig, h.mesh, h.plans, h.spearman, h.chosenOverFastest,
-                     100 * h.rmsRelativeError);
+    s += fmt::format("| {} | {} | {} | {:.3f} | {:.3f}{} | {:.1f} % |\n", h.rig, h.mesh, h.plans, h.spearman, h.chosenOverFastest,
+                     h.tiedForLeast > 1 ? fmt::format(" ({} tied)", h.tiedForLeast) : "", 100 * h.rmsRelativeError);
   return s + heldOutSummary(t, what) + "\n";
 }
 

@@ -124,11 +124,16 @@ struct HeldOutRig {
   std::vector<double> predicted, measured;  // ns per vertex, per plan
   double spearman = NAN;             // predicted against measured (within 0.5 %: ties)
   double chosenOverFastest = NAN;    // measured time of the least-predicted plan / the fastest
+  // Plans sharing the least predicted time (a roofline prices plans whose extra work hides under
+  // the same slowest pipe alike). The search may return any of them, so chosenOverFastest counts
+  // the slowest of them.
+  size_t tiedForLeast = 0;
   double rmsRelativeError = NAN;
 };
 struct LeaveOneRigOut {
   std::vector<HeldOutRig> rows;  // by rig, then mesh
   double medianSpearman = NAN, worstChosenOverFastest = NAN, medianRms = NAN, maxRms = NAN;
+  size_t pairsDecidedByATie = 0;  // rows whose least prediction several plans share
 };
 LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
                               double workloadVertices, double nearBestPower, const FitOptions& fit = {});
