@@ -5,15 +5,8 @@ Usage: python3 repeat.py OLD_EVALUATION NEW_EVALUATION OLD_LOG:NEW_LOG ...
 (the evaluations are `calibrate --evaluate` outputs over those logs, in the same order)."""
 import math, sys
 
-def rows(path):
-    hdr = None
-    for line in open(path):
-        if line.startswith('| mesh |'):
-            hdr = [c.strip() for c in line.strip().strip('|').split('|')]
-        elif hdr and line.startswith('|') and not line.startswith('|---'):
-            c = [x.strip() for x in line.strip().strip('|').split('|')]
-            if len(c) == len(hdr):
-                yield dict(zip(hdr, c))
+from logtable import rows
+
 
 def pairs(path):  # (rig, mesh) -> chosen / fastest, from an evaluation's table
     out = {}

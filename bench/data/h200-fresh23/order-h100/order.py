@@ -3,18 +3,12 @@
 plans timed first (early.log), last of 34 (late.log) and in the whole model (all.log), and each
 part's uniform-palette over storage-buffer-palette time (U/B) in two whole-model runs on the H100
 and one on the H200. Usage: python3 order.py   (stdlib only)"""
-import math, os
+import math, os, sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..'))
+from logtable import rows  # noqa: E402
 here = os.path.dirname(os.path.abspath(__file__))
 
-def rows(path):
-    hdr = None
-    for line in open(path):
-        if line.startswith('| mesh |'):
-            hdr = [c.strip() for c in line.strip().strip('|').split('|')]
-        elif hdr and line.startswith('|') and not line.startswith('|---'):
-            c = [x.strip() for x in line.strip().strip('|').split('|')]
-            if len(c) == len(hdr):
-                yield dict(zip(hdr, c))
 
 def num(r, k):
     return float(r[k])
