@@ -9,8 +9,9 @@
 # Fits and the held-out check are made offline from the logs (shadergen calibrate --from-logs).
 # Usage: bash gpu_collect.sh [DEVICE=NVIDIA] [OUTDIR=.]; SG_BUDGET scales every group's time limit,
 # SG_GROUPS="train world ..." runs only those groups (a device call's time limit), SG_HELDOUT_SEED picks
-# another random held-out set (default 2; the H200 has timed seeds 1-6 by session 23), SG_MESHES the procedural meshes (dawn,head; limb: 825 vertices, a
-# small draw), SG_MIN_FRAME_VERTICES the least vertices a timed frame draws (64000: the head at 32 draws).
+# another random held-out set (default 2; the H200 has timed seeds 1-6 by session 23), SG_MESHES the
+# procedural meshes (dawn,head; limb: 825 vertices, a small draw), SG_MIN_FRAME_VERTICES the least
+# vertices a timed frame draws (64000: the head at 32 draws).
 set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 device=${1-NVIDIA}

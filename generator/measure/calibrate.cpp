@@ -465,10 +465,10 @@ std::string heldOutSummary(const LeaveOneRigOut& loo, const char* what = "leave-
   return fmt::format("{} over {} (rig, mesh) pairs: median Spearman {:.3f}, worst chosen / fastest {:.3f}, "
                      "RMS relative error median {:.1f} %, max {:.1f} %{}",
                      what, loo.rows.size(), loo.medianSpearman, loo.worstChosenOverFastest, 100 * loo.medianRms, 100 * loo.maxRms,
-                     loo.pairsDecidedByATie == 0 ? ""
+                     loo.pairsWithATieForLeast == 0 ? ""
                                                  : fmt::format("; in {} the least prediction is shared (the slowest of those "
                                                                "plans counted)",
-                                                               loo.pairsDecidedByATie));
+                                                               loo.pairsWithATieForLeast));
 }
 
 // Predicted times this close (relative) are one time: sums of the same prices in another order.
@@ -530,7 +530,7 @@ LeaveOneRigOut summarise(std::vector<HeldOutRig> rows) {
   out.rows = std::move(rows);
   std::vector<double> rho, rms;
   for (const auto& h : out.rows) {
-    if (h.tiedForLeast > 1) ++out.pairsDecidedByATie;
+    if (h.tiedForLeast > 1) ++out.pairsWithATieForLeast;
     rho.push_back(h.spearman);
     rms.push_back(h.rmsRelativeError);
     if (!(out.worstChosenOverFastest >= h.chosenOverFastest)) out.worstChosenOverFastest = h.chosenOverFastest;

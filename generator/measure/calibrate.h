@@ -133,7 +133,7 @@ struct HeldOutRig {
 struct LeaveOneRigOut {
   std::vector<HeldOutRig> rows;  // by rig, then mesh
   double medianSpearman = NAN, worstChosenOverFastest = NAN, medianRms = NAN, maxRms = NAN;
-  size_t pairsDecidedByATie = 0;  // rows whose least prediction several plans share
+  size_t pairsWithATieForLeast = 0;  // rows whose least prediction several plans share
 };
 LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
                               double workloadVertices, double nearBestPower, const FitOptions& fit = {});

@@ -122,14 +122,14 @@ TEST(HeldOut, PlansSharingTheLeastPredictionCountAtTheSlowestOfThem) {
     ASSERT_EQ(check.rows.size(), 1u);
     EXPECT_EQ(check.rows[0].tiedForLeast, 2u);
     EXPECT_DOUBLE_EQ(check.rows[0].chosenOverFastest, 6.0 / 5.0);
-    EXPECT_EQ(check.pairsDecidedByATie, 1u);
+    EXPECT_EQ(check.pairsWithATieForLeast, 1u);
     EXPECT_NE(formatHeldOutCheck(check).find("| 1.200 (2 tied) |"), std::string::npos) << formatHeldOutCheck(check);
   }
   // One location more for the slow plan breaks the tie: the faster plan is chosen alone.
   const LeaveOneRigOut untied = checkHeldOut({a, plan("plan: forced x", 5, 4, 6), c}, p);
   EXPECT_EQ(untied.rows[0].tiedForLeast, 1u);
   EXPECT_DOUBLE_EQ(untied.rows[0].chosenOverFastest, 1.0);
-  EXPECT_EQ(untied.pairsDecidedByATie, 0u);
+  EXPECT_EQ(untied.pairsWithATieForLeast, 0u);
 }
 
 TEST(HeldOut, TheProfileRecordsTheSummary) {
