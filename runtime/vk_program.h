@@ -47,6 +47,13 @@ struct DescriptorBinding {
   std::string name;  // for messages
 };
 
+// Where a program's inputs (streams, uniform block, storage buffers, indices) live.
+// DeviceLocal: memory only the device reads, filled by a staging copy, as an engine keeps a
+// static mesh. Mapped: host-visible coherent memory the host writes in place (device-local
+// where the device has such a type: on a discrete GPU without resizable BAR a window of a
+// few hundred MiB, shared by every allocation of that type).
+enum class InputMemory { DeviceLocal, Mapped };
+
 struct ProgramInputs {
   uint32_t vertexCount = 0;
   std::vector<VertexStream> streams;
@@ -56,6 +63,7 @@ struct ProgramInputs {
   // The descriptors the program's shaders use (set 0: vertex stage, set 1: fragment stage).
   // A run refuses one that the fields above do not feed, naming it.
   std::vector<DescriptorBinding> declared;
+  InputMemory memory = InputMemory::DeviceLocal;  // where the buffers above live on the device
 };
 
 }  // namespace sg::rt

@@ -104,6 +104,7 @@ Timing Renderer::time(const DrawRequest& r, const TimingRequest& t) {
   // One command buffer per frame: the texture uploads in the first, then only draws.
   Timing out;
   out.verticesPerDraw = r.vertexCount;
+  out.inputMemory = o.inputMemory();
   for (uint32_t f = 0; f < t.frames; ++f) {
     if (f > 0) o.restart();
     vkCmdResetQueryPool(o.cmd(), queries, 0, 2);

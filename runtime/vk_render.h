@@ -53,6 +53,7 @@ struct Timing {
   // the work here, so this counts the work itself, not what other processes took meanwhile.
   std::vector<double> cpuNs;
   uint32_t verticesPerDraw = 0;  // vertex shader invocations asked for per draw (unique vertices)
+  std::string inputMemory;       // the memory types the inputs were in ("type 1 (device-local) of heap 0 (...)")
 };
 
 // What one draw of a request made the device do (a pipeline statistics query): vertex shader

@@ -95,17 +95,45 @@ Device::Device(const Harness::Handles& handles) : h(handles) {
   if (!bindXfb || !beginXfb || !endXfb) throw std::runtime_error("vulkan: transform feedback entry points are missing");
 }
 
+uint32_t chooseMemoryType(const VkPhysicalDeviceMemoryProperties& memory, uint32_t allowed, VkMemoryPropertyFlags required,
+                          VkMemoryPropertyFlags preferred) {
+  for (VkMemoryPropertyFlags want : {required | preferred, required})
+    for (uint32_t i = 0; i < memory.memoryTypeCount && i < 32; ++i)
+      if ((allowed & (1u << i)) && (memory.memoryTypes[i].propertyFlags & want) == want) return i;
+  return UINT32_MAX;
+}
+
+std::string describeMemoryType(const VkPhysicalDeviceMemoryProperties& memory, uint32_t type) {
+  if (type >= memory.memoryTypeCount) return "no memory type";
+  auto flagNames = [](uint32_t flags, std::initializer_list<std::pair<uint32_t, const char*>> names) {
+    std::string s;
+    for (const auto& [bit, name] : names)
+      if (flags & bit) s += (s.empty() ? "" : ", ") + std::string(name);
+    return s.empty() ? std::string("no flags") : s;
+  };
+  const VkMemoryType& t = memory.memoryTypes[type];
+  const std::string typeFlags =
+      flagNames(t.propertyFlags, {{VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, "device-local"},
+                                  {VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT, "host-visible"},
+                                  {VK_MEMORY_PROPERTY_HOST_COHERENT_BIT, "host-coherent"},
+                                  {VK_MEMORY_PROPERTY_HOST_CACHED_BIT, "host-cached"}});
+  if (t.heapIndex >= memory.memoryHeapCount) return fmt::format("type {} ({})", type, typeFlags);
+  const VkMemoryHeap& h = memory.memoryHeaps[t.heapIndex];
+  const double mib = double(h.size) / (1024.0 * 1024.0);
+  const std::string size = mib >= 1024 ? fmt::format("{:.1f} GiB", mib / 1024) : fmt::format("{:.0f} MiB", mib);
+  return fmt::format("type {} ({}) of heap {} ({}, {})", type, typeFlags, t.heapIndex, size,
+                     h.flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT ? "device-local" : "host");
+}
+
 VkDeviceMemory Device::allocate(const VkMemoryRequirements& mr, VkMemoryPropertyFlags required,
-                                VkMemoryPropertyFlags preferred) const {
+                                VkMemoryPropertyFlags preferred, uint32_t* type) const {
   VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   ai.allocationSize = mr.size;
-  ai.memoryTypeIndex = UINT32_MAX;
-  for (VkMemoryPropertyFlags want : {required | preferred, required})
-    for (uint32_t i = 0; i < memProps.memoryTypeCount && ai.memoryTypeIndex == UINT32_MAX; ++i)
-      if ((mr.memoryTypeBits & (1u << i)) && (memProps.memoryTypes[i].propertyFlags & want) == want) ai.memoryTypeIndex = i;
+  ai.memoryTypeIndex = chooseMemoryType(memProps, mr.memoryTypeBits, required, preferred);
   if (ai.memoryTypeIndex == UINT32_MAX) throw std::runtime_error("vulkan: no suitable memory type");
   VkDeviceMemory m = VK_NULL_HANDLE;
   check(vkAllocateMemory(h.device, &ai, nullptr, &m), "vkAllocateMemory");
+  if (type) *type = ai.memoryTypeIndex;
   return m;
 }
 
@@ -187,10 +215,11 @@ Buffer& ProgramObjects::buffer(VkDeviceSize size, VkBufferUsageFlags usage, Memo
   check(vkCreateBuffer(d_.h.device, &ci, nullptr, &b.buffer), "vkCreateBuffer");
   VkMemoryRequirements mr{};
   vkGetBufferMemoryRequirements(d_.h.device, b.buffer, &mr);
-  // Inputs live in mapped coherent memory: vkQueueSubmit makes earlier host writes visible
-  // to the device, so no staging copy or upload barrier is needed.
+  // Host-visible memory is coherent: vkQueueSubmit makes earlier host writes visible to the
+  // device, so what the host writes in place needs no flush.
   b.memory = d_.allocate(mr, hostVisible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT : 0,
-                         memory == Memory::Readback ? VK_MEMORY_PROPERTY_HOST_CACHED_BIT : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+                         memory == Memory::Readback ? VK_MEMORY_PROPERTY_HOST_CACHED_BIT : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT,
+                         &b.memoryType);
   check(vkBindBufferMemory(d_.h.device, b.buffer, b.memory, 0), "vkBindBufferMemory");
   if (hostVisible) check(vkMapMemory(d_.h.device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
   return b;
@@ -292,19 +321,23 @@ ProgramObjects::ProgramObjects(const Device& device, const ProgramInputs& inputs
     VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     check(vkBeginCommandBuffer(cmd_, &bi), "vkBeginCommandBuffer");
 
-    // Streams, uniform block and storage buffers (filled by upload()), the index buffer,
-    // texture staging, and room for the caller's capture/readback buffers.
-    buffers_.reserve(in_.streams.size() + in_.storageBuffers.size() + in_.textures.size() + 8);
+    // Streams, uniform block, storage buffers and the index buffer (filled by upload(), with a
+    // staging buffer each where they are device-local), texture staging, and room for the
+    // caller's capture/readback buffers.
+    const bool staged = in_.memory == InputMemory::DeviceLocal;
+    const Memory inputs = staged ? Memory::Device : Memory::Upload;
+    const VkBufferUsageFlags dst = staged ? VK_BUFFER_USAGE_TRANSFER_DST_BIT : 0;
+    const size_t inputBuffers = in_.streams.size() + in_.storageBuffers.size() + 2;
+    buffers_.reserve(inputBuffers * (staged ? 2 : 1) + in_.textures.size() + 8);
     images_.reserve(in_.textures.size() + 2);
     firstStream_ = buffers_.size();
     for (const VertexStream& s : in_.streams)
-      vertexBuffers_.push_back(buffer(VkDeviceSize(drawCount_) * s.stride, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, Memory::Upload).buffer);
+      vertexBuffers_.push_back(buffer(VkDeviceSize(drawCount_) * s.stride, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | dst, inputs).buffer);
     firstStorage_ = buffers_.size();
-    for (const StorageBufferData& sb : in_.storageBuffers) buffer(sb.data.size(), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::Upload);
-    if (!in_.uniformData.empty()) uniform_ = &buffer(in_.uniformData.size(), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, Memory::Upload);
+    for (const StorageBufferData& sb : in_.storageBuffers) buffer(sb.data.size(), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | dst, inputs);
+    if (!in_.uniformData.empty()) uniform_ = &buffer(in_.uniformData.size(), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | dst, inputs);
     if (rasterize_) {
-      index_ = &buffer(pass_.indices->size() * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, Memory::Upload);
-      std::memcpy(index_->mapped, pass_.indices->data(), pass_.indices->size() * 4);
+      index_ = &buffer(pass_.indices->size() * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT | dst, inputs);
       for (const Texture& t : in_.textures) uploadTexture(t);
     }
     createDescriptors();
@@ -553,16 +586,49 @@ void ProgramObjects::createPipeline() {
 }
 
 void ProgramObjects::upload() {
+  const bool staged = in_.memory == InputMemory::DeviceLocal;
+  // Where the host writes `target`'s bytes: its mapping, or a staging buffer copied into it.
+  auto destination = [&](Buffer& target, VkDeviceSize size) -> uint8_t* {
+    if (!staged) return static_cast<uint8_t*>(target.mapped);
+    Buffer& staging = buffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, Memory::Upload);
+    const VkBufferCopy region{0, 0, std::max<VkDeviceSize>(size, 4)};
+    vkCmdCopyBuffer(cmd_, staging.buffer, target.buffer, 1, &region);
+    return static_cast<uint8_t*>(staging.mapped);
+  };
   for (size_t i = 0; i < in_.streams.size(); ++i) {
     const VertexStream& s = in_.streams[i];
-    auto* dst = static_cast<uint8_t*>(buffers_[firstStream_ + i].mapped);
     const VkDeviceSize used = VkDeviceSize(in_.vertexCount) * s.stride, padded = VkDeviceSize(drawCount_) * s.stride;
+    uint8_t* dst = destination(buffers_[firstStream_ + i], padded);
     std::memcpy(dst, s.data.data(), used);
     std::memset(dst + used, 0, padded - used);  // the padding vertex reads zeros, never garbage
   }
-  for (size_t i = 0; i < in_.storageBuffers.size(); ++i)
-    std::memcpy(buffers_[firstStorage_ + i].mapped, in_.storageBuffers[i].data.data(), in_.storageBuffers[i].data.size());
-  if (uniform_) std::memcpy(uniform_->mapped, in_.uniformData.data(), in_.uniformData.size());
+  for (size_t i = 0; i < in_.storageBuffers.size(); ++i) {
+    const StorageBufferData& sb = in_.storageBuffers[i];
+    std::memcpy(destination(buffers_[firstStorage_ + i], sb.data.size()), sb.data.data(), sb.data.size());
+  }
+  if (uniform_) std::memcpy(destination(*uniform_, in_.uniformData.size()), in_.uniformData.data(), in_.uniformData.size());
+  if (index_) std::memcpy(destination(*index_, pass_.indices->size() * 4), pass_.indices->data(), pass_.indices->size() * 4);
+  if (staged) {
+    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_VERTEX_ATTRIBUTE_READ_BIT | VK_ACCESS_INDEX_READ_BIT | VK_ACCESS_UNIFORM_READ_BIT |
+                      VK_ACCESS_SHADER_READ_BIT;
+    vkCmdPipelineBarrier(cmd_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_VERTEX_INPUT_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT,
+                         0, 1, &b, 0, nullptr, 0, nullptr);
+  }
+}
+
+std::string ProgramObjects::inputMemory() const {
+  std::vector<uint32_t> types;
+  auto add = [&](const Buffer& b) {
+    if (std::find(types.begin(), types.end(), b.memoryType) == types.end()) types.push_back(b.memoryType);
+  };
+  for (size_t i = firstStream_; i < firstStorage_ + in_.storageBuffers.size(); ++i) add(buffers_[i]);
+  if (uniform_) add(*uniform_);
+  if (index_) add(*index_);
+  std::string s;
+  for (uint32_t t : types) s += (s.empty() ? "" : "; ") + describeMemoryType(d_.memProps, t);
+  return s;
 }
 
 void ProgramObjects::restart() {

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "runtime/vk_harness.h"
@@ -30,15 +31,25 @@ struct Device {
   PFN_vkCmdEndTransformFeedbackEXT endXfb = nullptr;
 
   explicit Device(const Harness::Handles& handles);
-  // Memory with the `required` flags, and the `preferred` ones where the device has such a type.
+  // Memory of the type chooseMemoryType picks; `type` (optional) receives its index.
   VkDeviceMemory allocate(const VkMemoryRequirements& requirements, VkMemoryPropertyFlags required,
-                          VkMemoryPropertyFlags preferred) const;
+                          VkMemoryPropertyFlags preferred, uint32_t* type = nullptr) const;
 };
+
+// The first memory type of `allowed` (a VkMemoryRequirements::memoryTypeBits) with the
+// `required` and `preferred` flags, else the first with the `required` ones; UINT32_MAX if none.
+// The Vulkan spec orders types so that, of two with the flags asked for, the one with fewer
+// extra flags comes first: asking for device-local alone never lands in a host-visible window.
+uint32_t chooseMemoryType(const VkPhysicalDeviceMemoryProperties& memory, uint32_t allowed, VkMemoryPropertyFlags required,
+                          VkMemoryPropertyFlags preferred);
+// "type 1 (device-local) of heap 0 (80 GiB, device-local)": where an allocation lives.
+std::string describeMemoryType(const VkPhysicalDeviceMemoryProperties& memory, uint32_t type);
 
 struct Buffer {
   VkBuffer buffer = VK_NULL_HANDLE;
   VkDeviceMemory memory = VK_NULL_HANDLE;
   void* mapped = nullptr;  // host-visible buffers only
+  uint32_t memoryType = UINT32_MAX;
 };
 struct ImageObj {
   VkImage image = VK_NULL_HANDLE;
@@ -72,8 +83,12 @@ class ProgramObjects {
   ProgramObjects(const ProgramObjects&) = delete;
   ProgramObjects& operator=(const ProgramObjects&) = delete;
 
-  // Copies the inputs into their (host-coherent) buffers.
+  // Writes the inputs (streams, uniform block, storage buffers, indices) into their buffers:
+  // mapped ones in place, device-local ones through staging buffers whose copies this records,
+  // with the barrier that makes them visible to the vertex stage. Call it before recording a draw.
   void upload();
+  // Where the inputs live (describeMemoryType of each distinct type, "; "-separated).
+  std::string inputMemory() const;
   // Starts recording again after a submit (a new frame).
   void restart();
   // Begins the render pass and binds the pipeline, the descriptor sets and the vertex/index buffers.

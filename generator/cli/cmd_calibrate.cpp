@@ -7,6 +7,7 @@
 #include <ctime>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include <unistd.h>
@@ -104,6 +105,8 @@ struct CalibrateCommand {
     co.fit.form = chosenForm();
     if (co.fit.constantCache && co.fit.form == ProfileForm::Additive)
       throw CLI::ValidationError("--constant-cache", "needs --form roofline or raster (the cache's misses are priced in the constant pipe)");
+    if (co.fit.pipeSumShare && co.fit.form == ProfileForm::Additive)
+      throw CLI::ValidationError("--pipe-sum-share", "needs --form roofline or raster (the share is of the pipes a program does not wait for)");
     if (co.fit.drawSizes && co.fit.form != ProfileForm::Raster)
       throw CLI::ValidationError("--draw-sizes", "needs --form raster (the other forms price a draw's size by their per-draw weights)");
     if (!writeCorpus.empty()) return writeCorpusFiles();
@@ -213,6 +216,11 @@ void registerCalibrate(CLI::App& app, CliState& state) {
                   "A smaller mesh (a model's part) is drawn more often than --draws, so that each timed frame draws at least this "
                   "many vertices (default 16000: the 2,009-vertex head at 8 draws; 0: exactly --draws)")
       ->check(CLI::Range(0, 100000000));
+  sub->add_option("--input-memory", cmd->co.inputMemory,
+                "Where the timed programs' inputs live: device-local (default; filled by a staging copy, as an engine keeps a "
+                "mesh) or mapped (host-visible memory written in place: on a discrete GPU a BAR window)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, rt::InputMemory>{{"device-local", rt::InputMemory::DeviceLocal},
+                                                                                {"mapped", rt::InputMemory::Mapped}}));
   sub->add_option("--frames", cmd->co.frames, "Timed frames; the median counts (default 9)")->check(CLI::Range(1, 1000));
   sub->add_option("--rounds", cmd->co.rounds, "Timings per program; the best counts (default 2)")->check(CLI::Range(1, 100));
   sub->add_option("--refits", cmd->co.refits, "With --rig: fits again with the plans each profile chose (default 1)")
@@ -249,6 +257,10 @@ void registerCalibrate(CLI::App& app, CliState& state) {
                 "With --form raster: fit one set of weights per mesh size the samples were timed at (vertices per "
                 "draw), a draw between two sizes priced by their weights interpolated in log(vertices); kept where it "
                 "lowers the fit's error (docs/device-profiles.md, \"Draw sizes\")");
+  sub->add_flag("--pipe-sum-share", cmd->co.fit.pipeSumShare,
+                "With --form roofline or raster: fit how imperfectly the pipes overlap, a program paying besides its "
+                "slowest pipe a share of the others (pipe_sum_share); kept where it lowers the fit's error "
+                "(docs/device-profiles.md, \"Pipes overlap imperfectly\")");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer (use for timings)");
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }

@@ -694,6 +694,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   rep.clock += fmt::format(" over {} draws per frame (a smaller mesh more: at least {} vertices), median of {} frames, best of {} rounds",
                            opts.drawsPerFrame, opts.minVerticesPerFrame, opts.frames, std::max<uint32_t>(1, opts.rounds));
   double GpuBenchRow::*const clock = hostClock ? &GpuBenchRow::rasterOffCpuNsPerVertex : &GpuBenchRow::rasterOnNsPerVertex;
+  std::string inputMemory;  // inputMemoryLine of the first timing, for the clock's line
 
   const auto stopped = [&] { return opts.stop && opts.stop->load(); };
   for (const auto& meshName : opts.meshes) {
@@ -732,6 +733,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
         if (s.validated) {
           rt::DrawRequest req;
           static_cast<rt::ProgramInputs&>(req) = p.inputs;
+          req.memory = opts.inputMemory;
           req.vertexSpirv = hostClock ? capture : render;
           req.fragmentSpirv = compileProbe(Stage::Fragment, probeFragmentGlsl(p), p.label).spirv();
           req.indices = m.indices;
@@ -745,6 +747,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           std::vector<double> rounds;
           for (uint32_t r = 0; r < std::max<uint32_t>(1, opts.rounds); ++r) {
             rt::Timing tm = renderer.time(req, t);
+            if (inputMemory.empty()) inputMemory = inputMemoryLine(opts.inputMemory, tm.inputMemory);
             const std::vector<double>& clock = hostClock ? tm.cpuNs : tm.frameNs;
             std::vector<double> frames(clock.begin() + 1, clock.end());
             rounds.push_back(medianOf(frames) / (double(t.drawsPerFrame) * double(tm.verticesPerDraw)));
@@ -815,6 +818,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
         bo.minVerticesPerFrame = opts.minVerticesPerFrame;
         bo.frames = opts.frames;
         bo.rounds = opts.rounds;
+        bo.inputMemory = opts.inputMemory;
         GpuBenchReport br;
         try {
           br = runGpuBench(bo);
@@ -824,6 +828,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
                                           meshName, e.what()));
           continue;
         }
+        if (inputMemory.empty()) inputMemory = br.inputMemory;
         if (!fitted) {  // the plans' predicted against measured time, by this calibration's clock
           const PredictionCheck pc = checkPredictions(br.rows, clock);
           CalibrationCheck c;
@@ -863,6 +868,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
     }
     benchRigs(slots, true, "plan: ");
   }
+  if (!inputMemory.empty()) rep.clock += "; " + inputMemory;
   double workload = 0;
   for (const auto& s : rep.samples)
     if (s.mesh == opts.meshes.front()) workload = s.vertices;
@@ -919,7 +925,7 @@ std::string additiveLines(const std::array<double, kTermCount>& nanoseconds) {
   return s;
 }
 
-// The workload scaling, its defaults and the constant cache, shared by every draw size (none
+// The workload scaling, its defaults, the pipes' sum share and the constant cache, shared by every draw size (none
 // for an additive profile without scaling: the file then reads as every profile before them).
 std::string workloadLines(const DeviceProfile& p) {
   std::string s;
@@ -937,6 +943,8 @@ std::string workloadLines(const DeviceProfile& p) {
       s += fmt::format("  {}: {:g}\n", featureName(f), p.workloadDefaults[size_t(f)]);
       defaults = true;
     }
+  if (p.pipeSumShare > 0)
+    s += fmt::format("pipe_sum_share: {:.4g}  # besides its slowest pipe a program pays this share of the others\n", p.pipeSumShare);
   if (p.constantCacheEntries > 0)
     s += fmt::format("constant_cache:  # past this palette footprint per warp, a distinct address costs miss_factor times as much\n"
                      "  entries: {:.10g}\n  miss_factor: {:.6g}\n",

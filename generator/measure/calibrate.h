@@ -47,6 +47,7 @@ struct CalibrationOptions {
   uint32_t frames = 9;              // + 1 warm-up frame
   uint32_t rounds = 2;              // best round counts
   uint32_t width = 256, height = 256;  // the target of every draw (bench's default)
+  rt::InputMemory inputMemory = rt::InputMemory::DeviceLocal;  // of every timed program (GpuBenchOptions)
   bool probes = true;
   // For each rig: the generated plan and every forced alternative (bench's programs), with
   // plans' fragment shader, rules and limits, and bench's floors. A glTF rig (MODEL.glb#m/p)

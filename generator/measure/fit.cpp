@@ -58,12 +58,16 @@ struct Layout {
   // With sizes: the parameters of a block every size shares, its first block's (a fragment's
   // price: a large draw covers too few fragments to price one of its own).
   std::vector<bool> shared;
-  // The constant cache's miss factor, a last parameter: the terms it multiplies.
+  // After the blocks: the pipes' sum share (`share`), then the constant cache's miss factor
+  // (`miss`) and the terms it multiplies.
+  bool share = false;
   bool miss = false;
   std::array<bool, kTermCount> missTerms{};
   size_t block() const { return additive.size() + perDraw.size() + pipeTerms.size(); }
   size_t blocks() const { return std::max<size_t>(1, sizes.size()); }
-  size_t size() const { return block() * blocks() + (miss ? 1 : 0); }
+  size_t shareIndex() const { return block() * blocks(); }
+  size_t missIndex() const { return shareIndex() + (share ? 1 : 0); }
+  size_t size() const { return missIndex() + (miss ? 1 : 0); }
 };
 
 Layout layoutOf(const DeviceProfile& form, bool drawWeights) {
@@ -109,7 +113,8 @@ class RowCost : public ceres::CostFunction {
       w[j] = isShared(j) ? parameters[0][j] : (1 - share) * parameters[0][below + j] + share * parameters[0][above + j];
     std::vector<double> grad(n, 0.0);
     const bool miss = l_.miss && past_;
-    const double m = miss ? parameters[0][l_.size() - 1] : 1.0;
+    const double m = miss ? parameters[0][l_.missIndex()] : 1.0;
+    const double s = l_.share ? parameters[0][l_.shareIndex()] : 0.0;
     auto factor = [&](int t) { return miss && l_.missTerms[static_cast<size_t>(t)] ? m : 1.0; };
     double ns = 0, dm = 0;
     size_t i = 0;
@@ -126,12 +131,17 @@ class RowCost : public ceres::CostFunction {
       if (factor(t) != 1.0) pipeDm[p] += w[i] * x_[t];
       ++i;
     }
+    double ds = 0;  // d ns / d share: the other pipes' sum
     if (l_.pipes) {
       const size_t slowest = static_cast<size_t>(std::max_element(pipe.begin(), pipe.end()) - pipe.begin());
-      ns += pipe[slowest];
-      dm += pipeDm[slowest];
+      for (size_t p = 0; p < l_.pipes; ++p) {
+        const double weight = p == slowest ? 1.0 : s;  // (1 - s) x slowest + s x every pipe
+        ns += weight * pipe[p];
+        dm += weight * pipeDm[p];
+        if (p != slowest) ds += pipe[p];
+      }
       i = pipeBegin;
-      for (const auto& [p, t] : l_.pipeTerms) grad[i++] = p == slowest ? x_[t] * factor(t) : 0.0;
+      for (const auto& [p, t] : l_.pipeTerms) grad[i++] = (p == slowest ? 1.0 : s) * x_[t] * factor(t);
     }
     residuals[0] = scale_ * (ns - measured_);
     if (jacobians && jacobians[0]) {
@@ -142,7 +152,8 @@ class RowCost : public ceres::CostFunction {
           J[j] += scale_ * grad[j];
         else
           J[below + j] += scale_ * (1 - share) * grad[j], J[above + j] += scale_ * share * grad[j];
-      if (miss) J[l_.size() - 1] = scale_ * dm;
+      if (miss) J[l_.missIndex()] = scale_ * dm;
+      if (l_.share) J[l_.shareIndex()] = scale_ * ds;
     }
     return true;
   }
@@ -169,7 +180,8 @@ DeviceProfile toProfile(const DeviceProfile& form, const Layout& l, const std::v
     for (const auto& [pi, t] : l.pipeTerms) p.pipes[pi].nanoseconds[static_cast<size_t>(t)] = std::min(block[i++], kMaxProfileWeightNs);
     if (!l.sizes.empty()) p.drawSizes.push_back({l.sizes[b], p.nanoseconds, p.pipes});
   }
-  if (l.miss) p.constantCacheMissFactor = w.back();
+  if (l.share) p.pipeSumShare = std::clamp(w[l.shareIndex()], 0.0, 1.0);
+  if (l.miss) p.constantCacheMissFactor = w[l.missIndex()];
   if (p.hasDrawWeights() || !p.drawSizes.empty()) p.verticesPerDraw = vertices;
   return p.atDrawSize(p.verticesPerDraw);
 }
@@ -201,7 +213,7 @@ Solved solve(const Layout& l, const std::vector<FitRow>& rows, const std::vector
     };
     size_t i = 0;
     // Shared over one block's parameters and the miss factor (as many as without draw sizes).
-    const double share = median / double(std::max<size_t>(1, l.block() + (l.miss ? 1 : 0)));
+    const double share = median / double(std::max<size_t>(1, l.block() + (l.miss ? 1 : 0) + (l.share ? 1 : 0)));
     for (int t : l.additive) typical[i++] = meanAmount(t, false) > 0 ? share / meanAmount(t, false) : 0;
     for (int t : l.perDraw) typical[i++] = meanAmount(t, true) > 0 ? share / meanAmount(t, true) : 0;
     for (const auto& [p, t] : l.pipeTerms) typical[i++] = meanAmount(t, false) > 0 ? share / meanAmount(t, false) : 0;
@@ -211,16 +223,18 @@ Solved solve(const Layout& l, const std::vector<FitRow>& rows, const std::vector
   for (double start : {0.1, 0.5, 1.0}) {
     std::vector<double> w(l.size());
     for (size_t j = 0; j < w.size(); ++j) w[j] = start * typical[j];
-    if (l.miss) w.back() = 1.0 + start;  // a miss factor starts above 1: at 1 its gradient may vanish
+    if (l.miss) w[l.missIndex()] = 1.0 + start;  // a miss factor starts above 1: at 1 its gradient may vanish
+    if (l.share) w[l.shareIndex()] = 0.1 * start;  // small: the pure roofline's neighbourhood
     ceres::Problem problem;
     for (size_t i = 0; i < rows.size(); ++i)
       problem.AddResidualBlock(new RowCost(l, xs[i], rows[i].vertices, rows[i].measuredNs, rows[i].weight, past[i]), nullptr,
                                w.data());
     for (size_t j = 0; j < w.size(); ++j) problem.SetParameterLowerBound(w.data(), static_cast<int>(j), 0.0);
     if (l.miss) {
-      problem.SetParameterLowerBound(w.data(), static_cast<int>(l.size() - 1), 1.0);
-      problem.SetParameterUpperBound(w.data(), static_cast<int>(l.size() - 1), kMaxMissFactor);
+      problem.SetParameterLowerBound(w.data(), static_cast<int>(l.missIndex()), 1.0);
+      problem.SetParameterUpperBound(w.data(), static_cast<int>(l.missIndex()), kMaxMissFactor);
     }
+    if (l.share) problem.SetParameterUpperBound(w.data(), static_cast<int>(l.shareIndex()), 1.0);
     ceres::Solver::Options o;
     o.linear_solver_type = ceres::DENSE_QR;
     o.max_num_iterations = 500;
@@ -300,6 +314,12 @@ FitResult fitProfile(const std::vector<FitRow>& rows, const FitOptions& options)
 
   const std::vector<bool> within(rows.size(), false);
   Solved best = solve(l, rows, xs, within);
+  // The pipes' sum share: how much of the pipes a program does not wait for still shows.
+  if (options.pipeSumShare && !skeleton.pipes.empty()) {
+    Layout shared = l;
+    shared.share = true;
+    if (Solved s = solve(shared, rows, xs, within); s.cost < (1 - kMinTermGain) * best.cost) best = std::move(s), l = shared;
+  }
   // Draw sizes (docs/device-profiles.md, "Draw sizes"): a block of weights per mesh size with
   // enough rows, kept where it explains kMinTermGain of the squared error.
   if (options.drawSizes && form == ProfileForm::Raster) {

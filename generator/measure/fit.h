@@ -38,8 +38,10 @@ struct FitOptions {
   ProfileForm form = ProfileForm::Additive;
   bool constantCache = false;  // roofline and raster forms
   bool drawSizes = false;      // raster form
+  bool pipeSumShare = false;   // roofline and raster forms
   FitOptions() = default;
-  FitOptions(ProfileForm f, bool cache = false, bool sizes = false) : form(f), constantCache(cache), drawSizes(sizes) {}
+  FitOptions(ProfileForm f, bool cache = false, bool sizes = false, bool share = false)
+      : form(f), constantCache(cache), drawSizes(sizes), pipeSumShare(share) {}
 };
 
 struct FitResult {
@@ -56,6 +58,10 @@ struct FitResult {
 // terms scaled by joints per warp), and keeps the best C where it lowers the weighted squared
 // error by kMinTermGain of the fit without it; else the profile has no constant_cache.
 constexpr size_t kMinRowsPerSideOfCapacity = 3;
+// The pipes' sum share (`pipeSumShare`, roofline and raster forms; DeviceProfile::pipeSumShare):
+// one more parameter s in [0, 1], a row costing additive + (1 - s) x slowest pipe + s x every
+// pipe; kept where it lowers the weighted squared error by kMinTermGain (below), and fitted
+// before draw sizes and the constant cache, which then keep it.
 constexpr double kMinTermGain = 0.02;  // of the weighted squared error, for a term to be kept
 
 // Per-draw weights only when the rows' draws differ in size (else they cannot be told apart

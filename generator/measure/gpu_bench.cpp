@@ -457,24 +457,31 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
       rt::TimingRequest t;
       t.drawsPerFrame = draws;
       t.frames = opts.frames + 1;
+      auto noteMemory = [&](const rt::Timing& tm) {
+        if (rep.inputMemory.empty()) rep.inputMemory = inputMemoryLine(opts.inputMemory, tm.inputMemory);
+      };
       auto perVertex = [&](const std::vector<double>& ns, uint32_t vertices) {
         std::vector<double> frames(ns.begin() + 1, ns.end());  // the first warms up
         return medianOf(frames) / (double(draws) * double(vertices));
       };
       if (opts.rasterOn) {
         rt::DrawRequest req = drawRequest(p.render, frag, textures, scene);
+        req.memory = opts.inputMemory;
         req.width = opts.render.width;
         req.height = opts.render.height;
         t.rasterize = true;
         rt::Timing tm = renderer.time(req, t);
+        noteMemory(tm);
         best(p.row, &GpuBenchRow::rasterOnNsPerVertex, perVertex(tm.frameNs, tm.verticesPerDraw));
         best(p.row, &GpuBenchRow::rasterOnWallNsPerVertex, perVertex(tm.wallNs, tm.verticesPerDraw));
       }
       if (opts.rasterOff) {
         rt::DrawRequest req = drawRequest(p.capture, frag, textures, scene);
+        req.memory = opts.inputMemory;
         t.rasterize = false;
         t.captureStride = p.capture.glsl.captureStride;
         rt::Timing tm = renderer.time(req, t);
+        noteMemory(tm);
         best(p.row, &GpuBenchRow::rasterOffNsPerVertex, perVertex(tm.frameNs, tm.verticesPerDraw));
         best(p.row, &GpuBenchRow::rasterOffWallNsPerVertex, perVertex(tm.wallNs, tm.verticesPerDraw));
         best(p.row, &GpuBenchRow::rasterOffCpuNsPerVertex, perVertex(tm.cpuNs, tm.verticesPerDraw));
@@ -507,12 +514,19 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   return rep;
 }
 
+std::string inputMemoryLine(rt::InputMemory placement, const std::string& memoryTypes) {
+  return fmt::format("inputs: {}, in {}",
+                     placement == rt::InputMemory::DeviceLocal ? "device-local (a staging copy)" : "mapped (written in place)",
+                     memoryTypes.empty() ? "no buffer" : memoryTypes);
+}
+
 std::string formatGpuBench(const GpuBenchReport& r) {
   std::string s = fmt::format("device: {} (driver: {})\n{}mesh: {} vertices, {} triangles; {} draws per frame, median of {} frames, best of {} rounds; "
                               "rasterization on: {}x{} target\n\n",
                               r.device, r.driver, r.limits.empty() ? "" : r.limits + "\n", r.vertices, r.triangles,
                               r.drawsPerFrame, r.frames, r.rounds, r.width, r.height);
   s.insert(s.size() - 1, "workload: " + describeWorkload(r.workload) + "\n");
+  if (!r.inputMemory.empty()) s.insert(s.size() - 1, r.inputMemory + "\n");
   if (r.shadedVerticesPerVertex >= 0)
     s.insert(s.size() - 1, fmt::format("one draw, counted by the device: {:.3f} vertex shader invocations per vertex (its fragments: the workload's)\n",
                                        r.shadedVerticesPerVertex));

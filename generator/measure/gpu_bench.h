@@ -32,6 +32,9 @@ struct GpuBenchOptions {
   uint32_t minVerticesPerFrame = 16000;
   uint32_t frames = 7;         // + 1 warm-up frame, not counted
   uint32_t rounds = 3;         // passes over every program; the best pass counts
+  // Where the timed programs' inputs live (runtime/vk_program.h). Device-local, as an engine
+  // keeps a mesh; mapped (host-visible, the harness's placement before session 24) to compare.
+  rt::InputMemory inputMemory = rt::InputMemory::DeviceLocal;
 };
 
 struct GpuBenchRow {
@@ -90,6 +93,7 @@ struct GpuBenchReport {
   // over the rounds, the spread a reader weighs the best-of-rounds ratio against.
   RoundSpread byRound;
   std::string predictionClock;
+  std::string inputMemory;  // where the timed inputs lived: inputMemoryLine of the first timing
   // The validated plan (generated or forced) that `predictionClock` timed fastest: an index
   // into rows, -1 where none was timed by it. Its `bans` make generate write it.
   int fastestPlan = -1;
@@ -138,6 +142,10 @@ RoundSpread generatedOverFastestByRound(const std::vector<GpuBenchRow>& rows);
 std::string describeRoundSpread(const RoundSpread& spread);
 
 // Markdown table + summary lines.
+// "inputs: device-local (a staging copy), in <memory types>" or "inputs: mapped, in <...>": where a
+// timing's inputs lived (rt::Timing::inputMemory), for the header of bench's and calibrate's tables.
+std::string inputMemoryLine(rt::InputMemory placement, const std::string& memoryTypes);
+
 std::string formatGpuBench(const GpuBenchReport& report);
 
 // Correlations (exposed for tests): NaN if fewer than 3 points or no variance.

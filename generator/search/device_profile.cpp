@@ -162,21 +162,22 @@ double DeviceProfile::predictNanoseconds(const TermAmounts& amounts, double vert
     DeviceProfile scratch;
     return pricedAt(*this, vertices, scratch).predictNanoseconds(amounts, vertices);
   }
-  double ns = 0, slowest = 0;
+  double ns = 0, slowest = 0, sum = 0;
   for (int t = 0; t < kTermCount; ++t) ns += perVertex(t, vertices) * double(amounts[static_cast<size_t>(t)]);
   for (const Pipe& pipe : pipes) {
     double x = 0;
     for (size_t t = 0; t < kTermCount; ++t) x += pipe.nanoseconds[t] * feature(scaledBy[t]) * double(amounts[t]);
     slowest = std::max(slowest, x);
+    sum += x;
   }
-  return ns + slowest;
+  return ns + (1 - pipeSumShare) * slowest + pipeSumShare * sum;
 }
 
 DeviceProfile parseDeviceProfile(const std::string& text, const std::string& file) {
   YamlCtx c{file};
   YAML::Node root = parseYaml(text, file);
   c.expectMap(root, "device profile");
-  c.checkKeys(root, {"device", "unit", "weights", "draw_weights", "vertices_per_draw", "pipes", "scaled_by",
+  c.checkKeys(root, {"device", "unit", "weights", "draw_weights", "vertices_per_draw", "pipes", "pipe_sum_share", "scaled_by",
                      "workload_defaults", "constant_cache", "draw_sizes", "notes"});
   DeviceProfile prof;
   prof.file = file;
@@ -280,6 +281,15 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
           parseNumber(c, it->second, fmt::format("workload default '{}'", featureName(f)), "units", "", 0, kMaxWorkloadFeature);
     }
   }
+  if (const YAML::Node share = root["pipe_sum_share"]) {
+    prof.pipeSumShare = parseNumber(c, share, "'pipe_sum_share'", "share of the other pipes", "", 0, HUGE_VAL);
+    if (prof.pipeSumShare > 1)
+      c.fail(share, fmt::format("'pipe_sum_share' is {}: a share of the other pipes lies between 0 (a pure roofline) and 1 "
+                                "(every pipe added)",
+                                c.scalar(share, "pipe_sum_share")));
+    if (prof.pipes.empty() && (prof.drawSizes.empty() || prof.drawSizes.front().pipes.empty()))
+      c.fail(share, "device profile: 'pipe_sum_share' without 'pipes': the share is of the pipes a program does not wait for");
+  }
   if (const YAML::Node cache = root["constant_cache"]) {
     c.expectMap(cache, "constant_cache");
     c.checkKeys(cache, {"entries", "miss_factor"});
@@ -311,11 +321,17 @@ std::vector<TermWeights> profileComponents(const DeviceProfile& priced) {
   const DeviceProfile& profile = pricedAt(priced, priced.verticesPerDraw, scratch);
   const TermWeights additive = profileWeights(profile);
   if (profile.pipes.empty()) return {additive};
+  // max_k [(1 - s) P_k + s sum_j P_j] = (1 - s) max_k P_k + s sum_j P_j: the blend is a max of sums too.
+  const double s = profile.pipeSumShare;
+  std::array<double, kTermCount> sum{};
+  for (const DeviceProfile::Pipe& pipe : profile.pipes)
+    for (size_t t = 0; t < kTermCount; ++t) sum[t] += pipe.nanoseconds[t];
   std::vector<TermWeights> out;
   for (const DeviceProfile::Pipe& pipe : profile.pipes) {
     TermWeights w = additive;
     for (size_t t = 0; t < kTermCount; ++t)
-      w[t] += std::llround(pipe.nanoseconds[t] * profile.feature(profile.scaledBy[t]) * kFemtosecondsPerNanosecond);
+      w[t] += std::llround(((1 - s) * pipe.nanoseconds[t] + s * sum[t]) * profile.feature(profile.scaledBy[t]) *
+                           kFemtosecondsPerNanosecond);
     out.push_back(w);
   }
   return out;
@@ -348,19 +364,26 @@ PlanCostPrediction predictPlanCost(const Plan& plan, const Problem& p, const Dev
     out.totalNanoseconds += out.nanoseconds[t];
   }
   if (profile.pipes.empty()) return out;
-  // Each pipe's share: its component less the additive part (exact in femtoseconds).
-  const std::vector<TermWeights> comps = profileComponents(profile);
+  // Each pipe's time: its component less the additive part (exact in femtoseconds), priced
+  // with no share of the others; the total is the largest component as the search prices it.
+  DeviceProfile pure = profile;
+  pure.pipeSumShare = 0;
+  const std::vector<TermWeights> pipesAlone = profileComponents(pure), comps = profileComponents(profile);
   const int64_t additive = weighTerms(w, out.amounts);
   double slowest = 0;
+  int64_t largest = 0;
   for (size_t k = 0; k < comps.size(); ++k) {
-    const double ns = static_cast<double>(weighTerms(comps[k], out.amounts) - additive) / kFemtosecondsPerNanosecond;
+    const double ns = static_cast<double>(weighTerms(pipesAlone[k], out.amounts) - additive) / kFemtosecondsPerNanosecond;
     out.pipeNanoseconds.push_back(ns);
     if (out.slowestPipe < 0 || ns > slowest) {
       slowest = ns;
       out.slowestPipe = static_cast<int>(k);
     }
+    largest = std::max(largest, weighTerms(comps[k], out.amounts) - additive);
   }
-  out.totalNanoseconds += slowest;
+  const double pipesNs = static_cast<double>(largest) / kFemtosecondsPerNanosecond;
+  out.otherPipesNanoseconds = profile.pipeSumShare > 0 ? pipesNs - slowest : 0;
+  out.totalNanoseconds += pipesNs;
   return out;
 }
 
@@ -405,6 +428,9 @@ std::string describePlanCost(const Plan& plan, const Problem& p, const DevicePro
   for (size_t k = 0; k < c.pipeNanoseconds.size(); ++k)
     out += fmt::format("    {:<26} {:>8} {:>10} {:>9.3f}{}\n", "pipe " + profile.pipes[k].name, "", "", c.pipeNanoseconds[k],
                        static_cast<int>(k) == c.slowestPipe ? "  (slowest: counted)" : "");
+  if (profile.pipeSumShare > 0)
+    out += fmt::format("    {:<26} {:>8} {:>10} {:>9.3f}\n", fmt::format("other pipes x {:g}", profile.pipeSumShare), "", "",
+                       c.otherPipesNanoseconds);
   if (profile.workload.known()) out += fmt::format("    workload: {}\n", describeWorkload(profile.workload));
   if (profile.constantCacheEntries > 0) {
     out += fmt::format("    constant cache: {:.1f} palette entries per warp{} against its {:g}: {}\n",

@@ -47,6 +47,12 @@ struct DeviceProfile {
     std::array<double, kTermCount> nanoseconds{};
   };
   std::vector<Pipe> pipes;
+  // How imperfectly the pipes overlap (docs/device-profiles.md, "Pipes overlap imperfectly"):
+  // besides its slowest pipe a program pays this share of its other pipes, so it costs
+  // additive + (1 - s) x slowest + s x (sum of the pipes). 0: a pure roofline (every profile
+  // before session 24); 1: every pipe added. Still a max of weighted sums (profileComponents),
+  // so the search stays exact.
+  double pipeSumShare = 0;
   // Per term, the workload feature its weights (additive and in every pipe) are multiplied by:
   // an indexed uniform load costs per distinct address a warp reads (`joints_per_warp`).
   std::array<int, kTermCount> scaledBy{};
@@ -122,8 +128,9 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
 
 // The profile's additive weights in femtoseconds per unit of each term, per vertex at its workload.
 TermWeights profileWeights(const DeviceProfile& profile);
-// The search's components (Problem::componentWeights): one per pipe, each the additive
-// weights plus the pipe's; the additive weights alone for a profile without pipes.
+// The search's components (Problem::componentWeights): one per pipe k, each the additive
+// weights plus (1 - s) x pipe k's plus s x every pipe's (s = pipeSumShare), whose largest is
+// additive + (1 - s) x slowest + s x sum; the additive weights alone for a profile without pipes.
 std::vector<TermWeights> profileComponents(const DeviceProfile& profile);
 // Prices the problem's actions, inputs and fixed terms under the profile (priceProblem, or
 // priceProblemByMax for a roofline).
@@ -141,6 +148,8 @@ struct PlanCostPrediction {
   std::array<double, kTermCount> nanoseconds{};  // rounded additive weight x amount, per term
   std::vector<double> pipeNanoseconds;           // per pipe of a roofline profile
   int slowestPipe = -1;                          // the pipe that bounds the program (-1: none)
+  // What the other pipes add beside the slowest: pipeSumShare x their sum (0 in a pure roofline).
+  double otherPipesNanoseconds = 0;
   double totalNanoseconds = 0;                   // equals plan cost / kFemtosecondsPerNanosecond
 };
 TermAmounts planTermAmounts(const Plan& plan, const Problem& p);

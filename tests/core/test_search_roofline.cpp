@@ -4,9 +4,11 @@
 // checked against an exhaustive solver written from that definition on small random
 // instances (with and without binding device limits), the integer program against A* on
 // larger libraries, and a hand-made instance where the largest pipe, not the sum, decides.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <random>
@@ -263,6 +265,75 @@ TEST(SearchRoofline, ThePredictionShowsEachTermInItsPipe) {
   EXPECT_NE(text.find("pipe fetch"), std::string::npos) << text;
   // 1 ns fixed + the slowest pipe (fetch, 1.5 ns); the memory pipe's 0.5 ns overlaps.
   EXPECT_DOUBLE_EQ(predictPlanCost(*plan, p, prof).totalNanoseconds, 2.5);
+}
+
+// Pipes that overlap imperfectly (DeviceProfile::pipeSumShare s): a program pays its slowest
+// pipe plus s times the others. "overlapped" reads 3 fetch and 3 memory units (1 ns each):
+// 3 + 3s; "fetch_only" 5 fetch units: 5. The first wins while s < 2/3, the second above it, in
+// every engine, and the prediction's total is the plan's cost.
+TEST(SearchRoofline, PipesThatOverlapImperfectlyPayAShareOfTheOthers) {
+  DeviceProfile prof;
+  prof.device = "test";
+  DeviceProfile::Pipe fetch, memory;
+  fetch.name = "fetch";
+  fetch.nanoseconds[kTermLocations] = 1;
+  memory.name = "memory";
+  memory.nanoseconds[kTermBufferLoads] = 1;
+  prof.pipes = {fetch, memory};
+  for (double share : {0.0, 0.5, 0.8}) {
+    prof.pipeSumShare = share;
+    Problem p = oneGoal();
+    addWay(p, "overlapped", 3, 3);
+    addWay(p, "fetch_only", 5, 0);
+    applyDeviceProfile(p, prof);
+    const bool overlapped = 3 + 3 * share < 5;
+    const double ns = overlapped ? 3 + 3 * share : 5;
+    for (const char* engine : {"auto", "ip", "forward"}) {
+      auto plan = solveWith(p, engine);
+      ASSERT_TRUE(plan) << engine;
+      EXPECT_EQ(p.actions[plan->actions[0]].name, overlapped ? "overlapped" : "fetch_only") << engine << " at " << share;
+      EXPECT_EQ(plan->cost, std::llround(ns * kFemtosecondsPerNanosecond)) << engine << " at " << share;
+      const PlanCostPrediction c = predictPlanCost(*plan, p, prof);
+      EXPECT_DOUBLE_EQ(c.totalNanoseconds, ns) << engine;
+      EXPECT_DOUBLE_EQ(c.otherPipesNanoseconds, overlapped ? 3 * share : 0) << engine;
+      if (share > 0) {
+        const std::string text = describePlanCost(*plan, p, prof);
+        EXPECT_NE(text.find(fmt::format("other pipes x {:g}", share)), std::string::npos) << text;
+      }
+    }
+  }
+}
+
+// The search's components of a profile with a share reproduce its definition (additive + (1 - s)
+// x slowest pipe + s x every pipe, DeviceProfile::predictNanoseconds) for random pipes, shares
+// and amounts: the largest component is that sum, to the femtosecond rounding of each weight.
+TEST(SearchRooflineProperty, ComponentsOfASharedProfileAreItsDefinition) {
+  std::mt19937 rng(33);
+  auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
+  for (int instance = 0; instance < 300; ++instance) {
+    DeviceProfile prof;
+    prof.nanoseconds[kTermVertices] = uniform(0, 2);
+    const int pipes = 2 + instance % 4;
+    for (int k = 0; k < pipes; ++k) {
+      DeviceProfile::Pipe pipe;
+      pipe.name = "p" + std::to_string(k);
+      for (size_t t = 0; t < kTermCount; ++t)
+        if (t != kTermVertices && t != kTermFragments && uniform(0, 1) < 0.4) pipe.nanoseconds[t] = uniform(0, 0.8);
+      prof.pipes.push_back(pipe);
+    }
+    prof.pipeSumShare = instance % 3 == 0 ? 0 : uniform(0, 1);
+    TermAmounts a{};
+    a[kTermVertices] = 1;
+    for (size_t t = 0; t < kTermCount; ++t)
+      if (t != kTermVertices && t != kTermFragments) a[t] = std::uniform_int_distribution<int64_t>(0, 200)(rng);
+    int64_t largest = 0;
+    for (const TermWeights& w : profileComponents(prof)) largest = std::max(largest, weighTerms(w, a));
+    int64_t units = 0;
+    for (int64_t x : a) units += x;
+    EXPECT_NEAR(static_cast<double>(largest) / kFemtosecondsPerNanosecond, prof.predictNanoseconds(a, 1000),
+                1e-6 * static_cast<double>(units) + 1e-9)
+        << "instance " << instance << ", share " << prof.pipeSumShare;
+  }
 }
 
 // A profile's constant cache: a warp whose palette footprint is past its capacity pays the miss

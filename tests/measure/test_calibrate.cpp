@@ -331,6 +331,51 @@ TEST(Calibrate, TheRooflineFitPredictsRowsItNeverSawWhereTheAdditiveCannot) {
   }
 }
 
+// A device whose pipes overlap imperfectly: besides the slowest a row pays `share` of the others
+// (DeviceProfile::pipeSumShare). The fit with the share finds it and the weights and predicts
+// rows it never saw; the pure roofline cannot. On a pure roofline's rows the share is not kept.
+std::vector<CalibrationSample> sharedRows(uint32_t seed, int n, double share) {
+  std::vector<CalibrationSample> out = roofline::rows(seed, n);
+  const roofline::Device d;
+  for (auto& s : out) {
+    const TermAmounts& a = s.amounts;
+    const double pipes[5] = {d.location * double(a[kTermLocations]) + d.byte * double(a[kTermAttributeBytes]),
+                             d.load * double(a[kTermBufferLoads]),
+                             d.address * s.workload.jointsPerWarp * double(a[kTermIndexedUniformLoads]),
+                             d.slot * double(a[kTermArithmetic]), d.output * double(a[kTermOutputs])};
+    double sum = 0, slowest = 0;
+    for (double p : pipes) sum += p, slowest = std::max(slowest, p);
+    s.measuredNs = d.vertexNs + d.drawNs / s.vertices + slowest + share * (sum - slowest);
+  }
+  return out;
+}
+
+TEST(Calibrate, TheFitFindsHowMuchOfTheOtherPipesShows) {
+  const double share = 0.15;
+  const std::vector<CalibrationSample> train = sharedRows(1, 160, share), test = sharedRows(2, 80, share);
+  const FitOptions withShare(ProfileForm::Roofline, false, false, true);
+  const DeviceProfile fitted = fitDeviceProfile(train, "shared device", 180000, 0, withShare);
+  const DeviceProfile pure = fitDeviceProfile(train, "shared device", 180000, 0, ProfileForm::Roofline);
+  EXPECT_NEAR(fitted.pipeSumShare, share, 0.02);
+  EXPECT_EQ(pure.pipeSumShare, 0);
+  EXPECT_LT(rmsRelativeError(fitted, test), 0.01);
+  EXPECT_GT(rmsRelativeError(pure, test), 2 * rmsRelativeError(fitted, test));
+  EXPECT_NEAR(fitted.pipes[0].nanoseconds[kTermLocations], roofline::Device{}.location, 0.02);
+  // Written and read back, it predicts the same.
+  CalibrationReport r;
+  r.profile = fitted;
+  const std::string yaml = deviceProfileYaml(r);
+  EXPECT_NE(yaml.find("pipe_sum_share: "), std::string::npos) << yaml;
+  const DeviceProfile back = parseDeviceProfile(yaml, "shared.yaml");
+  EXPECT_NEAR(back.pipeSumShare, fitted.pipeSumShare, 1e-4);
+  // A pure roofline's rows: the share explains nothing, so the profile has none.
+  const DeviceProfile onPure = fitDeviceProfile(roofline::rows(1, 160), "roofline device", 180000, 0, withShare);
+  EXPECT_EQ(onPure.pipeSumShare, 0);
+  CalibrationReport none;
+  none.profile = onPure;
+  EXPECT_EQ(deviceProfileYaml(none).find("pipe_sum_share"), std::string::npos);
+}
+
 // The same pipes, no per-draw cost, and a price per fragment a draw covers (the H200's raster-on
 // clock: docs/device-profiles.md, "The rasterizer's share"). Fragments per vertex vary from mesh
 // to mesh independently of its size, so the raster form fits them and the roofline's per-draw
