@@ -259,7 +259,7 @@ void registerCalibrate(CLI::App& app, CliState& state) {
                 "lowers the fit's error (docs/device-profiles.md, \"Draw sizes\")");
   sub->add_flag("--pipe-sum-share", cmd->co.fit.pipeSumShare,
                 "With --form roofline or raster: fit how imperfectly the pipes overlap, a program paying besides its "
-                "slowest pipe a share of the others (pipe_sum_share); kept where it lowers the fit's error "
+                "slowest pipe a share of the others (pipe_sum_share, 0 to 1); "
                 "(docs/device-profiles.md, \"Pipes overlap imperfectly\")");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer (use for timings)");
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });

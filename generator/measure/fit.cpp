@@ -180,7 +180,8 @@ DeviceProfile toProfile(const DeviceProfile& form, const Layout& l, const std::v
     for (const auto& [pi, t] : l.pipeTerms) p.pipes[pi].nanoseconds[static_cast<size_t>(t)] = std::min(block[i++], kMaxProfileWeightNs);
     if (!l.sizes.empty()) p.drawSizes.push_back({l.sizes[b], p.nanoseconds, p.pipes});
   }
-  if (l.share) p.pipeSumShare = std::clamp(w[l.shareIndex()], 0.0, 1.0);
+  // A share under kLeastPipeSumShare prices nothing a femtosecond weight can tell apart from none.
+  if (l.share && w[l.shareIndex()] >= kLeastPipeSumShare) p.pipeSumShare = std::min(w[l.shareIndex()], 1.0);
   if (l.miss) p.constantCacheMissFactor = w[l.missIndex()];
   if (p.hasDrawWeights() || !p.drawSizes.empty()) p.verticesPerDraw = vertices;
   return p.atDrawSize(p.verticesPerDraw);
@@ -314,11 +315,12 @@ FitResult fitProfile(const std::vector<FitRow>& rows, const FitOptions& options)
 
   const std::vector<bool> within(rows.size(), false);
   Solved best = solve(l, rows, xs, within);
-  // The pipes' sum share: how much of the pipes a program does not wait for still shows.
+  // The pipes' sum share: how much of the pipes a program does not wait for still shows. One
+  // parameter in [0, 1], fitted whenever asked (its gain on the training rows is small even
+  // where it changes choices: docs/device-profiles.md, "Pipes overlap imperfectly").
   if (options.pipeSumShare && !skeleton.pipes.empty()) {
-    Layout shared = l;
-    shared.share = true;
-    if (Solved s = solve(shared, rows, xs, within); s.cost < (1 - kMinTermGain) * best.cost) best = std::move(s), l = shared;
+    l.share = true;
+    best = solve(l, rows, xs, within);
   }
   // Draw sizes (docs/device-profiles.md, "Draw sizes"): a block of weights per mesh size with
   // enough rows, kept where it explains kMinTermGain of the squared error.

@@ -60,8 +60,9 @@ struct FitResult {
 constexpr size_t kMinRowsPerSideOfCapacity = 3;
 // The pipes' sum share (`pipeSumShare`, roofline and raster forms; DeviceProfile::pipeSumShare):
 // one more parameter s in [0, 1], a row costing additive + (1 - s) x slowest pipe + s x every
-// pipe; kept where it lowers the weighted squared error by kMinTermGain (below), and fitted
-// before draw sizes and the constant cache, which then keep it.
+// pipe; fitted whenever asked (a share below kLeastPipeSumShare is written as none), before
+// draw sizes and the constant cache, which then keep it.
+constexpr double kLeastPipeSumShare = 0.001;
 constexpr double kMinTermGain = 0.02;  // of the weighted squared error, for a term to be kept
 
 // Per-draw weights only when the rows' draws differ in size (else they cannot be told apart

@@ -368,7 +368,7 @@ TEST(Calibrate, TheFitFindsHowMuchOfTheOtherPipesShows) {
   EXPECT_NE(yaml.find("pipe_sum_share: "), std::string::npos) << yaml;
   const DeviceProfile back = parseDeviceProfile(yaml, "shared.yaml");
   EXPECT_NEAR(back.pipeSumShare, fitted.pipeSumShare, 1e-4);
-  // A pure roofline's rows: the share explains nothing, so the profile has none.
+  // A pure roofline's rows: the fitted share is nothing, and the profile states none.
   const DeviceProfile onPure = fitDeviceProfile(roofline::rows(1, 160), "roofline device", 180000, 0, withShare);
   EXPECT_EQ(onPure.pipeSumShare, 0);
   CalibrationReport none;
