@@ -88,6 +88,7 @@ struct Harness::Impl {
   VkDevice device = VK_NULL_HANDLE;
   uint32_t queueFamily = 0;
   VkQueue queue = VK_NULL_HANDLE;
+  bool memoryBudget = false;  // VK_EXT_memory_budget enabled
   std::unique_ptr<setup::Device> setup;  // what program set-up needs (vk_setup.h)
 
   static VKAPI_ATTR VkBool32 VKAPI_CALL onMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
@@ -239,17 +240,21 @@ struct Harness::Impl {
     VkPhysicalDeviceFeatures supported{};
     vkGetPhysicalDeviceFeatures(dev.pd, &supported);
     f2.features.pipelineStatisticsQuery = supported.pipelineStatisticsQuery;
-    const char* ext = VK_EXT_TRANSFORM_FEEDBACK_EXTENSION_NAME;
+    // Where the device has it, the memory budget: timings say what the process holds in the
+    // heap their inputs are in (docs/device-profiles.md, "Where the inputs live").
+    std::vector<const char*> exts{VK_EXT_TRANSFORM_FEEDBACK_EXTENSION_NAME};
+    memoryBudget = hasDeviceExtension(dev.pd, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+    if (memoryBudget) exts.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
     VkDeviceCreateInfo ci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
     ci.pNext = &f2;
     ci.queueCreateInfoCount = 1;
     ci.pQueueCreateInfos = &qci;
-    ci.enabledExtensionCount = 1;
-    ci.ppEnabledExtensionNames = &ext;
+    ci.enabledExtensionCount = static_cast<uint32_t>(exts.size());
+    ci.ppEnabledExtensionNames = exts.data();
     check(vkCreateDevice(dev.pd, &ci, nullptr, &device), "vkCreateDevice");
     vkGetDeviceQueue(device, queueFamily, 0, &queue);
 
-    setup = std::make_unique<setup::Device>(Harness::Handles{dev.pd, device, queueFamily, queue});
+    setup = std::make_unique<setup::Device>(Harness::Handles{dev.pd, device, queueFamily, queue, memoryBudget});
   }
 
   void destroy() {
@@ -295,7 +300,9 @@ std::string Harness::deviceName() const { return impl_->dev.props.deviceName; }
 std::string Harness::driver() const { return impl_->dev.driver; }
 bool Harness::validationEnabled() const { return impl_->validation; }
 const VkPhysicalDeviceLimits& Harness::limits() const { return impl_->dev.props.limits; }
-Harness::Handles Harness::handles() const { return {impl_->dev.pd, impl_->device, impl_->queueFamily, impl_->queue}; }
+Harness::Handles Harness::handles() const {
+  return {impl_->dev.pd, impl_->device, impl_->queueFamily, impl_->queue, impl_->memoryBudget};
+}
 
 RunResult Harness::run(const RunRequest& req) {
   Impl& h = *impl_;

@@ -67,6 +67,7 @@ class Harness {
     VkDevice device;
     uint32_t queueFamily;
     VkQueue queue;
+    bool memoryBudget;  // VK_EXT_memory_budget enabled: heaps' usage and budget can be asked
   };
   Handles handles() const;
 

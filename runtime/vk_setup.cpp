@@ -103,6 +103,14 @@ uint32_t chooseMemoryType(const VkPhysicalDeviceMemoryProperties& memory, uint32
   return UINT32_MAX;
 }
 
+namespace {
+std::string bytes(VkDeviceSize n) {
+  const double mib = double(n) / (1024.0 * 1024.0);
+  if (mib < 1) return fmt::format("{:.0f} KiB", mib * 1024);
+  return mib >= 1024 ? fmt::format("{:.1f} GiB", mib / 1024) : fmt::format("{:.0f} MiB", mib);
+}
+}  // namespace
+
 std::string describeMemoryType(const VkPhysicalDeviceMemoryProperties& memory, uint32_t type) {
   if (type >= memory.memoryTypeCount) return "no memory type";
   auto flagNames = [](uint32_t flags, std::initializer_list<std::pair<uint32_t, const char*>> names) {
@@ -119,9 +127,7 @@ std::string describeMemoryType(const VkPhysicalDeviceMemoryProperties& memory, u
                                   {VK_MEMORY_PROPERTY_HOST_CACHED_BIT, "host-cached"}});
   if (t.heapIndex >= memory.memoryHeapCount) return fmt::format("type {} ({})", type, typeFlags);
   const VkMemoryHeap& h = memory.memoryHeaps[t.heapIndex];
-  const double mib = double(h.size) / (1024.0 * 1024.0);
-  const std::string size = mib >= 1024 ? fmt::format("{:.1f} GiB", mib / 1024) : fmt::format("{:.0f} MiB", mib);
-  return fmt::format("type {} ({}) of heap {} ({}, {})", type, typeFlags, t.heapIndex, size,
+  return fmt::format("type {} ({}) of heap {} ({}, {})", type, typeFlags, t.heapIndex, bytes(h.size),
                      h.flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT ? "device-local" : "host");
 }
 
@@ -626,8 +632,23 @@ std::string ProgramObjects::inputMemory() const {
   for (size_t i = firstStream_; i < firstStorage_ + in_.storageBuffers.size(); ++i) add(buffers_[i]);
   if (uniform_) add(*uniform_);
   if (index_) add(*index_);
+  // With the memory budget: what this process holds in each such heap now (its buffers
+  // allocated) against what the driver would let it hold, so a run of many timings shows
+  // whether something accumulates in the heap its inputs share.
+  VkPhysicalDeviceMemoryBudgetPropertiesEXT budget{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_BUDGET_PROPERTIES_EXT};
+  if (d_.h.memoryBudget) {
+    VkPhysicalDeviceMemoryProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_PROPERTIES_2};
+    p2.pNext = &budget;
+    vkGetPhysicalDeviceMemoryProperties2(d_.h.physicalDevice, &p2);
+  }
   std::string s;
-  for (uint32_t t : types) s += (s.empty() ? "" : "; ") + describeMemoryType(d_.memProps, t);
+  for (uint32_t t : types) {
+    s += (s.empty() ? "" : "; ") + describeMemoryType(d_.memProps, t);
+    if (d_.h.memoryBudget && t < d_.memProps.memoryTypeCount) {
+      const uint32_t heap = d_.memProps.memoryTypes[t].heapIndex;
+      s += fmt::format(", the process using {} of a {} budget", bytes(budget.heapUsage[heap]), bytes(budget.heapBudget[heap]));
+    }
+  }
   return s;
 }
 

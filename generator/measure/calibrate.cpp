@@ -829,6 +829,9 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           continue;
         }
         if (inputMemory.empty()) inputMemory = br.inputMemory;
+        // Each rig's own: with a memory budget it says what the process held in the inputs' heap
+        // then, so a many-rig run shows whether anything accumulates from one rig to the next.
+        if (!br.inputMemory.empty()) rep.inputMemoryByRig.push_back(fmt::format("{} on '{}', {}", rigLabel(rig), meshName, br.inputMemory));
         if (!fitted) {  // the plans' predicted against measured time, by this calibration's clock
           const PredictionCheck pc = checkPredictions(br.rows, clock);
           CalibrationCheck c;
@@ -1021,6 +1024,7 @@ std::string formatCalibration(const CalibrationReport& r) {
                      c.rig, c.mesh, c.plans, c.spearman, c.generatedOverFastest, describeRoundSpread(c.byRound));
   s += formatLeaveOneRigOut(r.heldOut);
   s += formatHeldOutCheck(r.check);
+  for (const auto& m : r.inputMemoryByRig) s += m + "\n";
   for (const auto& n : r.notes) s += "note: " + n + "\n";
   return s;
 }

@@ -154,6 +154,8 @@ struct CalibrationReport {
   std::vector<CalibrationCheck> checks;
   LeaveOneRigOut heldOut;  // with two rigs or more
   LeaveOneRigOut check;    // rigs no fit saw (calibrate --check-log)
+  // Where each rig's timed inputs lived (inputMemoryLine), in timing order: "RIG on 'MESH', inputs: ...".
+  std::vector<std::string> inputMemoryByRig;
   std::vector<std::string> notes;  // corpus cases left out, and why
 };
 
