@@ -267,19 +267,30 @@ TEST(SearchRoofline, ThePredictionShowsEachTermInItsPipe) {
   EXPECT_DOUBLE_EQ(predictPlanCost(*plan, p, prof).totalNanoseconds, 2.5);
 }
 
+// A profile "test" of two pipes, each pricing one term.
+struct PipeTerm {
+  const char* name;
+  int term;
+  double ns;
+};
+DeviceProfile twoPipes(PipeTerm a, PipeTerm b) {
+  DeviceProfile prof;
+  prof.device = "test";
+  for (const PipeTerm& x : {a, b}) {
+    DeviceProfile::Pipe pipe;
+    pipe.name = x.name;
+    pipe.nanoseconds[static_cast<size_t>(x.term)] = x.ns;
+    prof.pipes.push_back(pipe);
+  }
+  return prof;
+}
+
 // Pipes that overlap imperfectly (DeviceProfile::pipeSumShare s): a program pays its slowest
 // pipe plus s times the others. "overlapped" reads 3 fetch and 3 memory units (1 ns each):
 // 3 + 3s; "fetch_only" 5 fetch units: 5. The first wins while s < 2/3, the second above it, in
 // every engine, and the prediction's total is the plan's cost.
 TEST(SearchRoofline, PipesThatOverlapImperfectlyPayAShareOfTheOthers) {
-  DeviceProfile prof;
-  prof.device = "test";
-  DeviceProfile::Pipe fetch, memory;
-  fetch.name = "fetch";
-  fetch.nanoseconds[kTermLocations] = 1;
-  memory.name = "memory";
-  memory.nanoseconds[kTermBufferLoads] = 1;
-  prof.pipes = {fetch, memory};
+  DeviceProfile prof = twoPipes({"fetch", kTermLocations, 1}, {"memory", kTermBufferLoads, 1});
   for (double share : {0.0, 0.5, 0.8}) {
     prof.pipeSumShare = share;
     Problem p = oneGoal();
@@ -340,14 +351,7 @@ TEST(SearchRooflineProperty, ComponentsOfASharedProfileAreItsDefinition) {
 // factor on every address, so the same two plans swap places across it, in every engine, and the
 // prediction says which side of the capacity the workload is on.
 TEST(SearchRoofline, TheConstantCacheMovesThePlanAcrossItsCapacity) {
-  DeviceProfile prof;
-  prof.device = "test";
-  DeviceProfile::Pipe memory, constant;
-  memory.name = "memory";
-  memory.nanoseconds[kTermBufferLoads] = 0.25;
-  constant.name = "constant";
-  constant.nanoseconds[kTermIndexedUniformLoads] = 0.06;
-  prof.pipes = {memory, constant};
+  DeviceProfile prof = twoPipes({"memory", kTermBufferLoads, 0.25}, {"constant", kTermIndexedUniformLoads, 0.06});
   prof.scaledBy[kTermIndexedUniformLoads] = kFeatureJointsPerWarp;
   prof.constantCacheEntries = 29;
   prof.constantCacheMissFactor = 2;
