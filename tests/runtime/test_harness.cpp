@@ -16,7 +16,7 @@
 #include <random>
 #include <sstream>
 
-#include <stdlib.h>
+#include "synchronization_validation.h"
 
 namespace {
 
@@ -187,16 +187,10 @@ std::string joinMessages(const Harness& h) {
   return all;
 }
 
-// The validation layer reads this when the instance is made: hazards between the staging
-// copies, the draws and the readback become messages, which every test here refuses.
-void checkSynchronizationToo() {
-  setenv("VK_LAYER_ENABLES", "VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT", /*overwrite=*/0);
-}
-
 class HarnessTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    checkSynchronizationToo();
+    sgtest::enableSynchronizationValidation();
     harness_ = std::make_unique<Harness>();
     skinSpirv_ = compileVertexShader(kSkinShader);
   }

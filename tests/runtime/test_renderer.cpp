@@ -10,7 +10,8 @@
 
 #include <glm/gtc/packing.hpp>
 #include <gtest/gtest.h>
-#include <stdlib.h>
+
+#include "synchronization_validation.h"
 
 #include <algorithm>
 #include <cstring>
@@ -70,9 +71,7 @@ Texture patternTexture(uint32_t size, bool cube, VkFormat format, uint32_t bindi
 class Mipmaps : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    // Synchronization hazards (the staging copies of device-local inputs, texture uploads,
-    // frames drawn into one target) become validation messages, which the tests refuse.
-    setenv("VK_LAYER_ENABLES", "VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT", /*overwrite=*/0);
+    sgtest::enableSynchronizationValidation();
     harness_ = std::make_unique<Harness>();
     renderer_ = std::make_unique<Renderer>(*harness_);
   }
