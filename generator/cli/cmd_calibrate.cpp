@@ -7,7 +7,6 @@
 #include <ctime>
 #include <filesystem>
 #include <iostream>
-#include <map>
 #include <sstream>
 
 #include <unistd.h>
@@ -216,11 +215,7 @@ void registerCalibrate(CLI::App& app, CliState& state) {
                   "A smaller mesh (a model's part) is drawn more often than --draws, so that each timed frame draws at least this "
                   "many vertices (default 16000: the 2,009-vertex head at 8 draws; 0: exactly --draws)")
       ->check(CLI::Range(0, 100000000));
-  sub->add_option("--input-memory", cmd->co.inputMemory,
-                "Where the timed programs' inputs live: device-local (default; filled by a staging copy, as an engine keeps a "
-                "mesh) or mapped (host-visible memory written in place: on a discrete GPU a BAR window)")
-      ->transform(CLI::CheckedTransformer(std::map<std::string, rt::InputMemory>{{"device-local", rt::InputMemory::DeviceLocal},
-                                                                                {"mapped", rt::InputMemory::Mapped}}));
+  addInputMemoryOption(*sub, cmd->co.inputMemory);
   sub->add_option("--frames", cmd->co.frames, "Timed frames; the median counts (default 9)")->check(CLI::Range(1, 1000));
   sub->add_option("--rounds", cmd->co.rounds, "Timings per program; the best counts (default 2)")->check(CLI::Range(1, 100));
   sub->add_option("--refits", cmd->co.refits, "With --rig: fits again with the plans each profile chose (default 1)")
@@ -259,8 +254,8 @@ void registerCalibrate(CLI::App& app, CliState& state) {
                 "lowers the fit's error (docs/device-profiles.md, \"Draw sizes\")");
   sub->add_flag("--pipe-sum-share", cmd->co.fit.pipeSumShare,
                 "With --form roofline or raster: fit how imperfectly the pipes overlap, a program paying besides its "
-                "slowest pipe a share of the others (pipe_sum_share, 0 to 1); "
-                "(docs/device-profiles.md, \"Pipes overlap imperfectly\")");
+                "slowest pipe a share of the others (pipe_sum_share, 0 to 1; docs/device-profiles.md, "
+                "\"Pipes overlap imperfectly\")");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer (use for timings)");
   sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
 }

@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <iostream>
-#include <map>
 
 #include "cli/commands.h"
 #include "cli/whole_model.h"
@@ -224,11 +223,7 @@ void registerRender(CLI::App& app, CliState& state) {
                 "A smaller mesh (a model's part) is drawn more often than --draws, so that each timed frame draws at least this "
                 "many vertices (default 16000: the 2,009-vertex head at 8 draws; 0: exactly --draws)")
       ->check(CLI::Range(0, 100000000));
-  b->add_option("--input-memory", bench->bo.inputMemory,
-                "Where the timed programs' inputs live: device-local (default; filled by a staging copy, as an engine keeps a "
-                "mesh) or mapped (host-visible memory written in place: on a discrete GPU a BAR window)")
-      ->transform(CLI::CheckedTransformer(std::map<std::string, rt::InputMemory>{{"device-local", rt::InputMemory::DeviceLocal},
-                                                                                {"mapped", rt::InputMemory::Mapped}}));
+  addInputMemoryOption(*b, bench->bo.inputMemory);
   b->add_option("--frames", bench->bo.frames, "Timed frames; the median is reported (default 7)")->check(CLI::Range(1, 1000));
   b->add_option("--rounds", bench->bo.rounds, "Passes over every program, order rotated; the best counts (default 3)")
       ->check(CLI::Range(1, 100));

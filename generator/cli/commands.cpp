@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <map>
 
 #include <fmt/format.h>
 
@@ -29,6 +30,14 @@ void addGltfReadOptions(CLI::App& cmd, GltfReadOptions& o, bool werror) {
   if (werror)
     cmd.add_flag("--Werror", o.warningsAsErrors,
                  "Treat the glTF import's warnings (weights, joints, rotations, frames) as errors (also -Werror)");
+}
+
+void addInputMemoryOption(CLI::App& cmd, rt::InputMemory& memory) {
+  cmd.add_option("--input-memory", memory,
+                 "Where the timed programs' inputs live: device-local (default; filled by a staging copy, as an engine keeps a "
+                 "mesh) or mapped (host-visible memory written in place: on a discrete GPU a BAR window)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, rt::InputMemory>{{"device-local", rt::InputMemory::DeviceLocal},
+                                                                                {"mapped", rt::InputMemory::Mapped}}));
 }
 
 void registerCommands(CLI::App& app, CliState& state) {

@@ -8,6 +8,7 @@
 
 #include "cli/output_files.h"
 #include "pipeline/generate.h"
+#include "runtime/vk_program.h"
 
 namespace sg {
 
@@ -44,6 +45,9 @@ struct CrossArgs {
 // --no-normalize-weights and (werror) --Werror (-Werror), for every command that imports a
 // glTF rig (docs/gltf.md#import-diagnostics-and-weights).
 void addGltfReadOptions(CLI::App& cmd, GltfReadOptions& o, bool werror = true);
+
+// --input-memory device-local|mapped, for every command that times programs (bench, calibrate).
+void addInputMemoryOption(CLI::App& cmd, rt::InputMemory& memory);
 
 // Every file `in` was loaded from (plus `extra`), named for refuseClobbering (output_files.h).
 std::vector<InputFile> inputFiles(const LoadedInputs& in, const std::vector<std::string>& extra = {});

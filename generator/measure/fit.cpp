@@ -310,18 +310,15 @@ FitResult fitProfile(const std::vector<FitRow>& rows, const FitOptions& options)
   }
   if (form == ProfileForm::Raster && !fragments.empty()) skeleton.workloadDefaults[kFeatureFragmentsPerVertex] = medianOf(fragments);
   Layout l = layoutOf(skeleton, sizes.size() > 1);
+  // The pipes' sum share: how much of the pipes a program does not wait for still shows. One
+  // parameter in [0, 1], fitted whenever asked (its gain on the training rows is small even
+  // where it changes choices: docs/device-profiles.md, "Pipes overlap imperfectly").
+  l.share = options.pipeSumShare && !skeleton.pipes.empty();
   std::vector<std::array<double, kTermCount>> xs;
   for (const FitRow& r : rows) xs.push_back(scaledAmounts(skeleton, r));
 
   const std::vector<bool> within(rows.size(), false);
   Solved best = solve(l, rows, xs, within);
-  // The pipes' sum share: how much of the pipes a program does not wait for still shows. One
-  // parameter in [0, 1], fitted whenever asked (its gain on the training rows is small even
-  // where it changes choices: docs/device-profiles.md, "Pipes overlap imperfectly").
-  if (options.pipeSumShare && !skeleton.pipes.empty()) {
-    l.share = true;
-    best = solve(l, rows, xs, within);
-  }
   // Draw sizes (docs/device-profiles.md, "Draw sizes"): a block of weights per mesh size with
   // enough rows, kept where it explains kMinTermGain of the squared error.
   if (options.drawSizes && form == ProfileForm::Raster) {

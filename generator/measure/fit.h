@@ -33,7 +33,8 @@ struct FitRow {
 enum class ProfileForm { Additive, Roofline, Raster };
 const char* profileFormName(ProfileForm form);  // "additive", "roofline", "raster"
 
-// What a fit fits: the form, and the optional terms below (each kept only where it lowers the error).
+// What a fit fits: the form, and the optional terms below (the constant cache and draw sizes
+// kept only where they lower the error; the pipes' sum share whenever asked).
 struct FitOptions {
   ProfileForm form = ProfileForm::Additive;
   bool constantCache = false;  // roofline and raster forms
