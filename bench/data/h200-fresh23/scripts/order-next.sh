@@ -12,7 +12,7 @@
 # runs it on lavapipe (a dry run). Models under .bundle/unseen/ (BrainStem) or the bundle's own.
 set -u
 if [ "${DEVICE:-NVIDIA}" = NVIDIA ]; then for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig; fi
-mkdir -p /tmp/b && tar -xzf .bundle/sg.tar.gz -C /tmp/b
+mkdir -p /tmp/b "$OUT" && tar -xzf .bundle/sg.tar.gz -C /tmp/b
 here=/tmp/b/sg; source $here/gpu_env.sh > $OUT/gpu.txt 2>&1
 std=(-f $here/examples/gltf/lit.frag -r $here/rules/standard.yaml --templates $here/templates)
 t=(--no-validation-layers --draws 32 --min-frame-vertices 64000 --frames ${SG_FRAMES:-7} --rounds 2 --refits 0 --no-check --no-probes --device "${DEVICE:-NVIDIA}")
