@@ -11,7 +11,10 @@
 
 #include <unistd.h>
 
+#include <nlohmann/json.hpp>
+
 #include "cli/commands.h"
+#include "cli/fresh_process.h"
 #include "common/input_file.h"
 #include "cli/output_files.h"
 #include "cli/whole_model.h"
@@ -32,6 +35,25 @@ struct CalibrateCommand {
   std::vector<std::string> fromLogs, checkLogs;
   std::string evaluate;  // --evaluate PROFILE: the held-out check of an existing profile
   std::string writeCorpus;  // --write-corpus DIR: the corpus's files, no device
+  bool oneProcess = false;  // --one-process: every rig timed in this process
+  // A fresh process timing one rig for its parent (cli/fresh_process.h): the rig, as JSON, and
+  // where its report goes. Hidden options; the parent adds them to its own command line.
+  std::string timeRig, report;
+  std::vector<std::string> commandLine;
+
+  static std::string rigTimingJson(const RigTiming& t) {
+    return nlohmann::json{{"rig", t.rig},         {"fragment", t.fragment}, {"mesh", t.mesh},
+                          {"profile", t.profilePath}, {"fitted", t.fitted},     {"cpu_device", t.cpuDevice}}
+        .dump();
+  }
+  static RigTiming rigTimingFrom(const std::string& text) {
+    try {
+      const nlohmann::json j = nlohmann::json::parse(text);
+      return RigTiming{j.at("rig"), j.at("fragment"), j.at("mesh"), j.at("profile"), j.at("fitted"), j.at("cpu_device")};
+    } catch (const nlohmann::json::exception& e) {
+      throw CLI::ValidationError("--time-rig", std::string("not a rig timing this shadergen writes: ") + e.what());
+    }
+  }
 
   // Samples of earlier runs (the tables calibrate prints): the device line and its rows.
   static std::vector<CalibrationSample> readLogs(const std::vector<std::string>& files, std::string* device) {
@@ -144,6 +166,17 @@ struct CalibrateCommand {
       }
     }
     co.rigs = rigs;
+    if (!timeRig.empty()) {  // the child of a calibration: one rig, its report to the parent
+      if (report.empty()) throw CLI::ValidationError("--time-rig", "needs --report");
+      const RigTiming t = rigTimingFrom(timeRig);
+      writeFreshProcessReport(report, [&] { return runGpuBench(rigBenchOptions(co, t)); });
+      return 0;
+    }
+    if (!oneProcess)
+      co.timeRig = [this](const RigTiming& t) {
+        const std::string what = fmt::format("{} on '{}'", rigLabel(t.rig), t.mesh);
+        return benchInFreshProcess(commandLine, {"--time-rig", rigTimingJson(t)}, what);
+      };
     co.check = !noCheck;
     co.probes = !noProbes;
     co.fit.form = chosenForm();
@@ -257,7 +290,13 @@ void registerCalibrate(CLI::App& app, CliState& state) {
                 "slowest pipe a share of the others (pipe_sum_share, 0 to 1; docs/device-profiles.md, "
                 "\"Pipes overlap imperfectly\")");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer (use for timings)");
-  sub->callback([cmd, &state] { state.run = [cmd] { return cmd->run(); }; });
+  addOneProcessFlag(*sub, cmd->oneProcess, "rig");
+  sub->add_option("--time-rig", cmd->timeRig)->group("");  // a fresh process's one rig (cli/fresh_process.h)
+  sub->add_option("--report", cmd->report)->group("");
+  sub->callback([cmd, &state] {
+    cmd->commandLine = state.commandLine;
+    state.run = [cmd] { return cmd->run(); };
+  });
 }
 
 }  // namespace sg

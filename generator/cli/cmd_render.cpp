@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "cli/commands.h"
+#include "cli/fresh_process.h"
 #include "cli/whole_model.h"
 #include "measure/gpu_bench.h"
 #include "render/render.h"
@@ -117,6 +118,11 @@ struct BenchCommand {
   std::string raster = "both";
   bool noLayers = false;
   bool noAlternatives = false, noFloor = false;
+  bool oneProcess = false;  // --one-process: every part of MODEL.glb#* timed in this process
+  // A fresh process timing one part for its parent (cli/fresh_process.h): the part and where its
+  // report goes. Hidden options; the parent adds them to its own command line.
+  std::string timePart, reportPath;
+  std::vector<std::string> commandLine;
 
   int run() {
     bo.render.gen = args.resolve();
@@ -134,8 +140,15 @@ struct BenchCommand {
     bo.rasterOff = raster != "on";
     bo.alternatives = !noAlternatives;
     bo.floor = !noFloor;
+    if (!timePart.empty()) {  // the child of a whole-model bench: one part, its report to the parent
+      if (reportPath.empty()) throw CLI::ValidationError("--time-part", "needs --report");
+      bo.render.gen.rigPath = timePart;
+      writeFreshProcessReport(reportPath, [&] { return runGpuBench(bo); });
+      return 0;
+    }
     // MODEL.glb#*: every primitive timed on its own mesh (its vertices, its index order), one
-    // table each; a primitive that cannot be generated is reported and the others still run.
+    // table each, each in a fresh process unless --one-process; a primitive that cannot be
+    // generated is reported and the others still run.
     if (auto parts = wholeModelParts(bo.render.gen.rigPath)) {
       if (!bo.handPortPath.empty())
         throw CLI::ValidationError("--hand-port", "does not apply to a whole model: one hand port cannot stand in for every primitive");
@@ -144,7 +157,7 @@ struct BenchCommand {
       std::vector<std::string> broken = forEachPart(*parts, [&](const GltfPart& part) {
         GpuBenchOptions one = bo;
         one.render.gen.rigPath = part.ref;
-        GpuBenchReport rep = runGpuBench(one);
+        GpuBenchReport rep = oneProcess ? runGpuBench(one) : benchInFreshProcess(commandLine, {"--time-part", part.ref}, part.ref);
         std::cout << fmt::format("## {} ({})\n\n", part.name, part.ref);
         failed += report(rep);
         std::cout << "\n";
@@ -235,7 +248,13 @@ void registerRender(CLI::App& app, CliState& state) {
                 "Vulkan device name (substring); default lavapipe. A named device's own limits constrain the search, "
                 "as in validate --device");
   b->add_flag("--no-validation-layers", bench->noLayers, "Run without the Khronos validation layer (use for timings)");
-  b->callback([bench, &state] { state.run = [bench] { return bench->run(); }; });
+  addOneProcessFlag(*b, bench->oneProcess, "part");
+  b->add_option("--time-part", bench->timePart)->group("");  // a fresh process's one part (cli/fresh_process.h)
+  b->add_option("--report", bench->reportPath)->group("");
+  b->callback([bench, &state] {
+    bench->commandLine = state.commandLine;
+    state.run = [bench] { return bench->run(); };
+  });
 }
 
 }  // namespace sg

@@ -40,6 +40,14 @@ void addInputMemoryOption(CLI::App& cmd, rt::InputMemory& memory) {
                                                                                 {"mapped", rt::InputMemory::Mapped}}));
 }
 
+void addOneProcessFlag(CLI::App& cmd, bool& oneProcess, const std::string& what) {
+  cmd.add_flag("--one-process", oneProcess,
+               fmt::format("Time every {0} in this process instead of each in a fresh one (the default): quicker to start, but "
+                           "on NVIDIA a {0}'s times then depend on the {0}s timed before it, by up to 30 % "
+                           "(docs/device-profiles.md, \"One process per rig\")",
+                           what));
+}
+
 void registerCommands(CLI::App& app, CliState& state) {
   registerGenerate(app, state);
   registerValidate(app, state);

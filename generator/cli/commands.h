@@ -14,6 +14,9 @@ namespace sg {
 
 struct CliState {
   std::function<int()> run;
+  // The command line as main received it (its glslc spellings normalised): what a command that
+  // times each rig in a fresh process runs again (cli/fresh_process.h).
+  std::vector<std::string> commandLine;
 };
 
 const char* shadergenVersionString();
@@ -48,6 +51,9 @@ void addGltfReadOptions(CLI::App& cmd, GltfReadOptions& o, bool werror = true);
 
 // --input-memory device-local|mapped, for every command that times programs (bench, calibrate).
 void addInputMemoryOption(CLI::App& cmd, rt::InputMemory& memory);
+// --one-process, for every command that times several rigs (bench MODEL.glb#*, calibrate): time
+// them all in this process instead of each in a fresh one (cli/fresh_process.h). `what`: "rig", "part".
+void addOneProcessFlag(CLI::App& cmd, bool& oneProcess, const std::string& what);
 
 // Every file `in` was loaded from (plus `extra`), named for refuseClobbering (output_files.h).
 std::vector<InputFile> inputFiles(const LoadedInputs& in, const std::vector<std::string>& extra = {});

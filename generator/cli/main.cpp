@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("shadergen ") + sg::shadergenVersionString());
   app.require_subcommand(1);
   sg::CliState state;
+  state.commandLine = args;
   sg::registerCommands(app, state);
   try {
     app.parse(static_cast<int>(cargs.size()), cargs.data());

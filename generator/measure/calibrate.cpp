@@ -672,6 +672,31 @@ std::vector<std::string> rigMeshes(const std::string& rig, const std::vector<std
   return meshes;
 }
 
+GpuBenchOptions rigBenchOptions(const CalibrationOptions& opts, const RigTiming& t) {
+  GpuBenchOptions bo;
+  bo.render.gen = opts.plans;
+  bo.render.gen.rigPath = t.rig;
+  if (!t.fragment.empty()) bo.render.gen.fragmentPath = t.fragment;
+  bo.render.gen.deviceProfilePath = t.profilePath;
+  bo.render.device = opts.device;
+  // The plans this device's limits allow (as bench --device and validate --device use):
+  // a palette that only fits the device's larger uniform block is a plan users get there.
+  bo.render.limits.fromDevice = true;
+  bo.render.validationLayers = opts.validationLayers;
+  bo.render.mesh = t.mesh == "small" ? "head" : t.mesh;
+  bo.render.width = opts.width;
+  bo.render.height = opts.height;
+  bo.floor = t.fitted;  // the floors are the same programs under any profile
+  bo.rasterOn = !t.cpuDevice;
+  bo.rasterOff = t.cpuDevice;
+  bo.drawsPerFrame = opts.drawsPerFrame;
+  bo.minVerticesPerFrame = opts.minVerticesPerFrame;
+  bo.frames = opts.frames;
+  bo.rounds = opts.rounds;
+  bo.inputMemory = opts.inputMemory;
+  return bo;
+}
+
 CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   if (opts.meshes.empty()) throw std::invalid_argument("calibration: no mesh");
   timeCpuDevicesSingleThreaded();
@@ -798,30 +823,10 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
     for (const auto& rig : rigs)
       for (const auto& meshName : rigMeshes(rig, opts.meshes)) {
         if (stopped()) return;
-        GpuBenchOptions bo;
-        bo.render.gen = opts.plans;
-        bo.render.gen.rigPath = rig;
-        if (fragmentOf.count(rig)) bo.render.gen.fragmentPath = fragmentOf.at(rig);
-        bo.render.gen.deviceProfilePath = profilePath;
-        bo.render.device = opts.device;
-        // The plans this device's limits allow (as bench --device and validate --device use):
-        // a palette that only fits the device's larger uniform block is a plan users get there.
-        bo.render.limits.fromDevice = true;
-        bo.render.validationLayers = opts.validationLayers;
-        bo.render.mesh = meshName == "small" ? "head" : meshName;
-        bo.render.width = opts.width;
-        bo.render.height = opts.height;
-        bo.floor = fitted;  // the floors are the same programs under any profile
-        bo.rasterOn = !hostClock;
-        bo.rasterOff = hostClock;
-        bo.drawsPerFrame = opts.drawsPerFrame;
-        bo.minVerticesPerFrame = opts.minVerticesPerFrame;
-        bo.frames = opts.frames;
-        bo.rounds = opts.rounds;
-        bo.inputMemory = opts.inputMemory;
+        const RigTiming timing{rig, fragmentOf.count(rig) ? fragmentOf.at(rig) : "", meshName, profilePath, fitted, hostClock};
         GpuBenchReport br;
         try {
-          br = runGpuBench(bo);
+          br = opts.timeRig ? opts.timeRig(timing) : runGpuBench(rigBenchOptions(opts, timing));
         } catch (const InputError& e) {
           if (!fragmentOf.count(rig)) throw;  // a given rig's error is the user's to see
           rep.notes.push_back(fmt::format("{} on '{}' left out: {}", std::filesystem::path(rig).filename().string(),

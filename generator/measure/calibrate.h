@@ -19,6 +19,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <istream>
 #include <map>
 #include <string>
@@ -37,6 +38,20 @@ inline constexpr const char* kOwnMesh = "own";
 std::vector<std::string> rigMeshes(const std::string& rig, const std::vector<std::string>& meshes);
 // A rig as samples and reports name it: "face.rig.yaml", "Fox.glb#0/0".
 std::string rigLabel(const std::string& rig);
+
+// One rig's timing in a calibration: bench's programs for `rig` on `mesh`, generated under the
+// profile at `profilePath` (the plans of a fit) or the slot model's (the first pass).
+struct RigTiming {
+  std::string rig;
+  std::string fragment;  // "" = the options' own (a corpus rig has its own request)
+  std::string mesh;
+  std::string profilePath;
+  bool fitted = true;  // the fit's samples (and the floors); false: the check's plans
+  bool cpuDevice = false;  // timed by the host's clock, raster off (isCpuDevice)
+};
+struct CalibrationOptions;
+// The bench options calibrate times a rig with.
+GpuBenchOptions rigBenchOptions(const CalibrationOptions& opts, const RigTiming& t);
 
 struct CalibrationOptions {
   std::string device;               // "" = lavapipe
@@ -74,6 +89,11 @@ struct CalibrationOptions {
   // probe or rig being timed finishes, the rest are skipped, and what was timed is fitted and
   // reported, with a note saying so.
   const std::atomic<bool>* stop = nullptr;
+  // How each rig is timed; empty: runGpuBench(rigBenchOptions(...)) in this process. Within one
+  // process NVIDIA's timings depend on what it timed before, by up to 30 % per program and
+  // reproducibly (bench/data/h100-order25), so the CLI times each rig in a fresh process of its own
+  // (cli/fresh_process.h; docs/device-profiles.md, "One process per rig").
+  std::function<GpuBenchReport(const RigTiming&)> timeRig;
 };
 
 struct CalibrationSample {

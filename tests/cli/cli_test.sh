@@ -623,6 +623,45 @@ pack)  # docs/rig-format.md "Packing": the streams and their layout, byte-identi
   grep -q "vs float data" last.out && fail "--no-float-check still checked" || ok "--no-float-check skips the second check"
   ;;
 
+fresh_process)
+  # calibrate and bench MODEL.glb#* time each rig in a fresh shadergen process unless --one-process
+  # (docs/device-profiles.md, "One process per rig"): the same programs, validated alike, either way,
+  # and a rig's input error comes back from its process as the error one process gives.
+  CESIUM=$SRC/../shared/models/CesiumMan/CesiumMan.glb
+  FIGURE=$SRC/../shared/models/RiggedFigure/RiggedFigure.glb
+  [ -f "$CESIUM" ] && [ -f "$FIGURE" ] || { echo "skipped: ../shared/models lacks CesiumMan or RiggedFigure"; exit 0; }
+  TIMING=(--no-validation-layers --draws 1 --frames 1 --rounds 1 --refits 0 --no-check --no-probes)
+  RIGS=(--rig "$CESIUM#0/0" --rig "$FIGURE#*" -f "$SRC/tests/gltf/data/lit.frag" -r "$SRC/rules/standard.yaml")
+  mkdir -p reports  # where the processes' reports pass: none may be left there
+  expect 0 "calibrate, a fresh process per rig" -- env TMPDIR="$T/reports" "$SG" calibrate "${TIMING[@]}" "${RIGS[@]}" -o fresh.yaml
+  mv last.out fresh.out
+  expect 0 "calibrate --one-process" -- "$SG" calibrate "${TIMING[@]}" "${RIGS[@]}" --one-process -o one.yaml
+  # Mesh, rig, program and every term's amount (the columns before the times) agree row by row.
+  programs() { grep -E '^\| own \|' "$1" | cut -d'|' -f2-14; }
+  n=$(programs fresh.out | wc -l)
+  [ "$n" -ge 10 ] && cmp -s <(programs fresh.out) <(programs last.out) && ok "the same $n programs timed either way" ||
+    fail "fresh: $n rows; diff: $(diff <(programs fresh.out) <(programs last.out) | head -5)"
+  [ -z "$(ls reports)" ] && ok "no report file left behind" || fail "left behind: $(ls reports)"
+  # A given rig whose request cannot be met: the located error, and exit 1, as in one process.
+  BAD=(--rig "$SRC/tests/bad-input/base/tiny.rig.yaml" -f "$SRC/tests/bad-input/fragment/not_a_semantic/x.frag"
+       -r "$SRC/tests/bad-input/base/tiny.rules.yaml" --meshes head)
+  expect 1 "calibrate, a rig that cannot be generated, in its process" -- "$SG" calibrate "${TIMING[@]}" "${BAD[@]}"
+  mv last.err fresh.err
+  expect 1 "the same with --one-process" -- "$SG" calibrate "${TIMING[@]}" "${BAD[@]}" --one-process
+  grep -q ': error: ' fresh.err && cmp -s fresh.err last.err && ok "the same error either way: $(head -1 fresh.err)" ||
+    fail "fresh: $(head -3 fresh.err); one process: $(head -3 last.err)"
+  # bench MODEL.glb#*: each part's table, the same programs and verdicts.
+  BENCH=(--rig "$FIGURE#*" -f "$SRC/tests/gltf/data/lit.frag" -r "$SRC/rules/standard.yaml" --no-validation-layers
+     --draws 1 --frames 1 --rounds 1 --raster on)
+  expect 0 "bench MODEL.glb#*, a fresh process per part" -- "$SG" bench "${BENCH[@]}"
+  mv last.out bench-fresh.out
+  expect 0 "bench MODEL.glb#* --one-process" -- "$SG" bench "${BENCH[@]}" --one-process
+  verdicts() { grep -E '^(## |\| (generated|forced|floor))' "$1" | cut -d'|' -f1-3; }
+  n=$(verdicts bench-fresh.out | grep -c '| pass')
+  [ "$n" -ge 2 ] && cmp -s <(verdicts bench-fresh.out) <(verdicts last.out) && ok "bench: the same parts and $n passing programs either way" ||
+    fail "bench: $(diff <(verdicts bench-fresh.out) <(verdicts last.out) | head -5)"
+  ;;
+
 *)
   echo "unknown case $case_name" >&2
   exit 2

@@ -1,0 +1,27 @@
+// One process per rig (docs/device-profiles.md, "One process per rig"): within one process NVIDIA's
+// timings of a rig depend, reproducibly and by up to 30 % per program, on the rigs the process timed
+// before it, while a fresh process times each rig alike every time (bench/data/h100-order25). So
+// `bench MODEL.glb#*` and `calibrate` time each rig in a fresh shadergen process: this executable
+// again, with the command line it was started with and the options that name the one rig.
+#pragma once
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "measure/gpu_bench.h"
+
+namespace sg {
+
+// Runs /proc/self/exe with `commandLine` (this process's, as main received it) plus
+// `--report FILE` and `extra`, waits for it and returns the report it wrote there. Its standard
+// output and error are this process's. The child's input error is rethrown here as that
+// InputError; a child that wrote nothing (a crash, a kill) is a std::runtime_error naming `what`.
+GpuBenchReport benchInFreshProcess(const std::vector<std::string>& commandLine, const std::vector<std::string>& extra,
+                                   const std::string& what);
+
+// In the child: times with `time` and writes its report, or the input error it threw, to `path`
+// for the parent. SIGINT is ignored meanwhile: the rig being timed finishes, as it would in one
+// process, and the parent decides what to time next.
+void writeFreshProcessReport(const std::string& path, const std::function<GpuBenchReport()>& time);
+
+}  // namespace sg
