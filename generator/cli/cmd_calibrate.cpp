@@ -167,7 +167,7 @@ struct CalibrateCommand {
     }
     co.rigs = rigs;
     if (!timeRig.empty()) {  // the child of a calibration: one rig, its report to the parent
-      if (report.empty()) throw CLI::ValidationError("--time-rig", "needs --report");
+      if (report.empty()) throw CLI::ValidationError("--time-rig", "needs --child-report");
       const RigTiming t = rigTimingFrom(timeRig);
       writeFreshProcessReport(report, [&] { return runGpuBench(rigBenchOptions(co, t)); });
       return 0;
@@ -292,7 +292,7 @@ void registerCalibrate(CLI::App& app, CliState& state) {
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer (use for timings)");
   addOneProcessFlag(*sub, cmd->oneProcess, "rig");
   sub->add_option("--time-rig", cmd->timeRig)->group("");  // a fresh process's one rig (cli/fresh_process.h)
-  sub->add_option("--report", cmd->report)->group("");
+  sub->add_option("--child-report", cmd->report)->group("");
   sub->callback([cmd, &state] {
     cmd->commandLine = state.commandLine;
     state.run = [cmd] { return cmd->run(); };

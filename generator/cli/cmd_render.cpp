@@ -141,7 +141,7 @@ struct BenchCommand {
     bo.alternatives = !noAlternatives;
     bo.floor = !noFloor;
     if (!timePart.empty()) {  // the child of a whole-model bench: one part, its report to the parent
-      if (reportPath.empty()) throw CLI::ValidationError("--time-part", "needs --report");
+      if (reportPath.empty()) throw CLI::ValidationError("--time-part", "needs --child-report");
       bo.render.gen.rigPath = timePart;
       writeFreshProcessReport(reportPath, [&] { return runGpuBench(bo); });
       return 0;
@@ -250,7 +250,7 @@ void registerRender(CLI::App& app, CliState& state) {
   b->add_flag("--no-validation-layers", bench->noLayers, "Run without the Khronos validation layer (use for timings)");
   addOneProcessFlag(*b, bench->oneProcess, "part");
   b->add_option("--time-part", bench->timePart)->group("");  // a fresh process's one part (cli/fresh_process.h)
-  b->add_option("--report", bench->reportPath)->group("");
+  b->add_option("--child-report", bench->reportPath)->group("");
   b->callback([bench, &state] {
     bench->commandLine = state.commandLine;
     state.run = [bench] { return bench->run(); };

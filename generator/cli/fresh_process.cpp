@@ -28,7 +28,7 @@ GpuBenchReport benchInFreshProcess(const std::vector<std::string>& commandLine, 
   const std::string report =
       (std::filesystem::temp_directory_path() / fmt::format("shadergen-rig-{}-{}.json", ::getpid(), serial++)).string();
   std::vector<std::string> args = commandLine;
-  args.insert(args.end(), {"--report", report});
+  args.insert(args.end(), {"--child-report", report});
   args.insert(args.end(), extra.begin(), extra.end());
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());

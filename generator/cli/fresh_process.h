@@ -13,7 +13,7 @@
 namespace sg {
 
 // Runs /proc/self/exe with `commandLine` (this process's, as main received it) plus
-// `--report FILE` and `extra`, waits for it and returns the report it wrote there. Its standard
+// `--child-report FILE` and `extra`, waits for it and returns the report it wrote there. Its standard
 // output and error are this process's. The child's input error is rethrown here as that
 // InputError; a child that wrote nothing (a crash, a kill) is a std::runtime_error naming `what`.
 GpuBenchReport benchInFreshProcess(const std::vector<std::string>& commandLine, const std::vector<std::string>& extra,
