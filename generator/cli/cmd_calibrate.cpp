@@ -175,7 +175,7 @@ struct CalibrateCommand {
     if (!oneProcess)
       co.timeRig = [this](const RigTiming& t) {
         const std::string what = fmt::format("{} on '{}'", rigLabel(t.rig), t.mesh);
-        return benchInFreshProcess(commandLine, {"--time-rig", rigTimingJson(t)}, what);
+        return benchInFreshProcess(commandLine, {"--time-rig", rigTimingJson(t)}, what, true);
       };
     co.check = !noCheck;
     co.probes = !noProbes;

@@ -157,7 +157,7 @@ struct BenchCommand {
       std::vector<std::string> broken = forEachPart(*parts, [&](const GltfPart& part) {
         GpuBenchOptions one = bo;
         one.render.gen.rigPath = part.ref;
-        GpuBenchReport rep = oneProcess ? runGpuBench(one) : benchInFreshProcess(commandLine, {"--time-part", part.ref}, part.ref);
+        GpuBenchReport rep = oneProcess ? runGpuBench(one) : benchInFreshProcess(commandLine, {"--time-part", part.ref}, part.ref, false);
         std::cout << fmt::format("## {} ({})\n\n", part.name, part.ref);
         failed += report(rep);
         std::cout << "\n";

@@ -23,7 +23,7 @@ extern char** environ;
 namespace sg {
 
 GpuBenchReport benchInFreshProcess(const std::vector<std::string>& commandLine, const std::vector<std::string>& extra,
-                                   const std::string& what) {
+                                   const std::string& what, bool finishOnInterrupt) {
   static std::atomic<unsigned> serial{0};
   const std::string report =
       (std::filesystem::temp_directory_path() / fmt::format("shadergen-rig-{}-{}.json", ::getpid(), serial++)).string();
@@ -33,12 +33,23 @@ GpuBenchReport benchInFreshProcess(const std::vector<std::string>& commandLine, 
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  if (finishOnInterrupt) {
+    sigset_t blocked;
+    sigemptyset(&blocked);
+    sigaddset(&blocked, SIGINT);
+    posix_spawnattr_setsigmask(&attr, &blocked);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK);
+  }
   pid_t pid = 0;
-  if (int e = posix_spawn(&pid, "/proc/self/exe", nullptr, nullptr, argv.data(), environ); e != 0)
-    throw std::runtime_error(fmt::format("shadergen: cannot start a process to time {}: {}", what, std::strerror(e)));
+  const int spawned = posix_spawn(&pid, "/proc/self/exe", nullptr, &attr, argv.data(), environ);
+  posix_spawnattr_destroy(&attr);
+  if (spawned != 0)
+    throw std::runtime_error(fmt::format("cannot start a process to time {}: {}", what, std::strerror(spawned)));
   int status = 0;
   while (waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) throw std::runtime_error(fmt::format("shadergen: lost the process timing {}: {}", what, std::strerror(errno)));
+    if (errno != EINTR) throw std::runtime_error(fmt::format("lost the process timing {}: {}", what, std::strerror(errno)));
   std::string text;
   std::error_code ec;
   if (std::filesystem::exists(report, ec)) {
@@ -48,13 +59,12 @@ GpuBenchReport benchInFreshProcess(const std::vector<std::string>& commandLine, 
   if (text.empty()) {
     const std::string how = WIFSIGNALED(status) ? fmt::format("was ended by signal {}", WTERMSIG(status))
                                                 : fmt::format("exited with status {}", WEXITSTATUS(status));
-    throw std::runtime_error(fmt::format("shadergen: the process timing {} {} without a report", what, how));
+    throw std::runtime_error(fmt::format("the process timing {} {} without a report", what, how));
   }
   return benchReportFromJson(text);  // an InputError the child wrote is thrown from here
 }
 
 void writeFreshProcessReport(const std::string& path, const std::function<GpuBenchReport()>& time) {
-  std::signal(SIGINT, SIG_IGN);
   std::string text;
   try {
     text = benchReportJson(time());

@@ -16,12 +16,14 @@ namespace sg {
 // `--child-report FILE` and `extra`, waits for it and returns the report it wrote there. Its standard
 // output and error are this process's. The child's input error is rethrown here as that
 // InputError; a child that wrote nothing (a crash, a kill) is a std::runtime_error naming `what`.
+// `finishOnInterrupt`: the child starts with SIGINT blocked, so an interrupt sent to the whole
+// process group (Ctrl-C, `timeout -s INT`) lets it finish its rig while the parent stops after it
+// (calibrate's rule); otherwise an interrupt ends the child with its parent (bench).
 GpuBenchReport benchInFreshProcess(const std::vector<std::string>& commandLine, const std::vector<std::string>& extra,
-                                   const std::string& what);
+                                   const std::string& what, bool finishOnInterrupt);
 
 // In the child: times with `time` and writes its report, or the input error it threw, to `path`
-// for the parent. SIGINT is ignored meanwhile: the rig being timed finishes, as it would in one
-// process, and the parent decides what to time next.
+// for the parent.
 void writeFreshProcessReport(const std::string& path, const std::function<GpuBenchReport()>& time);
 
 }  // namespace sg

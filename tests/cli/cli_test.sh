@@ -650,6 +650,22 @@ fresh_process)
   expect 1 "the same with --one-process" -- "$SG" calibrate "${TIMING[@]}" "${BAD[@]}" --one-process
   grep -q ': error: ' fresh.err && cmp -s fresh.err last.err && ok "the same error either way: $(head -1 fresh.err)" ||
     fail "fresh: $(head -3 fresh.err); one process: $(head -3 last.err)"
+  # An interrupt sent to the whole process group (`timeout -s INT`, Ctrl-C) reaches the rig's
+  # process too: it finishes its rig, and the calibration fits what was timed, as in one process.
+  setsid "$SG" calibrate "${DAWN[@]}" --meshes head,dawn --draws 2 --frames 2 --rounds 10 --no-probes \
+    --no-validation-layers -o group.yaml >group.out 2>group.err &
+  pid=$!
+  sleep 4
+  kill -INT -- "-$pid"
+  wait "$pid"
+  rc=$?
+  if [ "$rc" -eq 0 ] && grep -q "^note: interrupted: [0-9]* samples were timed" group.out && [ -s group.yaml ]; then
+    ok "calibrate, the process group interrupted: the rig's process finished it, and it was fitted"
+  elif [ "$rc" -ne 0 ] && [ "$rc" -ne 130 ] && grep -q "interrupted before anything was timed" group.err; then
+    ok "calibrate, the process group interrupted before any rig was timed: says so"
+  else
+    fail "calibrate after a group SIGINT: exit $rc; $(tail -3 group.out) $(cat group.err)"
+  fi
   # bench MODEL.glb#*: each part's table, the same programs and verdicts.
   BENCH=(--rig "$FIGURE#*" -f "$SRC/tests/gltf/data/lit.frag" -r "$SRC/rules/standard.yaml" --no-validation-layers
      --draws 1 --frames 1 --rounds 1 --raster on)
