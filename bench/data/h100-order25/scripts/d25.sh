@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Session 25, device call 3, with a bundle of commit 328de2d (calibrate times each rig in a fresh
+# Session 25, device call 3, with a bundle of commit 744e58b (calibrate times each rig in a fresh
 # process unless --one-process): what carries over inside one process, and the new default on the GPU.
 # BrainStem's runs with mapped inputs as order-next.sh's; the held-out groups with the default
 # (device-local) as their logs of calls 1-2. Each step inside SG_STOP seconds (a device budget):
