@@ -24,7 +24,7 @@ cal() {  # NAME LIMIT ARGS...: one calibrate run, unless SG_STOP seconds have pa
   echo "== $name: exit $?, $SECONDS s"; tar -czf $OUT/logs.tar.gz -C /tmp/o4 .
 }
 lit=(--input-memory mapped -f $here/examples/gltf/lit.frag "${std[@]}")
-cal fresh-BrainStem 120 --rig "$m#*" "${lit[@]}"
+cal fresh-BrainStem ${SG_FRESH_LIMIT:-120} --rig "$m#*" "${lit[@]}"
 data=$here/examples/heldout
 cal world 130 --meshes dawn,head --rig $data/limb16.rig.yaml --rig $data/limb8_palette300.rig.yaml --rig $data/face52.rig.yaml \
   --rig $data/octahedral.rig.yaml --rig $data/qtangent.rig.yaml -f $data/world.frag "${std[@]}"
