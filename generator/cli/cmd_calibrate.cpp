@@ -156,6 +156,14 @@ struct CalibrateCommand {
       throw CLI::ValidationError("--rig", "plans need --rig, --fragment and --rules together");
     if (co.corpus > 0 && co.plans.rulesPaths.empty())
       throw CLI::ValidationError("--corpus", "needs --rules whose vocabulary the random requests use (examples/dawn/rules.yaml)");
+    // The child of a calibration: one rig, its report to the parent. Before the rigs are listed,
+    // so a whole model is not read again for each of its parts.
+    if (!timeRig.empty()) {
+      if (report.empty()) throw CLI::ValidationError("--time-rig", "needs --child-report");
+      const RigTiming t = rigTimingFrom(timeRig);
+      writeFreshProcessReport(report, [&] { return runGpuBench(rigBenchOptions(co, t)); });
+      return 0;
+    }
     // MODEL.glb#*: each primitive is a rig of its own, timed on its own mesh.
     std::vector<std::string> rigs;
     for (const auto& r : co.rigs) {
@@ -166,12 +174,6 @@ struct CalibrateCommand {
       }
     }
     co.rigs = rigs;
-    if (!timeRig.empty()) {  // the child of a calibration: one rig, its report to the parent
-      if (report.empty()) throw CLI::ValidationError("--time-rig", "needs --child-report");
-      const RigTiming t = rigTimingFrom(timeRig);
-      writeFreshProcessReport(report, [&] { return runGpuBench(rigBenchOptions(co, t)); });
-      return 0;
-    }
     if (!oneProcess)
       co.timeRig = [this](const RigTiming& t) {
         const std::string what = fmt::format("{} on '{}'", rigLabel(t.rig), t.mesh);
