@@ -27,6 +27,19 @@ expect() {
   fi
 }
 DAWN=(--rig "$E/face.rig.yaml" -f "$E/face.frag" -r "$E/rules.yaml")
+# A calibrate run sent SIGINT, its exit status <rc> and files <name>.out, .err, .yaml: it fitted
+# what it timed, or, interrupted before any timing, failed saying so; never a death by the signal
+# (exit 130).
+interrupted_calibration() {  # interrupted_calibration <rc> <name> <what>
+  local rc=$1 name=$2 what=$3
+  if [ "$rc" -eq 0 ] && grep -q "^note: interrupted: [0-9]* samples were timed" "$name.out" && [ -s "$name.yaml" ]; then
+    ok "$what: fits what it timed"
+  elif [ "$rc" -ne 0 ] && [ "$rc" -ne 130 ] && grep -q "interrupted before anything was timed" "$name.err"; then
+    ok "$what, before any timing: says so"
+  else
+    fail "$what: exit $rc; $(tail -3 "$name.out") $(cat "$name.err")"
+  fi
+}
 no_temps() {  # no *.tmp.* / *.bak.* left anywhere under $1
   local left
   left=$(find "$1" -name '*.tmp.*' -o -name '*.bak.*')
@@ -524,13 +537,7 @@ device_profile)
   kill -INT "$pid"
   wait "$pid"
   rc=$?
-  if [ "$rc" -eq 0 ] && grep -q "^note: interrupted: [0-9]* samples were timed" int.out && [ -s int.yaml ]; then
-    ok "calibrate, interrupted: fits what it timed"
-  elif [ "$rc" -ne 0 ] && grep -q "interrupted before anything was timed" int.err; then
-    ok "calibrate, interrupted before any timing: says so"
-  else
-    fail "calibrate after SIGINT: exit $rc; $(tail -3 int.out) $(cat int.err)"
-  fi
+  interrupted_calibration "$rc" int "calibrate, interrupted"
   # `timeout -s INT` (the bench scripts' time limits) signals the command and then its process
   # group: two SIGINTs a moment apart are one interrupt, not the second that ends the process
   # (ending on timeout's copy lost every timed sample, bench/data/h200-linear-blend13).
@@ -543,13 +550,7 @@ device_profile)
   kill -INT "$pid" 2>/dev/null
   wait "$pid"
   rc=$?
-  if [ "$rc" -eq 0 ] && grep -q "^note: interrupted: [0-9]* samples were timed" int2.out && [ -s int2.yaml ]; then
-    ok "calibrate, SIGINT twice within a second: one interrupt, fits what it timed"
-  elif [ "$rc" -ne 0 ] && [ "$rc" -ne 130 ] && grep -q "interrupted before anything was timed" int2.err; then
-    ok "calibrate, SIGINT twice within a second before any timing: says so"
-  else
-    fail "calibrate after two SIGINTs: exit $rc; $(tail -3 int2.out) $(cat int2.err)"
-  fi
+  interrupted_calibration "$rc" int2 "calibrate, SIGINT twice within a second (one interrupt)"
   # Offline refit from a recorded log: the device (a driver name holding parentheses of its own)
   # and the fit are read back, the profile loads, and --evaluate checks held-out logs by name.
   LP=$SRC/bench/data/lavapipe-heldout
@@ -659,13 +660,7 @@ fresh_process)
   kill -INT -- "-$pid"
   wait "$pid"
   rc=$?
-  if [ "$rc" -eq 0 ] && grep -q "^note: interrupted: [0-9]* samples were timed" group.out && [ -s group.yaml ]; then
-    ok "calibrate, the process group interrupted: the rig's process finished it, and it was fitted"
-  elif [ "$rc" -ne 0 ] && [ "$rc" -ne 130 ] && grep -q "interrupted before anything was timed" group.err; then
-    ok "calibrate, the process group interrupted before any rig was timed: says so"
-  else
-    fail "calibrate after a group SIGINT: exit $rc; $(tail -3 group.out) $(cat group.err)"
-  fi
+  interrupted_calibration "$rc" group "calibrate, the process group interrupted (the rig's process finishes its rig)"
   # bench MODEL.glb#*: each part's table, the same programs and verdicts.
   BENCH=(--rig "$FIGURE#*" -f "$SRC/tests/gltf/data/lit.frag" -r "$SRC/rules/standard.yaml" --no-validation-layers
      --draws 1 --frames 1 --rounds 1 --raster on)
