@@ -32,8 +32,9 @@ group() {  # group NAME SECONDS ARGS...: one calibrate run, its log in OUTDIR/NA
   timeout -s INT -k 60 "$limit" "$sg" calibrate "${t[@]}" "$@" -o "${SG_PROFILE_DIR:-$outdir}/$name.yaml" > "$outdir/$name.log" 2>&1
   echo "== $name: exit $?, $((SECONDS - t0)) s (limit $limit)"
 }
-# Each rig is timed in a fresh process (docs/device-profiles.md, "One process per rig"): about half a
-# second more per (rig, mesh) on the H100 (session 25), 34 of them here.
+# Each rig is timed in a fresh process (docs/device-profiles.md, "One process per rig"): on the H100
+# this group took 236 s so, against 223 s in one process (about 0.4 s per (rig, mesh), 34 of them here;
+# bench/data/h100-fresh26).
 group train 260 --corpus "${SG_CORPUS:-16}" --seed 1 --rig "$here/examples/dawn/face.rig.yaml" \
   --rig "$here/examples/dawn/face-packed.rig.yaml" -f "$here/examples/dawn/face.frag" "${dawnRules[@]}"
 # A real model's own meshes in the fit (small draws, its own vertex order); not one the check uses.
