@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Session 26 (README.md): program by program, the groups timed with each rig in a fresh process
 (the default since session 25) against the same groups timed with many rigs in one process
-(session 25's H100 logs, ../h100-order25), and against themselves timed again (call 4).
+(session 25's H100 logs, ../h100-order25), and against themselves timed again (call 4; call 5 on another machine).
 Only plans count (probes and floors are not rigs' programs). Usage: python3 compare.py   (stdlib only)"""
 import os, statistics, sys
 
@@ -39,6 +39,8 @@ far += compare('corpus seed 7: one process (session 25)', times(os.path.join(her
 for g in ['world', 'pbr', 'body-depth', 'models', 'models-fox', 'unseen-formats', 'unseen-models']:
     compare(f'{g}: fresh processes again (call 4)', times(os.path.join(here, f'call4/s2/{g}.log')),
             times(os.path.join(here, f'call1/s2/{g}.log')))
+compare('unseen: fresh processes again, another machine (call 5)', times(os.path.join(here, 'call5/s2/unseen.log')),
+        times(os.path.join(here, 'call1/s2/unseen.log')))
 print('\nover 5 % apart, fresh against one process:')
 for x, k in sorted(far):
     print(f'  {x:.3f}  {k[1]} | {k[0]} | {k[2]}')
