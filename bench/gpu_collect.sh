@@ -20,6 +20,10 @@ source "$here/gpu_env.sh"
 t=(--no-validation-layers --meshes "${SG_MESHES:-dawn,head}" --draws "${SG_DRAWS:-32}" --min-frame-vertices "${SG_MIN_FRAME_VERTICES:-64000}"
    --frames "${SG_FRAMES:-7}" --rounds "${SG_ROUNDS:-2}" --refits 0 --no-check)
 [ -n "$device" ] && t+=(--device "$device")
+# SG_PLANS_UNDER=PROFILE (a path, e.g. "$here/devices/nvidia-h200-raster.yaml"): each rig's plan under that
+# profile is timed too, with its alternatives (calibrate --plans-under), so the held-out check sees the plan
+# the profile would choose and not only the instruction-slot plan's neighbourhood (about twice the time).
+[ -n "${SG_PLANS_UNDER:-}" ] && t+=(--plans-under "$SG_PLANS_UNDER")
 dawnRules=(-r "$here/examples/dawn/rules.yaml" --templates "$here/templates")
 std=(-r "$here/rules/standard.yaml" --templates "$here/templates")
 data="$here/examples/heldout"

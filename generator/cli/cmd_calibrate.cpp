@@ -156,6 +156,10 @@ struct CalibrateCommand {
       throw CLI::ValidationError("--rig", "plans need --rig, --fragment and --rules together");
     if (co.corpus > 0 && co.plans.rulesPaths.empty())
       throw CLI::ValidationError("--corpus", "needs --rules whose vocabulary the random requests use (examples/dawn/rules.yaml)");
+    if (!co.plansUnder.empty() && co.rigs.empty() && co.corpus == 0)
+      throw CLI::ValidationError("--plans-under", "needs --rig or --corpus (the rigs whose plans it times)");
+    // A profile's error is the user's, before anything is timed (a corpus rig's error only leaves that rig out).
+    for (const auto& p : co.plansUnder) loadDeviceProfile(p);
     // The child of a calibration: one rig, its report to the parent. Before the rigs are listed,
     // so a whole model is not read again for each of its parts.
     if (!timeRig.empty()) {
@@ -266,6 +270,11 @@ void registerCalibrate(CLI::App& app, CliState& state) {
   sub->add_option("--write-corpus", cmd->writeCorpus,
                   "Write the --corpus N --seed S rigs and requests to DIR (<name>.rig.yaml, <name>.frag; one line "
                   "per case) and exit; no device is opened");
+  sub->add_option("--plans-under", cmd->co.plansUnder,
+                  "With --rig or --corpus: also time each rig's plan under this device profile and its forced "
+                  "alternatives (\"plan under NAME: ...\"), so a held-out log holds the plan that profile would choose; "
+                  "repeat for several")
+      ->check(CLI::ExistingFile);
   sub->add_flag("--no-check", cmd->noCheck, "With --rig: do not time the rigs' plans under the fitted profile afterwards");
   sub->add_option("--from-log", cmd->fromLogs,
                   "Fit the samples of earlier runs' logs (their tables) instead of measuring; no device is opened")

@@ -875,6 +875,8 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
       remove.paths.push_back(slots);
     }
     benchRigs(slots, true, "plan: ");
+    for (const auto& profile : opts.plansUnder)
+      benchRigs(profile, true, fmt::format("plan under {}: ", std::filesystem::path(profile).stem().string()));
   }
   if (!inputMemory.empty()) rep.clock += "; " + inputMemory;
   double workload = 0;

@@ -73,6 +73,12 @@ struct CalibrationOptions {
   // own fragment shader, over plans.rulesPaths (examples/dawn/rules.yaml has the vocabulary).
   size_t corpus = 0;
   uint32_t corpusSeed = 1;
+  // Device profiles under which each rig's plan is searched and timed too, with its forced
+  // alternatives (labelled "plan under NAME: ", NAME the file's stem). The fit pass times the
+  // instruction-slot plan's neighbourhood; a profile's own plan may lie outside it, and the
+  // held-out check can only call "chosen" a plan that was timed (docs/device-profiles.md,
+  // "The profile's own plan").
+  std::vector<std::string> plansUnder;
   bool check = true;  // then the same rigs' plans under the fitted profile
   // Refits: each adds the plans the profile chose to the samples and fits again; the last
   // profile's plans are the check, which no fit saw.

@@ -574,6 +574,32 @@ device_profile)
   expect 0 "a written case generates" -- "$SG" generate --rig "$crig" -f "$cfrag" -r "$SRC/examples/dawn/rules.yaml" \
     --templates "$SRC/templates" -o corpus-case --emit glsl
   expect 2 "--write-corpus without --corpus (a usage error)" -- "$SG" calibrate --write-corpus corpus6
+  # --plans-under: each rig's plan under that profile is timed too, with its forced alternatives, so
+  # a held-out log holds the plan the profile would choose. Of seed 4242's three rigs, the H200
+  # profile moves at least one plan away from the instruction-slot plan (it reads the skin from buffers).
+  PU=(--no-probes --corpus 3 --seed 4242 --meshes head -r "$SRC/examples/dawn/rules.yaml" --templates "$SRC/templates"
+      --no-check --refits 0 --frames 1 --rounds 1 --draws 1 --min-frame-vertices 0)
+  expect 0 "calibrate --plans-under" -- "$SG" calibrate "${PU[@]}" --plans-under "$SRC/devices/nvidia-h200-raster.yaml" -o pu.yaml
+  generated() { grep -E "^\| head \| $1 \| $2 \|" last.out | cut -d'|' -f5-13; }
+  rigs=$(grep -oE '^\| head \| corpus-[0-9]+\.rig\.yaml \| plan: generated' last.out | cut -d'|' -f3 | tr -d ' ')
+  both=0 moved=0
+  for r in $rigs; do
+    a=$(generated "$r" "plan: generated") b=$(generated "$r" "plan under nvidia-h200-raster: generated")
+    [ -n "$a" ] && [ -n "$b" ] && both=$((both + 1))
+    [ -n "$b" ] && [ "$a" != "$b" ] && moved=$((moved + 1))
+  done
+  [ "$both" -eq 3 ] && [ "$moved" -ge 1 ] && ok "each rig's plan timed under both ($moved moved by the profile)" ||
+    fail "rigs with both plans: $both, moved: $moved; $(grep -c 'plan under' last.out) rows under the profile"
+  cp last.out pu.log
+  expect 0 "the log reads back, its plans under the profile among them" -- "$SG" calibrate --from-log pu.log
+  n=$(grep -c '| plan under nvidia-h200-raster: ' pu.log)
+  grep -q "^fit on 'head': $(grep -cE '^\| head \| corpus-.* \| [0-9]+\.[0-9]+ \|' pu.log) samples" last.out && [ "$n" -ge 3 ] &&
+    ok "every timed row fitted, the $n under the profile too" || fail "$(grep "^fit on" last.out); $n rows under the profile"
+  printf 'device: "x"\nweights: [1\n' > bad-profile.yaml
+  expect 1 "--plans-under a malformed profile" -- "$SG" calibrate "${PU[@]}" --plans-under bad-profile.yaml
+  grep -q '^bad-profile.yaml:[0-9]*:[0-9]*: error' last.err && ! grep -q 'corpus-' last.out &&
+    ok "its located error, before any rig is timed" || fail "printed: $(head -3 last.err) / $(head -3 last.out)"
+  expect 2 "--plans-under without rigs (a usage error)" -- "$SG" calibrate --plans-under "$SRC/devices/nvidia-h200-raster.yaml"
   # render MODEL.glb#* under a profile prices each primitive for its own mesh, as MODEL.glb#m/p
   # does (CesiumMan has one primitive; its palette loads are priced per joint a warp reads).
   CESIUM=$SRC/../shared/models/CesiumMan/CesiumMan.glb
