@@ -30,7 +30,7 @@ def searched_amounts(rig, mesh):
 evaluated = {}
 for log in sys.argv[4:]:
     for r in rows(log):
-        if r['program'].startswith('plan:') and r['rig'].startswith('corpus-'):
+        if r['program'].startswith('plan') and r['rig'].startswith('corpus-'):  # 'plan: ', 'plan under NAME: '
             evaluated.setdefault((r['rig'], r['mesh']), []).append((tuple(r[t] for t in TERMS), float(r['measured ns/vertex'])))
 print('| rig | mesh | searched plan / fastest timed |')
 print('|---|---|---:|')
