@@ -136,7 +136,8 @@ struct CalibrateCommand {
       if (checkLogs.empty()) throw CLI::ValidationError("--evaluate", "needs --check-log (the samples to predict)");
       CalibrationReport rep;
       rep.profile = loadDeviceProfile(evaluate);
-      rep.check = checkHeldOut(readLogs(checkLogs, nullptr), rep.profile);
+      // A log timed with --plans-under this profile holds the plan its search returned.
+      rep.check = checkHeldOut(readLogs(checkLogs, nullptr), rep.profile, planUnderLabel(evaluate) + "generated");
       std::cout << formatHeldOutCheck(rep.check);
       return 0;
     }

@@ -468,15 +468,26 @@ std::string heldOutSummary(const LeaveOneRigOut& loo, const char* what = "leave-
                      loo.pairsWithATieForLeast == 0 ? ""
                                                  : fmt::format("; in {} the least prediction is shared (the slowest of those "
                                                                "plans counted)",
-                                                               loo.pairsWithATieForLeast));
+                                                               loo.pairsWithATieForLeast)) +
+         (loo.pairsWithOwnPlan == 0 ? ""
+                                    : fmt::format("; in {} the profile's own plan was timed (calibrate --plans-under) and is "
+                                                  "the one counted",
+                                                  loo.pairsWithOwnPlan)) +
+         (loo.ownPlanNotLeast == 0 ? ""
+                                   : fmt::format("; in {} the log's plan under that name is not the least predicted "
+                                                 "(searched under another profile of that name): the least predicted counted",
+                                                 loo.ownPlanNotLeast));
 }
 
 // Predicted times this close (relative) are one time: sums of the same prices in another order.
 constexpr double kPredictedTie = 1e-9;
 
 // Each (rig, mesh) of `rig` ("" = every rig) in `samples`: its plans predicted by `profile`.
+// A pair with a plan labelled `ownPlanLabel` ("" = none) counts that plan where it is among the
+// least predicted; where it is not, the pair is counted in *ownPlanNotLeast.
 std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& samples, const std::string& rig,
-                                    const DeviceProfile& profile) {
+                                    const DeviceProfile& profile, const std::string& ownPlanLabel = "",
+                                    size_t* ownPlanNotLeast = nullptr) {
   // One choice per (rig, request, mesh), in the samples' order; a rig timed under several
   // requests names the request in its row.
   std::vector<std::tuple<std::string, std::string, std::string>> keys;
@@ -492,11 +503,23 @@ std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& sample
     HeldOutRig h;
     h.rig = requestsOf[r].size() > 1 ? fmt::format("{} ({})", r, request) : r;
     h.mesh = mesh;
-    std::set<TermAmounts> seen;  // a plan timed twice (chosen by two profiles) counts once
+    // Plans of the same term amounts (one plan timed twice, or two programs the model cannot tell
+    // apart) are predicted and ranked once, at their first timing: their index. The fastest and the
+    // profile's own plan are taken from every timing.
+    std::map<TermAmounts, size_t> seen;
+    constexpr size_t kNone = size_t(-1);
+    size_t own = kNone;  // the profile's own plan, where the log timed it
+    double ownNs = NAN, fastestNs = INFINITY;
     for (const auto& s : samples) {
       if (s.rig != r || s.request != request || s.mesh != mesh || !isPlanSample(s) || !s.validated || s.measuredNs <= 0)
         continue;
-      if (!seen.insert(s.amounts).second) continue;
+      fastestNs = std::min(fastestNs, s.measuredNs);
+      const auto [kept, added] = seen.emplace(s.amounts, h.measured.size());
+      if (own == kNone && !ownPlanLabel.empty() && s.label == ownPlanLabel) {
+        own = kept->second;
+        ownNs = s.measuredNs;
+      }
+      if (!added) continue;
       DeviceProfile at = profile;
       at.workload = s.workload;
       h.predicted.push_back(at.predictNanoseconds(s.amounts, s.vertices));
@@ -518,7 +541,18 @@ std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& sample
       if (h.predicted[i] <= least * (1 + kPredictedTie)) {
         if (h.tiedForLeast++ == 0 || h.measured[i] > h.measured[chosen]) chosen = i;
       }
-    h.chosenOverFastest = h.measured[chosen] / *std::min_element(h.measured.begin(), h.measured.end());
+    // The log timed the plan the profile's search returned: that one, unless another profile of
+    // the same name chose it (then it need not be the least predicted here).
+    double chosenNs = h.measured[chosen];
+    if (own != kNone) {
+      if (h.predicted[own] <= least * (1 + kPredictedTie)) {
+        chosenNs = ownNs;
+        h.ownPlan = true;
+      } else if (ownPlanNotLeast) {
+        ++*ownPlanNotLeast;
+      }
+    }
+    h.chosenOverFastest = chosenNs / fastestNs;
     h.spearman = spearmanWithinSpread(h.predicted, h.measured, 0.005);
     rows.push_back(std::move(h));
   }
@@ -530,7 +564,8 @@ LeaveOneRigOut summarise(std::vector<HeldOutRig> rows) {
   out.rows = std::move(rows);
   std::vector<double> rho, rms;
   for (const auto& h : out.rows) {
-    if (h.tiedForLeast > 1) ++out.pairsWithATieForLeast;
+    if (h.ownPlan) ++out.pairsWithOwnPlan;
+    else if (h.tiedForLeast > 1) ++out.pairsWithATieForLeast;
     rho.push_back(h.spearman);
     rms.push_back(h.rmsRelativeError);
     if (!(out.worstChosenOverFastest >= h.chosenOverFastest)) out.worstChosenOverFastest = h.chosenOverFastest;
@@ -560,8 +595,16 @@ LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, con
   return summarise(std::move(rows));
 }
 
-LeaveOneRigOut checkHeldOut(const std::vector<CalibrationSample>& heldOut, const DeviceProfile& profile) {
-  return summarise(predictRigs(heldOut, "", profile));
+LeaveOneRigOut checkHeldOut(const std::vector<CalibrationSample>& heldOut, const DeviceProfile& profile,
+                            const std::string& ownPlanLabel) {
+  size_t notLeast = 0;
+  LeaveOneRigOut out = summarise(predictRigs(heldOut, "", profile, ownPlanLabel, &notLeast));
+  out.ownPlanNotLeast = notLeast;
+  return out;
+}
+
+std::string planUnderLabel(const std::string& profilePath) {
+  return fmt::format("plan under {}: ", std::filesystem::path(profilePath).stem().string());
 }
 
 namespace {
@@ -574,7 +617,10 @@ std::string heldOutTable(const LeaveOneRigOut& t, const char* what, const char* 
                               what, meaning, rigColumn);
   for (const auto& h : t.rows)
     s += fmt::format("| {} | {} | {} | {:.3f} | {:.3f}{} | {:.1f} % |\n", h.rig, h.mesh, h.plans, h.spearman, h.chosenOverFastest,
-                     h.tiedForLeast > 1 ? fmt::format(" ({} tied)", h.tiedForLeast) : "", 100 * h.rmsRelativeError);
+                     h.ownPlan            ? std::string(" (its plan)")
+                     : h.tiedForLeast > 1 ? fmt::format(" ({} tied)", h.tiedForLeast)
+                                          : std::string(),
+                     100 * h.rmsRelativeError);
   return s + heldOutSummary(t, what) + "\n";
 }
 
@@ -876,7 +922,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
     }
     benchRigs(slots, true, "plan: ");
     for (const auto& profile : opts.plansUnder)
-      benchRigs(profile, true, fmt::format("plan under {}: ", std::filesystem::path(profile).stem().string()));
+      benchRigs(profile, true, planUnderLabel(profile));
   }
   if (!inputMemory.empty()) rep.clock += "; " + inputMemory;
   double workload = 0;

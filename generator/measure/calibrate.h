@@ -155,19 +155,32 @@ struct HeldOutRig {
   // the same slowest pipe alike). The search may return any of them, so chosenOverFastest counts
   // the slowest of them.
   size_t tiedForLeast = 0;
+  // The profile's own plan, timed by calibrate --plans-under, is the one counted (checkHeldOut's
+  // ownPlanLabel), not the slowest of a tie.
+  bool ownPlan = false;
   double rmsRelativeError = NAN;
 };
 struct LeaveOneRigOut {
   std::vector<HeldOutRig> rows;  // by rig, then mesh
   double medianSpearman = NAN, worstChosenOverFastest = NAN, medianRms = NAN, maxRms = NAN;
-  size_t pairsWithATieForLeast = 0;  // rows whose least prediction several plans share
+  size_t pairsWithATieForLeast = 0;  // rows whose least prediction several plans share (tie rule applied)
+  size_t pairsWithOwnPlan = 0;       // rows counting the profile's own plan (HeldOutRig::ownPlan)
+  // Rows whose log holds a plan under the profile's name that is not the least predicted (it was
+  // searched under another profile of that name): the least predicted counted.
+  size_t ownPlanNotLeast = 0;
 };
 LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
                               double workloadVertices, double nearBestPower, const FitOptions& fit = {});
 std::string formatLeaveOneRigOut(const LeaveOneRigOut& loo);
 // The held-out check: each (rig, mesh) of samples no fit saw, its plans predicted by `profile`
-// (same figures as leave-one-rig-out).
-LeaveOneRigOut checkHeldOut(const std::vector<CalibrationSample>& heldOut, const DeviceProfile& profile);
+// (same figures as leave-one-rig-out). With `ownPlanLabel` (planUnderLabel(PROFILE) + "generated"),
+// a pair whose log timed the plan the profile's search returned counts that plan, where it is
+// among the least predicted.
+LeaveOneRigOut checkHeldOut(const std::vector<CalibrationSample>& heldOut, const DeviceProfile& profile,
+                            const std::string& ownPlanLabel = "");
+// "plan under STEM: ", the prefix of the labels of plans timed under a profile file
+// (calibrate --plans-under), STEM the file's name without its directory and extension.
+std::string planUnderLabel(const std::string& profilePath);
 std::string formatHeldOutCheck(const LeaveOneRigOut& check);
 
 struct CalibrationReport {

@@ -233,9 +233,6 @@ std::vector<std::string> inputsRead(const LoadedInputs& in, const TemplateSet& t
 
 // ---- the stages in order ------------------------------------------------------------------
 
-namespace {
-
-// The search under the options' bans and device limits (what generateWith runs).
 Plan searchUnderOptions(LoadedInputs& in, const GenerateOptions& opts, SearchStats* stats) {
   if (!opts.bannedRules.empty()) in.problem = withoutRules(in.problem, opts.bannedRules);
   setDeviceLimits(in.problem, opts.maxAttributes, opts.maxUniformBlockBytes, opts.maxStorageBuffers);
@@ -256,6 +253,8 @@ Plan searchUnderOptions(LoadedInputs& in, const GenerateOptions& opts, SearchSta
   }
   return searchStage(in, search, stats);
 }
+
+namespace {
 
 // A profile prices the workload of the generation: the draw's vertices (its per-draw weights)
 // and the mesh's features (terms scaled by one), each where known. Here, so that every path

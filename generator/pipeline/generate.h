@@ -87,6 +87,12 @@ struct GenerateResult {
 const char* shadergenVersion();
 
 LoadedInputs loadInputs(const GenerateOptions& opts);
+// The search generate runs: opts' bans and engine, the device limits (attributes, uniform block,
+// storage buffers; per-vertex buffers past maxStorageBufferBytes dropped) and, with several device
+// profiles, the least worst-case regret. `in.problem` is left as searched, so that `explain`
+// re-searches each choice's alternative under the same limits. Throws the located error when no
+// plan fits.
+Plan searchUnderOptions(LoadedInputs& in, const GenerateOptions& opts, SearchStats* stats = nullptr);
 // The stages after loading, for a rig already loaded (loadInputs and `build` share them):
 // the error budgets (opts.maxError) take over-budget encodings out of the rig; a value the
 // rig stores both as itself and encoded is read in the form whose plan is cheapest; then
