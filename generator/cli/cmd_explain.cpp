@@ -10,15 +10,25 @@
 #include "analysis/graph.h"
 #include "cli/commands.h"
 #include "cli/output_files.h"
+#include "pipeline/generate.h"
+#include "search/astar.h"
 
 namespace sg {
 namespace {
 
-// Loads the inputs with --ban applied; nullopt plan = unreachable request.
+// Loads the inputs with --ban applied and searches as generate does (pipeline/generate.h: the
+// device limits, several profiles' regret), so that the plan shown is the plan generated;
+// nullopt plan = a request no rule reaches (explained by the caller). No plan within the device
+// limits: generate's located error.
 std::pair<LoadedInputs, std::optional<Plan>> loadAndSearch(const GenerateOptions& o) {
   LoadedInputs in = loadInputs(o);
   if (!o.bannedRules.empty()) in.problem = withoutRules(in.problem, o.bannedRules);
-  std::optional<Plan> plan = searchPlan(in.problem, o.heuristic);
+  const std::vector<bool> reachable = reachableFacts(in.problem);
+  for (int g : in.problem.goals)
+    if (!reachable[static_cast<size_t>(g)]) return {std::move(in), std::nullopt};
+  GenerateOptions searched = o;
+  searched.bannedRules.clear();  // applied above
+  Plan plan = searchUnderOptions(in, searched);
   return {std::move(in), std::move(plan)};
 }
 

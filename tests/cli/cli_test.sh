@@ -515,6 +515,22 @@ device_profile)
   expect 0 "explain --device-profile" -- "$SG" explain "${DAWN[@]}" --device-profile "$P" --no-alternatives
   grep -q "predicted per vertex on 'example" last.out && ok "explain shows the terms" || fail "$(cat last.out)"
   grep -qE "^    buffer_loads +[1-9]" last.out && ok "explain: buffer loads counted" || fail "$(cat last.out)"
+  # explain shows the plan generate writes: under the device limits given (a 300-bone palette fits
+  # a 64 KiB uniform block, not the default 16 KiB one) and under several profiles (the least
+  # worst-case regret, not the first profile's own plan).
+  rulesOf() { grep -oE "$1" last.out | awk '{print $NF}' | sort -u; }
+  V=$SRC/tests/validate/data
+  for case in "limits" "portable"; do
+    if [ $case = limits ]; then args=(--rig "$V/limb8_palette300.rig.yaml" -f "$V/world.frag" -r "$SRC/rules/standard.yaml" --max-uniform-bytes 65536)
+    else args=("${DAWN[@]}" --device-profile "$SRC/devices/nvidia-h200-raster.yaml" --device-profile "$SRC/devices/llvmpipe-2core.yaml"); fi
+    expect 0 "generate ($case)" -- "$SG" generate "${args[@]}" -o explained/$case
+    rulesOf '^ +[0-9]+\. [a-z_0-9]+' > explained-$case-generate.txt
+    expect 0 "explain ($case)" -- "$SG" explain "${args[@]}" --no-alternatives
+    rulesOf '<- [a-z_0-9]+' > explained-$case-explain.txt
+    [ -s explained-$case-generate.txt ] && cmp -s explained-$case-generate.txt explained-$case-explain.txt &&
+      ok "explain shows generate's plan ($case)" || fail "explain ($case): $(diff explained-$case-generate.txt explained-$case-explain.txt)"
+  done
+  grep -qx skin_matrix_blend explained-limits-generate.txt && ok "the 64 KiB block holds the palette" || fail "$(cat explained-limits-generate.txt)"
   # A profile with per-draw weights prices its own workload, or the vertices a draw is said to have.
   H=$SRC/devices/nvidia-h200.yaml
   expect 0 "explain, H200 profile" -- "$SG" explain "${DAWN[@]}" --device-profile "$H" --no-alternatives
