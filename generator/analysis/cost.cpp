@@ -621,6 +621,7 @@ void measureAccessTerms(Problem& p, const RuleSet& rules, const Rig& rig) {
       throw e;
     }
     act.terms[kTermBufferLoads] = act.terms[kTermBufferBytes] = act.terms[kTermBufferVec4Loads] = 0;
+    act.terms[kTermBufferTableLoads] = act.terms[kTermBufferTableVec4Loads] = 0;
     for (const auto& [fact, elements] : a.bufferLoads) {
       const int f = p.findFact(fact);
       if (f < 0 || p.facts[static_cast<size_t>(f)].source != Fact::Source::Buffer) continue;
@@ -629,9 +630,11 @@ void measureAccessTerms(Problem& p, const RuleSet& rules, const Rig& rig) {
       // The probe reads the semantic's own type; the program reads the buffer's layout:
       // tightly packed floats take one scalar load per component (glsl_emitter's accessor).
       auto loads = a.bufferVec4Loads.find(fact);
-      act.terms[kTermBufferLoads] += elements;
-      act.terms[kTermBufferVec4Loads] += b.element == Type::Float ? elements * componentCount(bf.type)
-                                                                   : (loads == a.bufferVec4Loads.end() ? elements : loads->second);
+      const bool table = b.kind == BufferSource::Kind::Array;  // read at a joint, not at the vertex
+      act.terms[table ? kTermBufferTableLoads : kTermBufferLoads] += elements;
+      act.terms[table ? kTermBufferTableVec4Loads : kTermBufferVec4Loads] +=
+          b.element == Type::Float ? elements * componentCount(bf.type)
+                                   : (loads == a.bufferVec4Loads.end() ? elements : loads->second);
       act.terms[kTermBufferBytes] += elements * b.strideBytes;
     }
     act.terms[kTermIndexedUniformLoads] = a.indexedUniformLoads;

@@ -297,9 +297,9 @@ Probe paletteProbe(const ProbeMesh& m, int n, bool perVertex, bool inBuffer = fa
     }
     for (int c = 0; c < 4; ++c) expectedAt(p, v, 0, c) = o[c];
   }
-  if (inBuffer) {  // storage-buffer loads, as the search counts a buffer palette's
-    p.amounts[kTermBufferLoads] = n;
-    p.amounts[kTermBufferVec4Loads] = 4 * n;  // a mat4: 4 vec4 loads
+  if (inBuffer) {  // a table's storage-buffer loads, as the search counts a buffer palette's
+    p.amounts[kTermBufferTableLoads] = n;
+    p.amounts[kTermBufferTableVec4Loads] = 4 * n;  // a mat4: 4 vec4 loads
     p.amounts[kTermBufferBytes] = 64 * n;
   } else {
     p.amounts[kTermIndexedUniformLoads] = perVertex ? n : 0;

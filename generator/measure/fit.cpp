@@ -33,7 +33,7 @@ DeviceProfile profileForm(ProfileForm form) {
       p.pipes.push_back(x);
     };
     pipe("fetch", {kTermLocations, kTermAttributeBytes});
-    pipe("memory", {kTermBufferLoads, kTermBufferVec4Loads, kTermBufferBytes});
+    pipe("memory", {kTermBufferLoads, kTermBufferVec4Loads, kTermBufferBytes, kTermBufferTableLoads, kTermBufferTableVec4Loads});
     // Uniform loads at a per-vertex index go through the constant cache, a unit of its own:
     // in one pipe with storage-buffer loads, a palette's cost hid under the fetch it adds to,
     // and the 300-bone palette was chosen at 1.56x the fastest (docs/device-profiles.md).
@@ -310,6 +310,16 @@ FitResult fitProfile(const std::vector<FitRow>& rows, const FitOptions& options)
   }
   if (form == ProfileForm::Raster && !fragments.empty()) skeleton.workloadDefaults[kFeatureFragmentsPerVertex] = medianOf(fragments);
   Layout l = layoutOf(skeleton, sizes.size() > 1);
+  // Rows of logs written before table reads were counted apart have none (their table reads are
+  // in the buffer loads): without the table terms' parameters the fit is the one it was then.
+  bool tableReads = false;
+  for (const FitRow& r : rows) tableReads |= r.amounts[kTermBufferTableLoads] > 0 || r.amounts[kTermBufferTableVec4Loads] > 0;
+  if (!tableReads) {
+    auto table = [](int t) { return t == kTermBufferTableLoads || t == kTermBufferTableVec4Loads; };
+    std::erase_if(l.additive, table);
+    std::erase_if(l.perDraw, table);
+    std::erase_if(l.pipeTerms, [&](const std::pair<size_t, int>& pt) { return table(pt.second); });
+  }
   // The pipes' sum share: how much of the pipes a program does not wait for still shows. One
   // parameter in [0, 1], fitted whenever asked (its gain on the training rows is small even
   // where it changes choices: docs/device-profiles.md, "Pipes overlap imperfectly").
@@ -369,6 +379,7 @@ FitResult fitProfile(const std::vector<FitRow>& rows, const FitOptions& options)
   for (const FitRow& r : rows) workload = std::max(workload, r.vertices);
   out.profile = toProfile(skeleton, l, best.w, workload);
   out.profile.constantCacheEntries = capacity;
+  if (!tableReads) priceTableReadsAsBufferLoads(out.profile);
   // Where a generation's mesh is unknown, price it like the median mesh the fit saw.
   if (!joints.empty()) out.profile.workloadDefaults[kFeatureJointsPerWarp] = medianOf(joints);
   if (capacity > 0 && !entries.empty()) out.profile.workloadDefaults[kFeaturePaletteEntriesPerWarp] = medianOf(entries);

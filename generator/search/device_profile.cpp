@@ -304,7 +304,43 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
     if (!priced)
       c.fail(cache, "constant_cache: no term is scaled_by joints_per_warp, so the cache's misses would price nothing");
   }
+  // A profile written before table reads were counted apart (it names neither table term) priced
+  // them as buffer loads: so it still does.
+  bool namesTableTerms = false;
+  auto names = [&](const YAML::Node& m) {
+    if (m && m.IsMap())
+      for (int t : {kTermBufferTableLoads, kTermBufferTableVec4Loads}) namesTableTerms |= bool(m[termName(t)]);
+  };
+  auto namesInPipes = [&](const YAML::Node& pipes) {
+    if (pipes && pipes.IsMap())
+      for (auto it = pipes.begin(); it != pipes.end(); ++it) names(it->second);
+  };
+  names(root["weights"]);
+  names(root["draw_weights"]);
+  names(root["scaled_by"]);
+  namesInPipes(root["pipes"]);
+  if (sizes)
+    for (auto it = sizes.begin(); it != sizes.end(); ++it) {
+      names(it->second["weights"]);
+      namesInPipes(it->second["pipes"]);
+    }
+  if (!namesTableTerms) priceTableReadsAsBufferLoads(prof);
   return prof.atDrawSize(prof.verticesPerDraw);
+}
+
+void priceTableReadsAsBufferLoads(DeviceProfile& prof) {
+  auto asBufferLoads = [](auto& ns) {
+    ns[kTermBufferTableLoads] = ns[kTermBufferLoads];
+    ns[kTermBufferTableVec4Loads] = ns[kTermBufferVec4Loads];
+  };
+  asBufferLoads(prof.nanoseconds);
+  asBufferLoads(prof.drawNanoseconds);
+  asBufferLoads(prof.scaledBy);
+  for (auto& pipe : prof.pipes) asBufferLoads(pipe.nanoseconds);
+  for (auto& d : prof.drawSizes) {
+    asBufferLoads(d.nanoseconds);
+    for (auto& pipe : d.pipes) asBufferLoads(pipe.nanoseconds);
+  }
 }
 
 TermWeights profileWeights(const DeviceProfile& priced) {

@@ -125,6 +125,10 @@ constexpr double kMaxProfileWeightNs = 1000;
 // kMaxProfileDrawWeightNs), and draw weights without vertices_per_draw.
 DeviceProfile loadDeviceProfile(const std::string& path);
 DeviceProfile parseDeviceProfile(const std::string& text, const std::string& file);
+// Prices storage-buffer table reads (kTermBufferTableLoads, kTermBufferTableVec4Loads) as the
+// profile prices buffer loads: what a profile means that was written, or fitted from logs written,
+// before they were counted apart.
+void priceTableReadsAsBufferLoads(DeviceProfile& prof);
 
 // The profile's additive weights in femtoseconds per unit of each term, per vertex at its workload.
 TermWeights profileWeights(const DeviceProfile& profile);

@@ -35,7 +35,8 @@ const char* termName(int term) {
   static const char* const names[kTermCount] = {"arithmetic",   "locations",  "attribute_bytes",
                                                 "buffer_bytes", "buffer_loads", "indexed_uniform_loads",
                                                 "buffer_vec4_loads", "indexed_uniform_vec4_loads",
-                                                "outputs",      "vertices",     "fragments"};
+                                                "outputs",      "vertices",     "fragments",
+                                                "buffer_table_loads", "buffer_table_vec4_loads"};
   return term >= 0 && term < kTermCount ? names[term] : "?";
 }
 

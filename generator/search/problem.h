@@ -58,6 +58,14 @@ enum CostTerm {
   // per fragment its draw covers (a profile scales it by the workload's fragments per vertex).
   // The same for every plan of a request: it moves the level of a prediction, not a choice.
   kTermFragments,
+  // Storage-buffer elements of a table (an array buffer: the palette in a buffer) loaded at an
+  // index computed per vertex, and their vec4 loads: counted here, not in kTermBufferLoads and
+  // kTermBufferVec4Loads, which count the per-vertex streams (a morph delta, an influence). The
+  // vertices of a warp read a few entries of a table through the cache and a stream's each its
+  // own (docs/device-profiles.md, "Table reads"). A profile that does not name them prices
+  // them as buffer loads, as it did before they were counted apart.
+  kTermBufferTableLoads,
+  kTermBufferTableVec4Loads,
   kTermCount
 };
 using TermAmounts = std::array<int64_t, kTermCount>;
@@ -66,7 +74,7 @@ const char* termName(int term);
 // Search cost units per unit of each term (int64: A* stays exact). Without a profile the
 // unit is the instruction slot; a profile's unit is the femtosecond (docs/device-profiles.md).
 using TermWeights = std::array<int64_t, kTermCount>;
-constexpr TermWeights kSlotWeights = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+constexpr TermWeights kSlotWeights = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
 // sum of weight x amount (checked: a hostile profile cannot overflow it silently).
 int64_t weighTerms(const TermWeights& w, const TermAmounts& a);
 

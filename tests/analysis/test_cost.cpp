@@ -270,9 +270,19 @@ TEST(AccessTerms, APaletteReadByTwoRulesIsLoadedOnce) {
   EXPECT_EQ(vec4Loads({skin, blend}), 16);
   EXPECT_EQ(elements({skin, blend}), 4);
   EXPECT_EQ(vec4Loads({buffered}), 16);  // influences from a buffer, the palette still uniform
-  // The palette from a storage buffer: no uniform load at all.
+  // The palette from a storage buffer: no uniform load at all, and its 4 mat4 entries are a
+  // table's loads (read at the joints), apart from the influences' per-vertex stream loads.
   EXPECT_EQ(vec4Loads({bufferPalette}), 0);
-  EXPECT_EQ(planAmounts(p, {bufferPalette})[kTermBufferVec4Loads], 16);
+  EXPECT_EQ(planAmounts(p, {bufferPalette})[kTermBufferTableLoads], 4);
+  EXPECT_EQ(planAmounts(p, {bufferPalette})[kTermBufferTableVec4Loads], 16);
+  EXPECT_EQ(planAmounts(p, {bufferPalette})[kTermBufferVec4Loads], 0);
+  // Influences from buffers: per-vertex stream loads (joints and weights, one vec4 each), no table.
+  EXPECT_EQ(planAmounts(p, {buffered})[kTermBufferLoads], 2);
+  EXPECT_EQ(planAmounts(p, {buffered})[kTermBufferTableLoads], 0);
+  const int both = action("skin_matrix_blend_buffered_influences_buffer_palette");
+  EXPECT_EQ(planAmounts(p, {both})[kTermBufferLoads], 2);
+  EXPECT_EQ(planAmounts(p, {both})[kTermBufferTableLoads], 4);
+  EXPECT_EQ(planAmounts(p, {both})[kTermBufferTableVec4Loads], 16);
 }
 }  // namespace
 }  // namespace sg

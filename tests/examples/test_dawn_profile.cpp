@@ -201,5 +201,52 @@ TEST(DawnProfile, PaletteVec4LoadsArePricedByTheSquareOfJointsPerWarp) {
   EXPECT_EQ(facePaletteItem(profile, 0).cost, 4 * one);  // unknown: the default, 2, squared
 }
 
+// Table reads from storage buffers (the palette in a buffer) are counted apart from the
+// per-vertex streams' loads since session 27. A profile that does not name them prices them as
+// buffer loads, so it means what it meant; one that prices them at nothing moves Dawn's body
+// depth pass at Dawn scale (2.62 joints per warp) to the palette in a buffer, the fastest plan the
+// H100 and the H200 timed for it (docs/device-profiles.md, "Table reads").
+TEST(DawnProfile, TableReadsArePricedAsBufferLoadsByAProfileThatDoesNotNameThem) {
+  // TABLE: lines of the memory pipe a newer profile adds.
+  auto profile = [](const std::string& table) {
+    return "device: d\nweights:\n  vertices: 0.4\npipes:\n  fetch:\n    locations: 0.5\n  memory:\n"
+           "    buffer_loads: 0.18\n    buffer_vec4_loads: 0.023\n" +
+           table +
+           "  constant:\n    indexed_uniform_loads: 0.06\n    indexed_uniform_vec4_loads: 0.015\n"
+           "scaled_by:\n  indexed_uniform_loads: joints_per_warp\n  indexed_uniform_vec4_loads: joints_per_warp\n";
+  };
+  const std::string before = profile(""), free = profile("    buffer_table_loads: 0\n    buffer_table_vec4_loads: 0\n");
+  const DeviceProfile old = parseDeviceProfile(before, "before.yaml");
+  TermAmounts table{}, streamed{};
+  table[kTermVertices] = streamed[kTermVertices] = 1;
+  table[kTermLocations] = streamed[kTermLocations] = 1;
+  table[kTermBufferLoads] = 2, table[kTermBufferVec4Loads] = 2;  // the influences
+  table[kTermBufferTableLoads] = 4, table[kTermBufferTableVec4Loads] = 16;  // the palette
+  streamed[kTermBufferLoads] = 6, streamed[kTermBufferVec4Loads] = 18;  // all counted as buffer loads
+  EXPECT_DOUBLE_EQ(old.predictNanoseconds(table, 180000), old.predictNanoseconds(streamed, 180000));
+  EXPECT_DOUBLE_EQ(old.predictNanoseconds(table, 180000), 0.4 + 6 * 0.18 + 18 * 0.023);  // the memory pipe, slowest
+  const DeviceProfile named = parseDeviceProfile(free, "named.yaml");
+  // The memory pipe reads the influences alone (0.406 ns): the fetch pipe's location is the slowest.
+  EXPECT_DOUBLE_EQ(named.predictNanoseconds(table, 180000), 0.4 + 0.5);
+
+  auto bodySkin = [&](const std::string& profileText, const char* name) {
+    GenerateOptions o;
+    o.rigPath = kDawn + "body.rig.yaml";
+    o.fragmentPath = kDawn + "depth.frag";
+    o.rulesPaths = {kDawn + "rules.yaml"};
+    o.templateDir = std::string(SG_SOURCE_DIR) + "/templates";
+    o.deviceProfilePath = writeProfile(name, profileText);
+    o.maxAttributes = 32, o.maxUniformBlockBytes = 65536;  // an H200's limits
+    o.workload.jointsPerWarp = 2.62;                       // the 'dawn' mesh's
+    const GenerateResult r = generate(o);
+    for (const std::string& rule : ruleNames(r))
+      if (rule.rfind("skin_matrix", 0) == 0) return rule;
+    return std::string("none");
+  };
+  EXPECT_EQ(bodySkin(before, "body-before"), "skin_matrix_blend_buffered_influences");
+  EXPECT_EQ(bodySkin(free, "body-table"),
+            "skin_matrix_blend_buffered_influences_buffer_palette");
+}
+
 }  // namespace
 }  // namespace sg
