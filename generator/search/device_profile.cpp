@@ -35,9 +35,9 @@ double parseNumber(const YamlCtx& c, const YAML::Node& n, const std::string& wha
 }
 
 // weights: or draw_weights: (term -> ns per unit).
-// `what` names one weight in messages ("weight", "draw weight").
+// `what` names one weight in messages ("weight", "draw weight"); `named` marks each term stated.
 void parseTermWeights(const YamlCtx& c, const YAML::Node& w, const char* section, const char* what, double max,
-                      std::array<double, kTermCount>& out) {
+                      std::array<double, kTermCount>& out, std::array<bool, kTermCount>& named) {
   c.expectMap(w, section);
   for (auto it = w.begin(); it != w.end(); ++it) {
     const std::string key = c.scalar(it->first, "weight name");
@@ -51,6 +51,7 @@ void parseTermWeights(const YamlCtx& c, const YAML::Node& w, const char* section
     }
     out[static_cast<size_t>(term)] =
         parseNumber(c, it->second, fmt::format("{} '{}'", what, key), "nanoseconds", "ns", 0, max);
+    named[static_cast<size_t>(term)] = true;
   }
 }
 
@@ -181,6 +182,7 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
                      "workload_defaults", "constant_cache", "draw_sizes", "notes"});
   DeviceProfile prof;
   prof.file = file;
+  std::array<bool, kTermCount> named{};  // the terms the profile states anywhere
   if (!root["device"]) c.fail(root, "device profile: missing 'device' (the device it was measured on)");
   prof.device = c.scalar(root["device"], "device");
   if (root["unit"] && c.scalar(root["unit"], "unit") != "ns")
@@ -190,14 +192,14 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
   // weights: and pipes: of the profile, or of one of its draw sizes.
   auto parseWeightsAndPipes = [&](const YAML::Node& weights, const YAML::Node& pipes, std::array<double, kTermCount>& ns,
                                   std::vector<DeviceProfile::Pipe>& out) {
-    parseTermWeights(c, weights, "weights", "weight", kMaxProfileWeightNs, ns);
+    parseTermWeights(c, weights, "weights", "weight", kMaxProfileWeightNs, ns, named);
     if (!pipes) return;
     c.expectMap(pipes, "pipes");
     for (auto it = pipes.begin(); it != pipes.end(); ++it) {
       DeviceProfile::Pipe pipe;
       pipe.name = c.scalar(it->first, "pipe name");
       parseTermWeights(c, it->second, "pipe", fmt::format("pipe '{}' weight", pipe.name).c_str(), kMaxProfileWeightNs,
-                       pipe.nanoseconds);
+                       pipe.nanoseconds, named);
       out.push_back(std::move(pipe));
     }
     if (out.size() > kMaxProfilePipes)
@@ -220,7 +222,7 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
   if (root["vertices_per_draw"])
     prof.verticesPerDraw = parseNumber(c, root["vertices_per_draw"], "'vertices_per_draw'", "vertices", "vertices", 1, kMaxVerticesPerDraw);
   if (root["draw_weights"]) {
-    parseTermWeights(c, root["draw_weights"], "draw_weights", "draw weight", kMaxProfileDrawWeightNs, prof.drawNanoseconds);
+    parseTermWeights(c, root["draw_weights"], "draw_weights", "draw weight", kMaxProfileDrawWeightNs, prof.drawNanoseconds, named);
     if (!root["vertices_per_draw"])
       c.fail(root["draw_weights"], "device profile: 'draw_weights' needs 'vertices_per_draw' (the workload they are spread over)");
   }
@@ -271,6 +273,7 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
         if (key == termName(t)) term = t;
       if (term < 0) c.fail(it->first, fmt::format("scaled_by: unknown cost term '{}'", key));
       prof.scaledBy[static_cast<size_t>(term)] = featureOf(it->second);
+      named[static_cast<size_t>(term)] = true;
     }
   }
   if (const YAML::Node defaults = root["workload_defaults"]) {
@@ -306,25 +309,7 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
   }
   // A profile written before table reads were counted apart (it names neither table term) priced
   // them as buffer loads: so it still does.
-  bool namesTableTerms = false;
-  auto names = [&](const YAML::Node& m) {
-    if (m && m.IsMap())
-      for (int t : {kTermBufferTableLoads, kTermBufferTableVec4Loads}) namesTableTerms |= bool(m[termName(t)]);
-  };
-  auto namesInPipes = [&](const YAML::Node& pipes) {
-    if (pipes && pipes.IsMap())
-      for (auto it = pipes.begin(); it != pipes.end(); ++it) names(it->second);
-  };
-  names(root["weights"]);
-  names(root["draw_weights"]);
-  names(root["scaled_by"]);
-  namesInPipes(root["pipes"]);
-  if (sizes)
-    for (auto it = sizes.begin(); it != sizes.end(); ++it) {
-      names(it->second["weights"]);
-      namesInPipes(it->second["pipes"]);
-    }
-  if (!namesTableTerms) priceTableReadsAsBufferLoads(prof);
+  if (!named[kTermBufferTableLoads] && !named[kTermBufferTableVec4Loads]) priceTableReadsAsBufferLoads(prof);
   return prof.atDrawSize(prof.verticesPerDraw);
 }
 
