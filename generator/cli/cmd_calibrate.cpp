@@ -137,7 +137,7 @@ struct CalibrateCommand {
       CalibrationReport rep;
       rep.profile = loadDeviceProfile(evaluate);
       // A log timed with --plans-under this profile holds the plan its search returned.
-      rep.check = checkHeldOut(readLogs(checkLogs, nullptr), rep.profile, planUnderLabel(evaluate) + "generated");
+      rep.check = checkHeldOut(readLogs(checkLogs, nullptr), rep.profile, ownPlanLabels(evaluate));
       std::cout << formatHeldOutCheck(rep.check);
       return 0;
     }

@@ -16,6 +16,7 @@
 
 #include "analysis/cost.h"
 #include "common/glsl_compile.h"
+#include "common/input_file.h"
 #include "measure/corpus.h"
 #include "measure/fit.h"
 #include "measure/workload.h"
@@ -23,6 +24,7 @@
 #include "runtime/procedural.h"
 #include "runtime/vk_render.h"
 #include "validate/program_inputs.h"
+#include "common/content_hash.h"
 
 namespace sg {
 namespace {
@@ -483,10 +485,10 @@ std::string heldOutSummary(const LeaveOneRigOut& loo, const char* what = "leave-
 constexpr double kPredictedTie = 1e-9;
 
 // Each (rig, mesh) of `rig` ("" = every rig) in `samples`: its plans predicted by `profile`.
-// A pair with a plan labelled `ownPlanLabel` ("" = none) counts that plan where it is among the
+// A pair with a plan labelled as one of `ownPlanLabels` counts that plan where it is among the
 // least predicted; where it is not, the pair is counted in *ownPlanNotLeast.
 std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& samples, const std::string& rig,
-                                    const DeviceProfile& profile, const std::string& ownPlanLabel = "",
+                                    const DeviceProfile& profile, const std::vector<std::string>& ownPlanLabels = {},
                                     size_t* ownPlanNotLeast = nullptr) {
   // One choice per (rig, request, mesh), in the samples' order; a rig timed under several
   // requests names the request in its row.
@@ -515,7 +517,7 @@ std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& sample
         continue;
       fastestNs = std::min(fastestNs, s.measuredNs);
       const auto [kept, added] = seen.emplace(s.amounts, h.measured.size());
-      if (own == kNone && !ownPlanLabel.empty() && s.label == ownPlanLabel) {
+      if (own == kNone && std::find(ownPlanLabels.begin(), ownPlanLabels.end(), s.label) != ownPlanLabels.end()) {
         own = kept->second;
         ownNs = s.measuredNs;
       }
@@ -596,15 +598,21 @@ LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, con
 }
 
 LeaveOneRigOut checkHeldOut(const std::vector<CalibrationSample>& heldOut, const DeviceProfile& profile,
-                            const std::string& ownPlanLabel) {
+                            const std::vector<std::string>& ownPlanLabels) {
   size_t notLeast = 0;
-  LeaveOneRigOut out = summarise(predictRigs(heldOut, "", profile, ownPlanLabel, &notLeast));
+  LeaveOneRigOut out = summarise(predictRigs(heldOut, "", profile, ownPlanLabels, &notLeast));
   out.ownPlanNotLeast = notLeast;
   return out;
 }
 
 std::string planUnderLabel(const std::string& profilePath) {
-  return fmt::format("plan under {}: ", std::filesystem::path(profilePath).stem().string());
+  return fmt::format("plan under {}@{}: ", std::filesystem::path(profilePath).stem().string(),
+                     sha256Hex(readInputFile(profilePath)).substr(0, kProfileFingerprintDigits));
+}
+
+std::vector<std::string> ownPlanLabels(const std::string& profilePath) {
+  return {planUnderLabel(profilePath) + "generated",
+          fmt::format("plan under {}: generated", std::filesystem::path(profilePath).stem().string())};
 }
 
 namespace {

@@ -74,7 +74,7 @@ struct CalibrationOptions {
   size_t corpus = 0;
   uint32_t corpusSeed = 1;
   // Device profiles under which each rig's plan is searched and timed too, with its forced
-  // alternatives (labelled "plan under NAME: ", NAME the file's stem). The fit pass times the
+  // alternatives (labelled planUnderLabel(PATH)). The fit pass times the
   // instruction-slot plan's neighbourhood; a profile's own plan may lie outside it, and the
   // held-out check can only call "chosen" a plan that was timed (docs/device-profiles.md,
   // "The profile's own plan").
@@ -156,7 +156,7 @@ struct HeldOutRig {
   // the slowest of them.
   size_t tiedForLeast = 0;
   // The profile's own plan, timed by calibrate --plans-under, is the one counted (checkHeldOut's
-  // ownPlanLabel), not the slowest of a tie.
+  // ownPlanLabels), not the slowest of a tie.
   bool ownPlan = false;
   double rmsRelativeError = NAN;
 };
@@ -173,14 +173,21 @@ LeaveOneRigOut leaveOneRigOut(const std::vector<CalibrationSample>& samples, con
                               double workloadVertices, double nearBestPower, const FitOptions& fit = {});
 std::string formatLeaveOneRigOut(const LeaveOneRigOut& loo);
 // The held-out check: each (rig, mesh) of samples no fit saw, its plans predicted by `profile`
-// (same figures as leave-one-rig-out). With `ownPlanLabel` (planUnderLabel(PROFILE) + "generated"),
-// a pair whose log timed the plan the profile's search returned counts that plan, where it is
-// among the least predicted.
+// (same figures as leave-one-rig-out). With `ownPlanLabels` (ownPlanLabels(PROFILE)), a pair
+// whose log timed the plan the profile's search returned counts that plan, where it is among the
+// least predicted.
 LeaveOneRigOut checkHeldOut(const std::vector<CalibrationSample>& heldOut, const DeviceProfile& profile,
-                            const std::string& ownPlanLabel = "");
-// "plan under STEM: ", the prefix of the labels of plans timed under a profile file
-// (calibrate --plans-under), STEM the file's name without its directory and extension.
+                            const std::vector<std::string>& ownPlanLabels = {});
+// "plan under STEM@FINGERPRINT: ", the prefix of the labels of plans timed under a profile file
+// (calibrate --plans-under): STEM the file's name without its directory and extension,
+// FINGERPRINT the first digits of the SHA-256 of its bytes, so a log names the very profile
+// its plans were searched under, not only a file name a later profile may take.
+constexpr size_t kProfileFingerprintDigits = 12;
 std::string planUnderLabel(const std::string& profilePath);
+// The labels a log may give the profile's own plan: planUnderLabel(PATH) + "generated", then
+// "plan under STEM: generated" as logs written before the fingerprint (session 28) have it;
+// such a row may have been searched under an earlier profile of that name.
+std::vector<std::string> ownPlanLabels(const std::string& profilePath);
 std::string formatHeldOutCheck(const LeaveOneRigOut& check);
 
 struct CalibrationReport {

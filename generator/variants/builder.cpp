@@ -17,7 +17,7 @@
 #include "emit/reflection.h"
 #include "pipeline/generate.h"
 #include "rig/rig_lod.h"
-#include "variants/content_hash.h"
+#include "common/content_hash.h"
 
 namespace sg {
 namespace {

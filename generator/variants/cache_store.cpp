@@ -10,7 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "variants/content_hash.h"
+#include "common/content_hash.h"
 
 namespace sg {
 namespace {

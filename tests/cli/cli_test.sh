@@ -597,10 +597,12 @@ device_profile)
       --no-check --refits 0 --frames 1 --rounds 1 --draws 1 --min-frame-vertices 0)
   expect 0 "calibrate --plans-under" -- "$SG" calibrate "${PU[@]}" --plans-under "$SRC/devices/nvidia-h200-raster.yaml" -o pu.yaml
   generated() { grep -E "^\| head \| $1 \| $2 \|" last.out | cut -d'|' -f5-13; }
+  # The label names the profile by its file's stem and the first 12 hex digits of its SHA-256.
+  fp=$(sha256sum "$SRC/devices/nvidia-h200-raster.yaml" | cut -c1-12)
   rigs=$(grep -oE '^\| head \| corpus-[0-9]+\.rig\.yaml \| plan: generated' last.out | cut -d'|' -f3 | tr -d ' ')
   both=0 moved=0
   for r in $rigs; do
-    a=$(generated "$r" "plan: generated") b=$(generated "$r" "plan under nvidia-h200-raster: generated")
+    a=$(generated "$r" "plan: generated") b=$(generated "$r" "plan under nvidia-h200-raster@$fp: generated")
     [ -n "$a" ] && [ -n "$b" ] && both=$((both + 1))
     [ -n "$b" ] && [ "$a" != "$b" ] && moved=$((moved + 1))
   done
@@ -608,9 +610,17 @@ device_profile)
     fail "rigs with both plans: $both, moved: $moved; $(grep -c 'plan under' last.out) rows under the profile"
   cp last.out pu.log
   expect 0 "the log reads back, its plans under the profile among them" -- "$SG" calibrate --from-log pu.log
-  n=$(grep -c '| plan under nvidia-h200-raster: ' pu.log)
+  n=$(grep -c "| plan under nvidia-h200-raster@$fp: " pu.log)
   grep -q "^fit on 'head': $(grep -cE '^\| head \| corpus-.* \| [0-9]+\.[0-9]+ \|' pu.log) samples" last.out && [ "$n" -ge 3 ] &&
     ok "every timed row fitted, the $n under the profile too" || fail "$(grep "^fit on" last.out); $n rows under the profile"
+  # --evaluate counts each rig's own plan where the log timed it under this very profile; the
+  # profile changed by one comment line, under the same name, is another profile: none is its own.
+  expect 0 "--evaluate the profile on its own plans" -- "$SG" calibrate --evaluate "$SRC/devices/nvidia-h200-raster.yaml" --check-log pu.log
+  own=$(grep -c '(its plan)' last.out)
+  mkdir -p edited && { cat "$SRC/devices/nvidia-h200-raster.yaml"; echo "# edited"; } > edited/nvidia-h200-raster.yaml
+  expect 0 "--evaluate an edited profile of the same name" -- "$SG" calibrate --evaluate edited/nvidia-h200-raster.yaml --check-log pu.log
+  [ "$own" -eq 3 ] && ! grep -q '(its plan)' last.out && ok "its own plan counted in 3 pairs, an edited profile's in none" ||
+    fail "own plans: $own under the profile, $(grep -c '(its plan)' last.out) under the edited one"
   printf 'device: "x"\nweights: [1\n' > bad-profile.yaml
   expect 1 "--plans-under a malformed profile" -- "$SG" calibrate "${PU[@]}" --plans-under bad-profile.yaml
   grep -q '^bad-profile.yaml:[0-9]*:[0-9]*: error' last.err && ! grep -q 'corpus-' last.out &&

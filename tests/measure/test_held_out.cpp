@@ -147,9 +147,17 @@ TEST(HeldOut, PlansSharingTheLeastPredictionCountAtTheSlowestOfThem) {
   EXPECT_EQ(untied.pairsWithATieForLeast, 0u);
 }
 
-TEST(HeldOut, PlanUnderLabelNamesTheProfileFilesStem) {
-  EXPECT_EQ(planUnderLabel("/work/devices/nvidia-h200-raster.yaml"), "plan under nvidia-h200-raster: ");
-  EXPECT_EQ(planUnderLabel("h100.yaml"), "plan under h100: ");
+// The label names the file's stem and the first 12 hex digits of the SHA-256 of its bytes: "abc"
+// is FIPS 180-2's first example, ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad.
+TEST(HeldOut, PlanUnderLabelNamesTheProfileFilesStemAndContents) {
+  const std::string dir = ::testing::TempDir();
+  std::ofstream(dir + "/h100.yaml") << "abc";
+  EXPECT_EQ(planUnderLabel(dir + "/h100.yaml"), "plan under h100@ba7816bf8f01: ");
+  EXPECT_EQ(ownPlanLabels(dir + "/h100.yaml"),
+            (std::vector<std::string>{"plan under h100@ba7816bf8f01: generated", "plan under h100: generated"}));
+  std::ofstream(dir + "/h100.yaml") << "abd";  // one byte more or less is another profile
+  EXPECT_NE(planUnderLabel(dir + "/h100.yaml"), "plan under h100@ba7816bf8f01: ");
+  EXPECT_THROW(planUnderLabel(dir + "/no-such-profile.yaml"), std::exception);
 }
 
 // calibrate --evaluate PROFILE on a log timed with --plans-under PROFILE: the log holds the plan
@@ -161,7 +169,7 @@ TEST(HeldOut, TheProfilesOwnPlanIsCountedWhereTheLogTimedIt) {
   // Predicted 5, 5 and 7 (as above); measured 5, 6 and 5.5: the fastest is 5.
   {  // its own plan is the faster of the tie: 5 / 5
     const LeaveOneRigOut check =
-        checkHeldOut({plan(own, 4, 0, 5), plan("plan under r: forced x", 4, 4, 6), plan("plan: forced y", 6, 0, 5.5)}, p, own);
+        checkHeldOut({plan(own, 4, 0, 5), plan("plan under r: forced x", 4, 4, 6), plan("plan: forced y", 6, 0, 5.5)}, p, {own});
     ASSERT_EQ(check.rows.size(), 1u);
     EXPECT_TRUE(check.rows[0].ownPlan);
     EXPECT_DOUBLE_EQ(check.rows[0].chosenOverFastest, 1.0);
@@ -180,7 +188,7 @@ TEST(HeldOut, TheProfilesOwnPlanIsCountedWhereTheLogTimedIt) {
   }
   {  // its own plan is the slower of the tie: 6 / 5
     const LeaveOneRigOut check =
-        checkHeldOut({plan("plan: generated", 4, 0, 5), plan(own, 4, 4, 6), plan("plan: forced y", 6, 0, 5.5)}, p, own);
+        checkHeldOut({plan("plan: generated", 4, 0, 5), plan(own, 4, 4, 6), plan("plan: forced y", 6, 0, 5.5)}, p, {own});
     ASSERT_EQ(check.rows.size(), 1u);
     EXPECT_TRUE(check.rows[0].ownPlan);
     EXPECT_DOUBLE_EQ(check.rows[0].chosenOverFastest, 1.2);
@@ -192,7 +200,7 @@ TEST(HeldOut, TheProfilesOwnPlanIsCountedWhereTheLogTimedIt) {
     const LeaveOneRigOut check =
         checkHeldOut({plan("plan: generated", 4, 0, 5), plan("plan: forced x", 4, 4, 6), plan("plan: forced y", 6, 0, 5.5),
                       plan("plan: forced z", 4, 0, 4.5), plan(own, 4, 4, 6.6)},
-                     p, own);
+                     p, {own});
     ASSERT_EQ(check.rows.size(), 1u);
     EXPECT_EQ(check.rows[0].plans, 3u);
     EXPECT_TRUE(check.rows[0].ownPlan);
@@ -219,7 +227,7 @@ TEST(HeldOut, AnOwnPlanThatIsNotLeastPredictedFallsBackToTheLeastPredicted) {
   const std::string own = "plan under r: generated";
   // Its plan predicted 7 against the least 5, shared by plans measured 5 and 6: 6 / 5.
   const LeaveOneRigOut check =
-      checkHeldOut({plan("plan: generated", 4, 0, 5), plan("plan: forced x", 4, 4, 6), plan(own, 6, 0, 5.5)}, p, own);
+      checkHeldOut({plan("plan: generated", 4, 0, 5), plan("plan: forced x", 4, 4, 6), plan(own, 6, 0, 5.5)}, p, {own});
   expectTheSlowestOfTheTie(check, 1);
   const std::string text = formatHeldOutCheck(check);
   EXPECT_NE(text.find("; in 1 the log's plan under that name is not the least predicted (searched under another profile "
@@ -236,12 +244,29 @@ TEST(HeldOut, WithoutAnOwnPlanLabelTheTieRuleHolds) {
                                                   plan("plan: forced y", 6, 0, 5.5)};
   for (const std::string& label : {std::string(), std::string("plan under other: generated")}) {
     SCOPED_TRACE(label);
-    const LeaveOneRigOut check = checkHeldOut(samples, p, label);
+    const LeaveOneRigOut check = checkHeldOut(samples, p, {label});
     expectTheSlowestOfTheTie(check, 0);
     const std::string text = formatHeldOutCheck(check);
     EXPECT_EQ(text.find("its plan"), std::string::npos) << text;
     EXPECT_EQ(text.find("plans-under"), std::string::npos) << text;
   }
+}
+
+// A log's plan under another version of the profile (same name, other fingerprint) is not its plan:
+// the tie rule holds, and no row says the name matched.
+TEST(HeldOut, APlanUnderAnotherFingerprintOfTheNameIsNotTheProfilesOwn) {
+  const DeviceProfile p = twoPipeRoofline();
+  const std::vector<std::string> labels = {"plan under r@000000000001: generated", "plan under r: generated"};
+  const LeaveOneRigOut other = checkHeldOut(
+      {plan("plan under r@0000000000ff: generated", 4, 0, 5), plan("plan: forced x", 4, 4, 6), plan("plan: forced y", 6, 0, 5.5)},
+      p, labels);
+  expectTheSlowestOfTheTie(other, 0);
+  // The same row under this fingerprint is its plan: 5 / 5.
+  const LeaveOneRigOut same = checkHeldOut(
+      {plan(labels[0], 4, 0, 5), plan("plan: forced x", 4, 4, 6), plan("plan: forced y", 6, 0, 5.5)}, p, labels);
+  ASSERT_EQ(same.rows.size(), 1u);
+  EXPECT_TRUE(same.rows[0].ownPlan);
+  EXPECT_DOUBLE_EQ(same.rows[0].chosenOverFastest, 1.0);
 }
 
 TEST(HeldOut, TheProfileRecordsTheSummary) {

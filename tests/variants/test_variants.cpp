@@ -17,7 +17,7 @@
 #include "pipeline/generate.h"
 #include "variants/builder.h"
 #include "variants/cache_store.h"
-#include "variants/content_hash.h"
+#include "common/content_hash.h"
 #include "variants/manifest.h"
 
 namespace fs = std::filesystem;

@@ -1,6 +1,7 @@
-// SHA-256 of byte strings, for the content-addressed variant cache: a key must change
-// whenever any input byte does, and an entry read from another machine is checked against
-// its digest. Computed by OpenSSL's libcrypto (EVP), not by hand.
+// SHA-256 of byte strings: the keys of the content-addressed variant cache (a key must change
+// whenever any input byte does, and an entry read from another machine is checked against its
+// digest) and the fingerprint naming a device profile in calibrate's logs. Computed by OpenSSL's
+// libcrypto (EVP), not by hand.
 #pragma once
 #include <memory>
 #include <string>

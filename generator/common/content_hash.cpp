@@ -1,4 +1,4 @@
-#include "variants/content_hash.h"
+#include "common/content_hash.h"
 
 #include <openssl/evp.h>
 
