@@ -20,6 +20,7 @@
 #include "cli/whole_model.h"
 #include "measure/calibrate.h"
 #include "measure/corpus.h"
+#include "measure/fit.h"
 
 namespace sg {
 namespace {
@@ -32,6 +33,7 @@ struct CalibrateCommand {
   bool noCheck = false;
   bool noProbes = false;
   std::string form = "additive";
+  std::string outsidePipes;  // --outside-pipes, "" = the form's own
   std::vector<std::string> fromLogs, checkLogs;
   std::string evaluate;  // --evaluate PROFILE: the held-out check of an existing profile
   std::string writeCorpus;  // --write-corpus DIR: the corpus's files, no device
@@ -122,8 +124,33 @@ struct CalibrateCommand {
     return form == "roofline" ? ProfileForm::Roofline : form == "raster" ? ProfileForm::Raster : ProfileForm::Additive;
   }
 
+  // --outside-pipes: "none" or term names, each one a pipe of the form prices.
+  void parseOutsidePipes() {
+    if (outsidePipes.empty()) return;
+    if (co.fit.form == ProfileForm::Additive)
+      throw CLI::ValidationError("--outside-pipes", "needs --form roofline or raster (the additive form has no pipes)");
+    std::vector<int> terms;
+    if (outsidePipes != "none") {
+      const DeviceProfile pipes = profileForm(co.fit.form);
+      for (size_t start = 0; start <= outsidePipes.size();) {
+        const size_t comma = std::min(outsidePipes.find(',', start), outsidePipes.size());
+        const std::string name = outsidePipes.substr(start, comma - start);
+        int term = -1;
+        for (int t = 0; t < kTermCount; ++t)
+          for (const auto& pipe : pipes.pipes)
+            if (name == termName(t) && pipe.nanoseconds[size_t(t)] > 0) term = t;
+        if (term < 0)
+          throw CLI::ValidationError("--outside-pipes", fmt::format("'{}' is not a term any pipe of the {} form prices", name, form));
+        if (std::count(terms.begin(), terms.end(), term) == 0) terms.push_back(term);
+        start = comma + 1;
+      }
+    }
+    co.fit.outsidePipes = terms;
+  }
+
   int run() {
     co.fit.form = chosenForm();
+    parseOutsidePipes();
     if (co.fit.constantCache && co.fit.form == ProfileForm::Additive)
       throw CLI::ValidationError("--constant-cache", "needs --form roofline or raster (the cache's misses are priced in the constant pipe)");
     if (co.fit.pipeSumShare && co.fit.form == ProfileForm::Additive)
@@ -301,6 +328,11 @@ void registerCalibrate(CLI::App& app, CliState& state) {
                 "With --form roofline or raster: fit how imperfectly the pipes overlap, a program paying besides its "
                 "slowest pipe a share of the others (pipe_sum_share, 0 to 1; docs/device-profiles.md, "
                 "\"Pipes overlap imperfectly\")");
+  sub->add_option("--outside-pipes", cmd->outsidePipes,
+                  "With --form roofline or raster: the terms priced in the additive part as well as in their pipe (the "
+                  "share of their cost the device does not overlap), comma-separated term names, or none. Default: "
+                  "locations,buffer_loads,buffer_vec4_loads for raster, none for roofline (docs/device-profiles.md, "
+                  "\"Inputs outside the overlap\")");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer (use for timings)");
   addOneProcessFlag(*sub, cmd->oneProcess, "rig");
   sub->add_option("--time-rig", cmd->timeRig)->group("");  // a fresh process's one rig (cli/fresh_process.h)

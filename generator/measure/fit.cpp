@@ -44,6 +44,11 @@ DeviceProfile profileForm(ProfileForm form) {
   return p;
 }
 
+std::vector<int> outsidePipesOf(ProfileForm form) {
+  if (form == ProfileForm::Raster) return {kTermLocations, kTermBufferLoads, kTermBufferVec4Loads};
+  return {};
+}
+
 namespace {
 
 // The parameters: a block of per-vertex additive weights (the additive form: every term but
@@ -70,11 +75,14 @@ struct Layout {
   size_t size() const { return missIndex() + (miss ? 1 : 0); }
 };
 
-Layout layoutOf(const DeviceProfile& form, bool drawWeights) {
+// `outside`: terms in the additive part besides their pipe (FitOptions::outsidePipes).
+Layout layoutOf(const DeviceProfile& form, bool drawWeights, const std::vector<int>& outside) {
   Layout l;
   const bool raster = form.scaledBy[kTermFragments] == kFeatureFragmentsPerVertex;
   for (int t = 0; t < kTermCount; ++t)
-    if (t == kTermFragments ? raster : (form.pipes.empty() || t == kTermVertices)) l.additive.push_back(t);
+    if (t == kTermFragments ? raster
+                            : (form.pipes.empty() || t == kTermVertices || std::count(outside.begin(), outside.end(), t)))
+      l.additive.push_back(t);
   if (drawWeights && !raster)
     for (int t = 0; t < kTermCount; ++t) l.perDraw.push_back(t);
   l.pipes = form.pipes.size();
@@ -309,7 +317,7 @@ FitResult fitProfile(const std::vector<FitRow>& rows, const FitOptions& options)
     if (r.workload.jointsPerWarp > 0) joints.push_back(r.workload.jointsPerWarp);
   }
   if (form == ProfileForm::Raster && !fragments.empty()) skeleton.workloadDefaults[kFeatureFragmentsPerVertex] = medianOf(fragments);
-  Layout l = layoutOf(skeleton, sizes.size() > 1);
+  Layout l = layoutOf(skeleton, sizes.size() > 1, options.outsidePipes.value_or(outsidePipesOf(form)));
   // Rows of logs written before table reads were counted apart have none (their table reads are
   // in the buffer loads): without the table terms' parameters the fit is the one it was then.
   bool tableReads = false;
@@ -328,6 +336,10 @@ FitResult fitProfile(const std::vector<FitRow>& rows, const FitOptions& options)
   for (const FitRow& r : rows) xs.push_back(scaledAmounts(skeleton, r));
 
   const std::vector<bool> within(rows.size(), false);
+  // A term is kept where it lowers the weighted squared error by kMinTermGain, and by more than
+  // rounding: on rows a fit already prices exactly (both costs about 1e-28) either may be lower.
+  const double negligible = kNegligibleRelativeError * kNegligibleRelativeError * double(rows.size());
+  auto gains = [&](double with, double without) { return with < (1 - kMinTermGain) * without - negligible; };
   Solved best = solve(l, rows, xs, within);
   // Draw sizes (docs/device-profiles.md, "Draw sizes"): a block of weights per mesh size with
   // enough rows, kept where it explains kMinTermGain of the squared error.
@@ -340,7 +352,7 @@ FitResult fitProfile(const std::vector<FitRow>& rows, const FitOptions& options)
     sized.shared.assign(l.block(), false);
     for (size_t j = 0; j < l.additive.size(); ++j) sized.shared[j] = l.additive[j] == kTermFragments;
     if (sized.sizes.size() >= 2)
-      if (Solved s = solve(sized, rows, xs, within); s.cost < (1 - kMinTermGain) * best.cost) best = std::move(s), l = sized;
+      if (Solved s = solve(sized, rows, xs, within); gains(s.cost, best.cost)) best = std::move(s), l = sized;
   }
   // The constant cache's capacity (docs/device-profiles.md, "The constant cache's capacity"):
   // each threshold between the footprints the rows read, with a miss factor fitted beside the
@@ -366,7 +378,7 @@ FitResult fitProfile(const std::vector<FitRow>& rows, const FitOptions& options)
       Solved s = solve(withMiss, rows, xs, past);
       if (s.cost < bestWithMiss) bestWithMiss = s.cost, chosen = s, capacity = c;
     }
-    if (capacity > 0 && bestWithMiss < (1 - kMinTermGain) * best.cost) {
+    if (capacity > 0 && gains(bestWithMiss, best.cost)) {
       best = chosen;
       l = withMiss;
     } else {

@@ -3,8 +3,10 @@
 // solved by Ceres Solver (bounded nonlinear least squares). Two forms of model:
 //   additive  ns = sum_t (w_t + d_t / V) x_t                      (every profile before issue 33)
 //   roofline  ns = sum_t (w_t + d_t / V) x_t  +  max_p sum_{t in p} w_pt x_t
-//   raster    the roofline without per-draw weights, its additive part the fixed cost per vertex
-//             and one per fragment the draw covers (x_fragments scaled by fragments per vertex)
+//   raster    the roofline without per-draw weights, its additive part the fixed cost per vertex,
+//             one per fragment the draw covers (x_fragments scaled by fragments per vertex) and
+//             the share of input locations and storage-buffer loads outside the overlap
+//             (FitOptions::outsidePipes)
 // where x_t is the amount of term t, scaled by a workload feature where the form says so
 // (uniform loads at a per-vertex index, elements and vec4s, by the joints a warp reads), and
 // V the vertices per draw. In the roofline form the additive part holds the per-vertex fixed
@@ -14,6 +16,7 @@
 // stood in for on the H200 (docs/device-profiles.md, "The rasterizer's share"): the fragments a
 // draw covers, counted by the device.
 #pragma once
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,10 +43,22 @@ struct FitOptions {
   bool constantCache = false;  // roofline and raster forms
   bool drawSizes = false;      // raster form
   bool pipeSumShare = false;   // roofline and raster forms
+  // Roofline and raster forms: the terms priced in the additive part as well as in their pipe,
+  // the share of their cost the device does not overlap with the other pipes. Unset: the
+  // form's own (outsidePipesOf).
+  std::optional<std::vector<int>> outsidePipes;
   FitOptions() = default;
   FitOptions(ProfileForm f, bool cache = false, bool sizes = false, bool share = false)
       : form(f), constantCache(cache), drawSizes(sizes), pipeSumShare(share) {}
 };
+
+// The terms a form prices outside its pipes as well as in them (FitOptions::outsidePipes unset).
+// The raster form: a vertex's input locations and its storage-buffer loads (and their vec4s).
+// Fitted so on the H200's and the H100's training logs, they came out at about a quarter of a
+// location's price (0.12-0.16 ns against 0.32-0.36 in the fetch pipe) and most of a vec4 load's,
+// and the profiles chose and ranked held-out plans better than with every term inside its pipe
+// (docs/device-profiles.md, "Inputs outside the overlap"). The roofline form: none.
+std::vector<int> outsidePipesOf(ProfileForm form);
 
 struct FitResult {
   DeviceProfile profile;       // device and file left empty
@@ -65,6 +80,8 @@ constexpr size_t kMinRowsPerSideOfCapacity = 3;
 // draw sizes and the constant cache, which then keep it.
 constexpr double kLeastPipeSumShare = 0.001;
 constexpr double kMinTermGain = 0.02;  // of the weighted squared error, for a term to be kept
+// A relative error per row below which a fit counts as exact (no term can lower it further).
+constexpr double kNegligibleRelativeError = 1e-6;
 
 // Per-draw weights only when the rows' draws differ in size (else they cannot be told apart
 // from per-vertex ones). Deterministic: same rows, same weights. Throws std::runtime_error

@@ -621,6 +621,15 @@ device_profile)
   expect 0 "--evaluate an edited profile of the same name" -- "$SG" calibrate --evaluate edited/nvidia-h200-raster.yaml --check-log pu.log
   [ "$own" -eq 3 ] && ! grep -q '(its plan)' last.out && ok "its own plan counted in 3 pairs, an edited profile's in none" ||
     fail "own plans: $own under the profile, $(grep -c '(its plan)' last.out) under the edited one"
+  # --outside-pipes: the raster form prices locations and buffer loads outside the pipes too by
+  # default; "none" is the form before (every term inside its pipe); names are checked.
+  expect 0 "--outside-pipes none" -- "$SG" calibrate --from-log pu.log --form raster --outside-pipes none -o inside.yaml
+  expect 0 "the raster form's default" -- "$SG" calibrate --from-log pu.log --form raster -o outside.yaml
+  awk '/^weights:/{w=1} /^pipes:/{w=0} w && /^  locations:/{print $2}' inside.yaml | grep -qx 0 &&
+    ok "none: locations priced in the fetch pipe only" || fail "$(grep -A3 '^weights' inside.yaml)"
+  expect 2 "--outside-pipes an unknown term" -- "$SG" calibrate --from-log pu.log --form raster --outside-pipes locations,bogus
+  grep -q "'bogus' is not a term any pipe of the raster form prices" last.err && ok "names the term" || fail "$(cat last.err)"
+  expect 2 "--outside-pipes with the additive form" -- "$SG" calibrate --from-log pu.log --outside-pipes locations
   printf 'device: "x"\nweights: [1\n' > bad-profile.yaml
   expect 1 "--plans-under a malformed profile" -- "$SG" calibrate "${PU[@]}" --plans-under bad-profile.yaml
   grep -q '^bad-profile.yaml:[0-9]*:[0-9]*: error' last.err && ! grep -q 'corpus-' last.out &&

@@ -432,6 +432,48 @@ TEST(Calibrate, TheRasterFitPricesTheFragmentsADrawCovers) {
 // A device with a constant cache of `capacity` palette entries: a warp whose footprint is larger
 // pays `miss` times the constant pipe's per-address price (an LRU cache under a warp's cyclic
 // reuse misses every time). Footprints vary independently of joints per warp, as the head's do.
+// A device that overlaps its pipes except for a share of each input location and storage-buffer
+// load, paid by every vertex beside the slowest pipe (as the H200's and H100's logs fit:
+// docs/device-profiles.md, "Inputs outside the overlap").
+constexpr double kLocationOutside = 0.12, kLoadOutside = 0.03;
+std::vector<CalibrationSample> outsideRows(uint32_t seed, int n) {
+  std::vector<CalibrationSample> out = rasterRows(seed, n, 0.05);
+  for (auto& s : out)
+    s.measuredNs += kLocationOutside * double(s.amounts[kTermLocations]) + kLoadOutside * double(s.amounts[kTermBufferLoads]);
+  return out;
+}
+
+TEST(Calibrate, TheRasterFitPricesTheShareOfInputsThePipesDoNotOverlap) {
+  const std::vector<CalibrationSample> train = outsideRows(1, 200), test = outsideRows(2, 80);
+  const DeviceProfile raster = fitDeviceProfile(train, "outside device", 180000, 0, ProfileForm::Raster);
+  const roofline::Device d;
+  EXPECT_NEAR(raster.nanoseconds[kTermLocations], kLocationOutside, 0.01);
+  EXPECT_NEAR(raster.nanoseconds[kTermBufferLoads], kLoadOutside, 0.005);
+  EXPECT_NEAR(raster.pipes[0].nanoseconds[kTermLocations], d.location, 0.02);
+  EXPECT_NEAR(raster.pipes[1].nanoseconds[kTermBufferLoads], d.load, 0.01);
+  EXPECT_LT(rmsRelativeError(raster, test), 0.01);
+  // Every term inside its pipe (--outside-pipes none, the raster form before session 28) cannot say it.
+  FitOptions inside(ProfileForm::Raster);
+  inside.outsidePipes = std::vector<int>{};
+  const DeviceProfile pure = fitDeviceProfile(train, "outside device", 180000, 0, inside);
+  EXPECT_EQ(pure.nanoseconds[kTermLocations], 0);
+  EXPECT_GT(rmsRelativeError(pure, test), 0.02);
+  // A choice that turns on it, on one mesh: 8 locations, against 6 and 20 buffer loads. The device
+  // pays 0.3 + 0.96 + 2.8 = 4.06 ns for the first and 0.3 + 0.72 + 0.6 + max(2.1, 1.4) = 3.72 for
+  // the second.
+  TermAmounts attributes{}, buffered{};
+  attributes[kTermVertices] = buffered[kTermVertices] = 1;
+  attributes[kTermLocations] = 8, buffered[kTermLocations] = 6, buffered[kTermBufferLoads] = 20;
+  DeviceProfile at = raster;
+  at.workload.fragmentsPerVertex = 0;
+  EXPECT_NEAR(at.predictNanoseconds(attributes, 180000), 4.06, 0.04);
+  EXPECT_NEAR(at.predictNanoseconds(buffered, 180000), 3.72, 0.04);
+  // The default raster form on a device that overlaps everything (rasterRows) finds no share.
+  const DeviceProfile overlapped = fitDeviceProfile(rasterRows(1, 200, 0.05), "raster device", 180000, 0, ProfileForm::Raster);
+  EXPECT_LT(overlapped.nanoseconds[kTermLocations], 0.005);
+  EXPECT_LT(overlapped.nanoseconds[kTermBufferLoads], 0.001);
+}
+
 std::vector<CalibrationSample> cacheRows(uint32_t seed, int n, double capacity, double miss) {
   std::vector<CalibrationSample> out = rasterRows(seed, n, 0.05);
   std::mt19937 rng(seed + 200);

@@ -18,7 +18,7 @@ for fit in raster constant-cache draw-sizes draw-sizes+constant-cache; do
   flags=()
   [[ $fit == *constant-cache* ]] && flags+=(--constant-cache)
   [[ $fit == draw-sizes* ]] && flags+=(--draw-sizes)
-  (cd "$here" && "$sg" calibrate --from-log train.log "${check[@]}" --form raster --near-best-weight 0 "${flags[@]}" -o "$tmp/p.yaml") |
+  (cd "$here" && "$sg" calibrate --from-log train.log "${check[@]}" --form raster --outside-pipes none --near-best-weight 0 "${flags[@]}" -o "$tmp/p.yaml") |
     grep -v ": device profile of" > "$here/fit-$fit.txt"
   cp "$tmp/p.yaml" "$here/fit-$fit.yaml"
   {

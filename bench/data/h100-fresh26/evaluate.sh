@@ -22,7 +22,7 @@ summarize() {  # NAME FILE
   awk '/^held-out check:/{h=1} h && /^\|/' "$2" | awk -F'|' -v f="$1" '$6+0 > 1.05 {print f ": over 5 %:" $2 "|" $3 "|" $6}'
 }
 fit() {  # NAME TRAIN_LOG: the raster form fitted on TRAIN_LOG, checked on the fresh held-out logs
-  (cd "$here" && "$sg" calibrate --from-log "$2" "${check[@]}" --form raster --near-best-weight 0 -o "$tmp/p.yaml") |
+  (cd "$here" && "$sg" calibrate --from-log "$2" "${check[@]}" --form raster --outside-pipes none --near-best-weight 0 -o "$tmp/p.yaml") |
     grep -v ": device profile of" > "$here/fit-$1.txt"
   cp "$tmp/p.yaml" "$here/fit-$1.yaml"
 }

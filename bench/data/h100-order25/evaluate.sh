@@ -21,7 +21,7 @@ summarize() {  # NAME FILE
   grep -E '^held-out check over' "$2" | sed "s/^/$1: /"
   awk '/^held-out check:/{h=1} h && /^\|/' "$2" | awk -F'|' -v f="$1" '$6+0 > 1.05 {print f ": over 5 %:" $2 "|" $3 "|" $6}'
 }
-(cd "$here" && "$sg" calibrate --from-log call2/s2/train.log "${check[@]}" --form raster --near-best-weight 0 -o "$tmp/p.yaml") |
+(cd "$here" && "$sg" calibrate --from-log call2/s2/train.log "${check[@]}" --form raster --outside-pipes none --near-best-weight 0 -o "$tmp/p.yaml") |
   grep -v ": device profile of" > "$here/fit-raster.txt"
 cp "$tmp/p.yaml" "$here/fit-raster.yaml"
 summarize "raster refitted on the staged H100 train.log" "$here/fit-raster.txt" >> "$here/summary.txt"

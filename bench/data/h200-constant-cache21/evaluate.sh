@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The constant cache's capacity fitted on session 18's H200 training log and checked on the
 # held-out logs of sessions 18 and 19, once the logs carry palette footprints (augment.py):
-#   fit-capacity.txt   calibrate --form raster --constant-cache   (the profile: fit-capacity.yaml)
+#   fit-capacity.txt   calibrate --form raster --outside-pipes none --constant-cache   (the profile: fit-capacity.yaml)
 #   fit-without.txt    the same logs, the same form, no capacity   (fit-without.yaml)
 #   fit-blind.txt      the footprints removed (augment.py blind): what --constant-cache can do without them
 #   shipped.txt        devices/nvidia-h200-raster.yaml on the augmented held-out logs
@@ -22,7 +22,7 @@ python3 "$here/augment.py" "$logs" "$tmp/aug"
 python3 "$here/augment.py" "$A/train.log" "$tmp/blind" blind
 check=()
 for g in "${held[@]}" "${unseen[@]}"; do check+=(--check-log "$tmp/aug/$g.log"); done
-fit=(--form raster --near-best-weight 0)
+fit=(--form raster --outside-pipes none --near-best-weight 0)
 "$sg" calibrate --from-log "$tmp/aug/train.log" "${check[@]}" "${fit[@]}" --constant-cache -o "$tmp/c.yaml" | grep -v ": device profile of" > "$here/fit-capacity.txt"
 "$sg" calibrate --from-log "$tmp/aug/train.log" "${check[@]}" "${fit[@]}" -o "$tmp/w.yaml" | grep -v ": device profile of" > "$here/fit-without.txt"
 "$sg" calibrate --from-log "$tmp/blind/train.log" "${check[@]}" "${fit[@]}" --constant-cache -o "$tmp/b.yaml" | grep -v ": device profile of" > "$here/fit-blind.txt"

@@ -24,7 +24,7 @@ for fit in raster constant-cache draw-sizes draw-sizes+constant-cache; do
   flags=()
   [[ $fit == *constant-cache* ]] && flags+=(--constant-cache)
   [[ $fit == draw-sizes* ]] && flags+=(--draw-sizes)
-  "$sg" calibrate --from-log "$tmp/train.log" "${check[@]}" --form raster --near-best-weight 0 "${flags[@]}" -o "$tmp/p.yaml" |
+  "$sg" calibrate --from-log "$tmp/train.log" "${check[@]}" --form raster --outside-pipes none --near-best-weight 0 "${flags[@]}" -o "$tmp/p.yaml" |
     grep -v ": device profile of" > "$here/fit-$fit.txt"
   grep -v '^# held-out' "$tmp/p.yaml" > "$here/fit-$fit.yaml"
   {

@@ -34,7 +34,7 @@ for fit in raster draw-sizes+constant-cache both-logs; do
   flags=() logs=(--from-log "$here/train.log")
   [[ $fit == draw-sizes* ]] && flags+=(--draw-sizes --constant-cache)
   [[ $fit == both-logs ]] && logs+=(--from-log "$tmp/train.log")
-  "$sg" calibrate "${logs[@]}" "${check[@]}" --form raster --near-best-weight 0 "${flags[@]}" -o "$tmp/p.yaml" |
+  "$sg" calibrate "${logs[@]}" "${check[@]}" --form raster --outside-pipes none --near-best-weight 0 "${flags[@]}" -o "$tmp/p.yaml" |
     grep -v ": device profile of" > "$here/fit-$fit.txt"
   grep -v '^# held-out' "$tmp/p.yaml" > "$here/fit-$fit.yaml"
 done

@@ -25,7 +25,7 @@ done
 for f in "$N"/public-models/*.log; do models+=(--check-log "$f"); done
 for g in world corpus-heldout corpus-heldout-seed4 body-depth pbr models models-fox unseen unseen-formats unseen-models; do h100+=(--check-log "$C/$g.log"); done
 for fit in raster share; do
-  flags=(--form raster --near-best-weight 0)
+  flags=(--form raster --outside-pipes none --near-best-weight 0)
   [[ $fit == share ]] && flags+=(--pipe-sum-share)
   "$sg" calibrate --from-log "$D/train.log" "${old[@]}" "${flags[@]}" -o "$here/h200-$fit.yaml" | grep -v ": device profile of" > "$here/h200-$fit.txt"
   "$sg" calibrate --evaluate "$here/h200-$fit.yaml" "${fresh[@]}" > "$here/h200-$fit-fresh.txt"

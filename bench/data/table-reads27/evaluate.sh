@@ -25,7 +25,7 @@ check() {  # DIR LOG...: --check-log arguments (an augmented copy's name has '-'
 }
 fit() {  # NAME TRAIN CHECKS...
   local name=$1 train=$2; shift 2
-  "$sg" calibrate --from-log "$train" "$@" --form raster --near-best-weight 0 -o "$here/fit-$name.yaml" | grep -v ": device profile of" > "$here/fit-$name.txt"
+  "$sg" calibrate --from-log "$train" "$@" --form raster --outside-pipes none --near-best-weight 0 -o "$here/fit-$name.yaml" | grep -v ": device profile of" > "$here/fit-$name.txt"
 }
 fit h200 "$tmp/h200/train.log" $(check "$tmp/h200" "${h200[@]}")
 fit h200-before "$H2/train.log" $(check "$H2" "${h200[@]}")
