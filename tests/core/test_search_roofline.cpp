@@ -316,14 +316,18 @@ TEST(SearchRoofline, PipesThatOverlapImperfectlyPayAShareOfTheOthers) {
 }
 
 // The search's components of a profile with a share reproduce its definition (additive + (1 - s)
-// x slowest pipe + s x every pipe, DeviceProfile::predictNanoseconds) for random pipes, shares
-// and amounts: the largest component is that sum, to the femtosecond rounding of each weight.
+// x slowest pipe + s x every pipe, DeviceProfile::predictNanoseconds) for random pipes, shares,
+// additive weights (on terms in pipes too) and amounts: the largest component is that sum, to the
+// femtosecond rounding of each weight.
 TEST(SearchRooflineProperty, ComponentsOfASharedProfileAreItsDefinition) {
   std::mt19937 rng(33);
   auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
   for (int instance = 0; instance < 300; ++instance) {
     DeviceProfile prof;
     prof.nanoseconds[kTermVertices] = uniform(0, 2);
+    // Terms priced in the additive part too (the raster form's share outside the overlap).
+    for (size_t t = 0; t < kTermCount; ++t)
+      if (t != kTermVertices && t != kTermFragments && uniform(0, 1) < 0.3) prof.nanoseconds[t] = uniform(0, 0.3);
     const int pipes = 2 + instance % 4;
     for (int k = 0; k < pipes; ++k) {
       DeviceProfile::Pipe pipe;
