@@ -473,8 +473,13 @@ std::string heldOutSummary(const LeaveOneRigOut& loo, const char* what = "leave-
                                                                loo.pairsWithATieForLeast)) +
          (loo.pairsWithOwnPlan == 0 ? ""
                                     : fmt::format("; in {} the profile's own plan was timed (calibrate --plans-under) and is "
-                                                  "the one counted",
-                                                  loo.pairsWithOwnPlan)) +
+                                                  "the one counted{}",
+                                                  loo.pairsWithOwnPlan,
+                                                  loo.ownPlansByNameOnly == 0
+                                                      ? ""
+                                                      : fmt::format(" ({} of them found by the profile's name only, in logs "
+                                                                    "written before the fingerprint)",
+                                                                    loo.ownPlansByNameOnly))) +
          (loo.ownPlanNotLeast == 0 ? ""
                                    : fmt::format("; in {} the log's plan under that name is not the least predicted "
                                                  "(searched under another profile of that name): the least predicted counted",
@@ -511,15 +516,18 @@ std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& sample
     std::map<TermAmounts, size_t> seen;
     constexpr size_t kNone = size_t(-1);
     size_t own = kNone;  // the profile's own plan, where the log timed it
+    bool ownByNameOnly = false;  // found by a label after the first of ownPlanLabels
     double ownNs = NAN, fastestNs = INFINITY;
     for (const auto& s : samples) {
       if (s.rig != r || s.request != request || s.mesh != mesh || !isPlanSample(s) || !s.validated || s.measuredNs <= 0)
         continue;
       fastestNs = std::min(fastestNs, s.measuredNs);
       const auto [kept, added] = seen.emplace(s.amounts, h.measured.size());
-      if (own == kNone && std::find(ownPlanLabels.begin(), ownPlanLabels.end(), s.label) != ownPlanLabels.end()) {
+      if (const auto label = std::find(ownPlanLabels.begin(), ownPlanLabels.end(), s.label);
+          own == kNone && label != ownPlanLabels.end()) {
         own = kept->second;
         ownNs = s.measuredNs;
+        ownByNameOnly = label != ownPlanLabels.begin();
       }
       if (!added) continue;
       DeviceProfile at = profile;
@@ -550,6 +558,7 @@ std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& sample
       if (h.predicted[own] <= least * (1 + kPredictedTie)) {
         chosenNs = ownNs;
         h.ownPlan = true;
+        h.ownPlanByNameOnly = ownByNameOnly;
       } else if (ownPlanNotLeast) {
         ++*ownPlanNotLeast;
       }
@@ -566,7 +575,7 @@ LeaveOneRigOut summarise(std::vector<HeldOutRig> rows) {
   out.rows = std::move(rows);
   std::vector<double> rho, rms;
   for (const auto& h : out.rows) {
-    if (h.ownPlan) ++out.pairsWithOwnPlan;
+    if (h.ownPlan) ++out.pairsWithOwnPlan, out.ownPlansByNameOnly += h.ownPlanByNameOnly;
     else if (h.tiedForLeast > 1) ++out.pairsWithATieForLeast;
     rho.push_back(h.spearman);
     rms.push_back(h.rmsRelativeError);

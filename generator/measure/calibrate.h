@@ -158,6 +158,7 @@ struct HeldOutRig {
   // The profile's own plan, timed by calibrate --plans-under, is the one counted (checkHeldOut's
   // ownPlanLabels), not the slowest of a tie.
   bool ownPlan = false;
+  bool ownPlanByNameOnly = false;  // its label had no fingerprint (ownPlanLabels' second)
   double rmsRelativeError = NAN;
 };
 struct LeaveOneRigOut {
@@ -165,6 +166,7 @@ struct LeaveOneRigOut {
   double medianSpearman = NAN, worstChosenOverFastest = NAN, medianRms = NAN, maxRms = NAN;
   size_t pairsWithATieForLeast = 0;  // rows whose least prediction several plans share (tie rule applied)
   size_t pairsWithOwnPlan = 0;       // rows counting the profile's own plan (HeldOutRig::ownPlan)
+  size_t ownPlansByNameOnly = 0;     // of them, found by the name-only label of older logs
   // Rows whose log holds a plan under the profile's name that is not the least predicted (it was
   // searched under another profile of that name): the least predicted counted.
   size_t ownPlanNotLeast = 0;

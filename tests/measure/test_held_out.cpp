@@ -266,7 +266,21 @@ TEST(HeldOut, APlanUnderAnotherFingerprintOfTheNameIsNotTheProfilesOwn) {
       {plan(labels[0], 4, 0, 5), plan("plan: forced x", 4, 4, 6), plan("plan: forced y", 6, 0, 5.5)}, p, labels);
   ASSERT_EQ(same.rows.size(), 1u);
   EXPECT_TRUE(same.rows[0].ownPlan);
+  EXPECT_FALSE(same.rows[0].ownPlanByNameOnly);
   EXPECT_DOUBLE_EQ(same.rows[0].chosenOverFastest, 1.0);
+  EXPECT_EQ(formatHeldOutCheck(same).find("by the profile's name only"), std::string::npos);
+  // A log written before the fingerprint names the profile only: its plan counts, and the summary says how it was found.
+  const LeaveOneRigOut named = checkHeldOut(
+      {plan(labels[1], 4, 0, 5), plan("plan: forced x", 4, 4, 6), plan("plan: forced y", 6, 0, 5.5)}, p, labels);
+  ASSERT_EQ(named.rows.size(), 1u);
+  EXPECT_TRUE(named.rows[0].ownPlan);
+  EXPECT_TRUE(named.rows[0].ownPlanByNameOnly);
+  EXPECT_EQ(named.ownPlansByNameOnly, 1u);
+  EXPECT_NE(formatHeldOutCheck(named).find("; in 1 the profile's own plan was timed (calibrate --plans-under) and is the one "
+                                           "counted (1 of them found by the profile's name only, in logs written before the "
+                                           "fingerprint)"),
+            std::string::npos)
+      << formatHeldOutCheck(named);
 }
 
 TEST(HeldOut, TheProfileRecordsTheSummary) {
