@@ -86,6 +86,7 @@ struct CalibrateCommand {
     for (const auto& f : fromLogs) rep.clock += " " + std::filesystem::path(f).filename().string();
     rep.driver = "as recorded (see the device)";
     rep.nearBestPower = co.nearBestPower;
+    rep.outsidePipes = co.fit.outsidePipes.value_or(outsidePipesOf(co.fit.form));
     rep.profile = fitDeviceProfile(rep.samples, rep.device, 180000, co.nearBestPower, co.fit);
     rep.fits = evaluateFit(rep.samples, rep.profile, {"dawn", "head"});
     rep.heldOut = leaveOneRigOut(rep.samples, rep.device, 180000, co.nearBestPower, co.fit);

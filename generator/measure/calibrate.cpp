@@ -946,6 +946,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   for (const auto& s : rep.samples)
     if (s.mesh == opts.meshes.front()) workload = s.vertices;
   rep.nearBestPower = rigs.empty() ? 0 : opts.nearBestPower;
+  rep.outsidePipes = opts.fit.outsidePipes.value_or(outsidePipesOf(opts.fit.form));
   if (stopped() && std::none_of(rep.samples.begin(), rep.samples.end(), [](const CalibrationSample& s) { return s.validated; }))
     throw std::runtime_error("calibration: interrupted before anything was timed: nothing to fit");
   rep.profile =
@@ -1116,7 +1117,10 @@ std::string deviceProfileYaml(const CalibrationReport& r) {
     const ProfileForm form = r.profile.pipes.empty()                                           ? ProfileForm::Additive
                              : r.profile.scaledBy[kTermFragments] == kFeatureFragmentsPerVertex ? ProfileForm::Raster
                                                                                                  : ProfileForm::Roofline;
-    s += fmt::format("# form: {}\n", profileFormName(form));
+    std::string outside;
+    if (!r.profile.pipes.empty())
+      for (int t : r.outsidePipes) outside += (outside.empty() ? " (outside the pipes too: " : ", ") + std::string(termName(t));
+    s += fmt::format("# form: {}{}\n", profileFormName(form), outside.empty() ? "" : outside + ")");
   }
   s += fmt::format("device: \"{}\"\nunit: ns\n", r.profile.device);
   return s + weightLines(r.profile);

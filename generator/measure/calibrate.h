@@ -197,6 +197,7 @@ struct CalibrationReport {
   std::string clock;  // what measured the samples: GPU timestamps, or host time on a CPU device
   std::vector<CalibrationSample> samples;
   double nearBestPower = 0;  // of the fit (CalibrationOptions)
+  std::vector<int> outsidePipes;  // the terms the fit priced outside the pipes too (FitOptions::outsidePipes, resolved)
   DeviceProfile profile;
   std::vector<CalibrationFit> fits;  // one per mesh
   std::vector<CalibrationCheck> checks;

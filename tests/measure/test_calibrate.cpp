@@ -468,6 +468,13 @@ TEST(Calibrate, TheRasterFitPricesTheShareOfInputsThePipesDoNotOverlap) {
   at.workload.fragmentsPerVertex = 0;
   EXPECT_NEAR(at.predictNanoseconds(attributes, 180000), 4.06, 0.04);
   EXPECT_NEAR(at.predictNanoseconds(buffered, 180000), 3.72, 0.04);
+  // The profile says how it was fitted.
+  CalibrationReport r;
+  r.profile = raster;
+  r.outsidePipes = outsidePipesOf(ProfileForm::Raster);
+  EXPECT_NE(deviceProfileYaml(r).find("# form: raster (outside the pipes too: locations, buffer_loads, buffer_vec4_loads)\n"),
+            std::string::npos)
+      << deviceProfileYaml(r);
   // The default raster form on a device that overlaps everything (rasterRows) finds no share.
   const DeviceProfile overlapped = fitDeviceProfile(rasterRows(1, 200, 0.05), "raster device", 180000, 0, ProfileForm::Raster);
   EXPECT_LT(overlapped.nanoseconds[kTermLocations], 0.005);
