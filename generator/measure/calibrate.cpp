@@ -15,6 +15,7 @@
 #include <tuple>
 
 #include "analysis/cost.h"
+#include "common/content_hash.h"
 #include "common/glsl_compile.h"
 #include "common/input_file.h"
 #include "measure/corpus.h"
@@ -24,7 +25,6 @@
 #include "runtime/procedural.h"
 #include "runtime/vk_render.h"
 #include "validate/program_inputs.h"
-#include "common/content_hash.h"
 
 namespace sg {
 namespace {
@@ -620,8 +620,8 @@ std::string planUnderLabel(const std::string& profilePath) {
 }
 
 std::vector<std::string> ownPlanLabels(const std::string& profilePath) {
-  return {planUnderLabel(profilePath) + "generated",
-          fmt::format("plan under {}: generated", std::filesystem::path(profilePath).stem().string())};
+  const std::string exact = planUnderLabel(profilePath);
+  return {exact + "generated", exact.substr(0, exact.rfind('@')) + ": generated"};
 }
 
 namespace {

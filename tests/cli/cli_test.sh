@@ -625,6 +625,9 @@ device_profile)
   # default; "none" is the form before (every term inside its pipe); names are checked.
   expect 0 "--outside-pipes none" -- "$SG" calibrate --from-log pu.log --form raster --outside-pipes none -o inside.yaml
   expect 0 "the raster form's default" -- "$SG" calibrate --from-log pu.log --form raster -o outside.yaml
+  grep -qx '# form: raster (outside the pipes too: locations, buffer_loads, buffer_vec4_loads)' outside.yaml &&
+    grep -qx '# form: raster' inside.yaml && ok "each profile's header says what it priced outside the pipes" ||
+    fail "$(grep '^# form' outside.yaml inside.yaml)"
   awk '/^weights:/{w=1} /^pipes:/{w=0} w && /^  locations:/{print $2}' inside.yaml | grep -qx 0 &&
     ok "none: locations priced in the fetch pipe only" || fail "$(grep -A3 '^weights' inside.yaml)"
   expect 2 "--outside-pipes an unknown term" -- "$SG" calibrate --from-log pu.log --form raster --outside-pipes locations,bogus
