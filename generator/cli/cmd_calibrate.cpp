@@ -2,6 +2,7 @@
 // (docs/device-profiles.md).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <ctime>
@@ -34,6 +35,8 @@ struct CalibrateCommand {
   bool noProbes = false;
   std::string form = "additive";
   std::string outsidePipes;  // --outside-pipes, "" = the form's own
+  std::vector<std::string> thresholdTerms;  // --threshold
+  bool noFloors = false;                    // --no-floors
   std::vector<std::string> fromLogs, checkLogs;
   std::string evaluate;  // --evaluate PROFILE: the held-out check of an existing profile
   std::string writeCorpus;  // --write-corpus DIR: the corpus's files, no device
@@ -87,6 +90,7 @@ struct CalibrateCommand {
     rep.driver = "as recorded (see the device)";
     rep.nearBestPower = co.nearBestPower;
     rep.outsidePipes = co.fit.outsidePipes.value_or(outsidePipesOf(co.fit.form));
+    rep.floors = co.fit.floors;
     rep.profile = fitDeviceProfile(rep.samples, rep.device, 180000, co.nearBestPower, co.fit);
     rep.fits = evaluateFit(rep.samples, rep.profile, {"dawn", "head"});
     rep.heldOut = leaveOneRigOut(rep.samples, rep.device, 180000, co.nearBestPower, co.fit);
@@ -136,11 +140,11 @@ struct CalibrateCommand {
       for (size_t start = 0; start <= outsidePipes.size();) {
         const size_t comma = std::min(outsidePipes.find(',', start), outsidePipes.size());
         const std::string name = outsidePipes.substr(start, comma - start);
-        int term = -1;
-        for (int t = 0; t < kTermCount; ++t)
-          for (const auto& pipe : pipes.pipes)
-            if (name == termName(t) && pipe.nanoseconds[size_t(t)] > 0) term = t;
-        if (term < 0)
+        const int term = termByName(name);
+        const bool piped = term >= 0 && std::any_of(pipes.pipes.begin(), pipes.pipes.end(), [&](const DeviceProfile::Pipe& pipe) {
+                             return pipe.nanoseconds[size_t(term)] > 0;
+                           });
+        if (!piped)
           throw CLI::ValidationError("--outside-pipes", fmt::format("'{}' is not a term any pipe of the {} form prices", name, form));
         if (std::count(terms.begin(), terms.end(), term) == 0) terms.push_back(term);
         start = comma + 1;
@@ -149,9 +153,27 @@ struct CalibrateCommand {
     co.fit.outsidePipes = terms;
   }
 
+  // --threshold TERM (repeatable): the terms the fit may price past a threshold.
+  void parseThresholds() {
+    for (const std::string& name : thresholdTerms) {
+      const int term = termByName(name);
+      if (term < 0 || term == kTermVertices) {
+        std::string known;
+        for (int t = 0; t < kTermCount; ++t)
+          if (t != kTermVertices) known += fmt::format("{}{}", known.empty() ? "" : ", ", termName(t));
+        throw CLI::ValidationError("--threshold", fmt::format("'{}' is not a term a threshold may price (known: {})", name, known));
+      }
+      if (kMaxProfileThresholds <= co.fit.thresholds.size())
+        throw CLI::ValidationError("--threshold", fmt::format("at most {} terms (each doubles what the search weighs)", kMaxProfileThresholds));
+      if (std::count(co.fit.thresholds.begin(), co.fit.thresholds.end(), term) == 0) co.fit.thresholds.push_back(term);
+    }
+  }
+
   int run() {
     co.fit.form = chosenForm();
     parseOutsidePipes();
+    parseThresholds();
+    co.fit.floors = !noFloors;
     if (co.fit.constantCache && co.fit.form == ProfileForm::Additive)
       throw CLI::ValidationError("--constant-cache", "needs --form roofline or raster (the cache's misses are priced in the constant pipe)");
     if (co.fit.pipeSumShare && co.fit.form == ProfileForm::Additive)
@@ -334,6 +356,13 @@ void registerCalibrate(CLI::App& app, CliState& state) {
                   "share of their cost the device does not overlap), comma-separated term names, or none. Default: "
                   "locations,buffer_loads,buffer_vec4_loads for raster, none for roofline (docs/device-profiles.md, "
                   "\"Inputs outside the overlap\")");
+  sub->add_option("--threshold", cmd->thresholdTerms,
+                  "Fit a price per unit of this term past a threshold, the threshold chosen by the fit among the amounts the "
+                  "samples part, kept where it lowers the fit's error; repeat for up to 3 terms (docs/device-profiles.md, "
+                  "\"A price past a threshold\": lavapipe's inputs past the 14th)");
+  sub->add_flag("--no-floors", cmd->noFloors,
+                "Fit the probes and the rigs' plans, not bench's floors (which read every input and sum it at once: on "
+                "lavapipe they price an input as no plan pays it; docs/device-profiles.md)");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer (use for timings)");
   addOneProcessFlag(*sub, cmd->oneProcess, "rig");
   sub->add_option("--time-rig", cmd->timeRig)->group("");  // a fresh process's one rig (cli/fresh_process.h)

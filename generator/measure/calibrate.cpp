@@ -393,6 +393,9 @@ std::string compareCapture(const Probe& p, const std::vector<uint8_t>& captured,
   return "";
 }
 
+// Bench's floors of a rig ("floor (pass-through)", "floor + every input fetched").
+bool isFloorSample(const CalibrationSample& s) { return !s.rig.empty() && s.label.find("floor") != std::string::npos; }
+
 }  // namespace
 
 DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, const std::string& deviceName,
@@ -400,7 +403,7 @@ DeviceProfile fitDeviceProfile(const std::vector<CalibrationSample>& samples, co
   std::map<std::pair<std::string, std::string>, double> fastest;  // (rig, mesh) -> ns per vertex
   std::vector<const CalibrationSample*> used;
   for (const auto& s : samples)
-    if (s.fitted && s.validated && s.measuredNs > 0 && s.vertices > 0) {
+    if (s.fitted && s.validated && s.measuredNs > 0 && s.vertices > 0 && (fit.floors || !isFloorSample(s))) {
       used.push_back(&s);
       auto [it, added] = fastest.emplace(std::make_pair(s.rig, s.mesh), s.measuredNs);
       if (!added) it->second = std::min(it->second, s.measuredNs);
@@ -454,7 +457,7 @@ std::vector<CalibrationFit> evaluateFit(std::vector<CalibrationSample>& samples,
 
 namespace {
 
-bool isPlanSample(const CalibrationSample& s) { return !s.rig.empty() && s.label.find("floor") == std::string::npos; }
+bool isPlanSample(const CalibrationSample& s) { return !s.rig.empty() && !isFloorSample(s); }
 
 double medianOfFinite(std::vector<double> v) {
   v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
@@ -947,6 +950,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
     if (s.mesh == opts.meshes.front()) workload = s.vertices;
   rep.nearBestPower = rigs.empty() ? 0 : opts.nearBestPower;
   rep.outsidePipes = opts.fit.outsidePipes.value_or(outsidePipesOf(opts.fit.form));
+  rep.floors = opts.fit.floors;
   if (stopped() && std::none_of(rep.samples.begin(), rep.samples.end(), [](const CalibrationSample& s) { return s.validated; }))
     throw std::runtime_error("calibration: interrupted before anything was timed: nothing to fit");
   rep.profile =
@@ -999,7 +1003,7 @@ std::string additiveLines(const std::array<double, kTermCount>& nanoseconds) {
   return s;
 }
 
-// The workload scaling, its defaults, the pipes' sum share and the constant cache, shared by every draw size (none
+// The workload scaling, its defaults, the pipes' sum share, the constant cache and the thresholds, shared by every draw size (none
 // for an additive profile without scaling: the file then reads as every profile before them).
 std::string workloadLines(const DeviceProfile& p) {
   std::string s;
@@ -1023,6 +1027,10 @@ std::string workloadLines(const DeviceProfile& p) {
     s += fmt::format("constant_cache:  # past this palette footprint per warp, a distinct address costs miss_factor times as much\n"
                      "  entries: {:.10g}\n  miss_factor: {:.6g}\n",
                      p.constantCacheEntries, p.constantCacheMissFactor);
+  if (!p.thresholds.empty()) {
+    s += "thresholds:  # past `at` units of a term, each unit costs `ns` more per vertex\n";
+    for (const DeviceProfile::Threshold& h : p.thresholds) s += fmt::format("  {}: {{ at: {:g}, ns: {:.6g} }}\n", termName(h.term), h.at, h.nanoseconds);
+  }
   return s;
 }
 
@@ -1102,8 +1110,8 @@ std::string formatCalibration(const CalibrationReport& r) {
 
 std::string deviceProfileYaml(const CalibrationReport& r) {
   std::string s = "# Measured by `shadergen calibrate` (docs/device-profiles.md): ns per vertex per unit of each\n"
-                  "# term (and, under draw_weights, ns per draw), the least-squares fit (Ceres Solver, weights >= 0)\n"
-                  "# of every validated probe's, plan's and floor's time.\n";
+                  "# term (and, under draw_weights, ns per draw), the least-squares fit (Ceres Solver, weights >= 0)\n";
+  s += r.floors ? "# of every validated probe's, plan's and floor's time.\n" : "# of every validated probe's and plan's time (not the floors': --no-floors).\n";
   if (r.nearBestPower > 0)
     s += fmt::format("# A rig's plans and floors weighed (its fastest on that mesh / their time)^{:g}.\n", r.nearBestPower);
   s += fmt::format("# clock: {}; driver: {}\n", r.clock, r.driver);

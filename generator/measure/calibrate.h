@@ -198,6 +198,7 @@ struct CalibrationReport {
   std::vector<CalibrationSample> samples;
   double nearBestPower = 0;  // of the fit (CalibrationOptions)
   std::vector<int> outsidePipes;  // the terms the fit priced outside the pipes too (FitOptions::outsidePipes, resolved)
+  bool floors = true;             // bench's floors were rows of the fit (FitOptions::floors)
   DeviceProfile profile;
   std::vector<CalibrationFit> fits;  // one per mesh
   std::vector<CalibrationCheck> checks;

@@ -64,16 +64,24 @@ struct Layout {
   // price: a large draw covers too few fragments to price one of its own).
   std::vector<bool> shared;
   // After the blocks: the pipes' sum share (`share`), then the constant cache's miss factor
-  // (`miss`) and the terms it multiplies.
+  // (`miss`) and the terms it multiplies, then one price per threshold (term, at), each row
+  // paying it per unit of the term's scaled amount past `at`.
   bool share = false;
   bool miss = false;
   std::array<bool, kTermCount> missTerms{};
+  std::vector<std::pair<int, double>> thresholds;
   size_t block() const { return additive.size() + perDraw.size() + pipeTerms.size(); }
   size_t blocks() const { return std::max<size_t>(1, sizes.size()); }
   size_t shareIndex() const { return block() * blocks(); }
   size_t missIndex() const { return shareIndex() + (share ? 1 : 0); }
-  size_t size() const { return missIndex() + (miss ? 1 : 0); }
+  size_t thresholdIndex(size_t h) const { return missIndex() + (miss ? 1 : 0) + h; }
+  size_t size() const { return thresholdIndex(thresholds.size()); }
 };
+
+// A row's units of a threshold's term past it (its amounts already scaled).
+double pastThreshold(const std::array<double, kTermCount>& x, const std::pair<int, double>& threshold) {
+  return std::max(0.0, x[static_cast<size_t>(threshold.first)] - threshold.second);
+}
 
 // `outside`: terms in the additive part besides their pipe (FitOptions::outsidePipes).
 Layout layoutOf(const DeviceProfile& form, bool drawWeights, const std::vector<int>& outside) {
@@ -83,8 +91,10 @@ Layout layoutOf(const DeviceProfile& form, bool drawWeights, const std::vector<i
     if (t == kTermFragments ? raster
                             : (form.pipes.empty() || t == kTermVertices || std::count(outside.begin(), outside.end(), t)))
       l.additive.push_back(t);
+  // Outside the raster form a fragment is 1 per vertex, as `vertices` is: one per-draw weight for both.
   if (drawWeights && !raster)
-    for (int t = 0; t < kTermCount; ++t) l.perDraw.push_back(t);
+    for (int t = 0; t < kTermCount; ++t)
+      if (t != kTermFragments) l.perDraw.push_back(t);
   l.pipes = form.pipes.size();
   for (size_t p = 0; p < form.pipes.size(); ++p)
     for (int t = 0; t < kTermCount; ++t)
@@ -151,6 +161,7 @@ class RowCost : public ceres::CostFunction {
       i = pipeBegin;
       for (const auto& [p, t] : l_.pipeTerms) grad[i++] = (p == slowest ? 1.0 : s) * x_[t] * factor(t);
     }
+    for (size_t h = 0; h < l_.thresholds.size(); ++h) ns += parameters[0][l_.thresholdIndex(h)] * pastThreshold(x_, l_.thresholds[h]);
     residuals[0] = scale_ * (ns - measured_);
     if (jacobians && jacobians[0]) {
       double* J = jacobians[0];
@@ -162,6 +173,7 @@ class RowCost : public ceres::CostFunction {
           J[below + j] += scale_ * (1 - share) * grad[j], J[above + j] += scale_ * share * grad[j];
       if (miss) J[l_.missIndex()] = scale_ * dm;
       if (l_.share) J[l_.shareIndex()] = scale_ * ds;
+      for (size_t h = 0; h < l_.thresholds.size(); ++h) J[l_.thresholdIndex(h)] = scale_ * pastThreshold(x_, l_.thresholds[h]);
     }
     return true;
   }
@@ -191,6 +203,9 @@ DeviceProfile toProfile(const DeviceProfile& form, const Layout& l, const std::v
   // A share under kLeastPipeSumShare prices nothing a femtosecond weight can tell apart from none.
   if (l.share && w[l.shareIndex()] >= kLeastPipeSumShare) p.pipeSumShare = std::min(w[l.shareIndex()], 1.0);
   if (l.miss) p.constantCacheMissFactor = w[l.missIndex()];
+  p.thresholds.clear();
+  for (size_t h = 0; h < l.thresholds.size(); ++h)
+    p.thresholds.push_back({l.thresholds[h].first, l.thresholds[h].second, std::min(w[l.thresholdIndex(h)], kMaxProfileWeightNs)});
   if (p.hasDrawWeights() || !p.drawSizes.empty()) p.verticesPerDraw = vertices;
   return p.atDrawSize(p.verticesPerDraw);
 }
@@ -222,11 +237,16 @@ Solved solve(const Layout& l, const std::vector<FitRow>& rows, const std::vector
     };
     size_t i = 0;
     // Shared over one block's parameters and the miss factor (as many as without draw sizes).
-    const double share = median / double(std::max<size_t>(1, l.block() + (l.miss ? 1 : 0) + (l.share ? 1 : 0)));
+    const double share = median / double(std::max<size_t>(1, l.block() + (l.miss ? 1 : 0) + (l.share ? 1 : 0) + l.thresholds.size()));
     for (int t : l.additive) typical[i++] = meanAmount(t, false) > 0 ? share / meanAmount(t, false) : 0;
     for (int t : l.perDraw) typical[i++] = meanAmount(t, true) > 0 ? share / meanAmount(t, true) : 0;
     for (const auto& [p, t] : l.pipeTerms) typical[i++] = meanAmount(t, false) > 0 ? share / meanAmount(t, false) : 0;
     for (size_t b = 1; b < l.blocks(); ++b) std::copy_n(typical.begin(), l.block(), typical.begin() + long(b * l.block()));
+    for (size_t h = 0; h < l.thresholds.size(); ++h) {
+      double past = 0;
+      for (const auto& x : xs) past += pastThreshold(x, l.thresholds[h]);
+      typical[l.thresholdIndex(h)] = past > 0 ? share * double(rows.size()) / past : 0;
+    }
   }
   Solved best;
   for (double start : {0.1, 0.5, 1.0}) {
@@ -336,6 +356,7 @@ FitResult fitProfile(const std::vector<FitRow>& rows, const FitOptions& options)
   for (const FitRow& r : rows) xs.push_back(scaledAmounts(skeleton, r));
 
   const std::vector<bool> within(rows.size(), false);
+  std::vector<bool> pastCapacity = within;  // each row past the constant cache's capacity (once one is kept)
   // A term is kept where it lowers the weighted squared error by kMinTermGain, and by more than
   // rounding: on rows a fit already prices exactly (both costs about 1e-28) either may be lower.
   const double negligible = kNegligibleRelativeError * kNegligibleRelativeError * double(rows.size());
@@ -364,6 +385,7 @@ FitResult fitProfile(const std::vector<FitRow>& rows, const FitOptions& options)
     for (size_t t = 0; t < kTermCount; ++t) withMiss.missTerms[t] = skeleton.scaledBy[t] == kFeatureJointsPerWarp;
     double bestWithMiss = INFINITY;
     Solved chosen;
+    std::vector<bool> chosenPast;
     // A row is past a capacity by the profile's own rule (a footprint not recorded: the default).
     DeviceProfile rule = skeleton;
     rule.workloadDefaults[kFeaturePaletteEntriesPerWarp] = medianOf(entries);
@@ -376,14 +398,35 @@ FitResult fitProfile(const std::vector<FitRow>& rows, const FitOptions& options)
         past.push_back(rule.constantCacheFactor() > 1);
       }
       Solved s = solve(withMiss, rows, xs, past);
-      if (s.cost < bestWithMiss) bestWithMiss = s.cost, chosen = s, capacity = c;
+      if (s.cost < bestWithMiss) bestWithMiss = s.cost, chosen = s, capacity = c, chosenPast = past;
     }
     if (capacity > 0 && gains(bestWithMiss, best.cost)) {
       best = chosen;
       l = withMiss;
+      pastCapacity = chosenPast;
     } else {
       capacity = 0;
     }
+  }
+  // Prices past a threshold (docs/device-profiles.md, "A price past a threshold"): for each term
+  // asked, each threshold between two distinct amounts of the rows (kMinRowsPerSideOfThreshold
+  // rows at least on each side) with its price as one more parameter; the best is kept where it
+  // explains kMinTermGain of the squared error.
+  for (int term : options.thresholds) {
+    std::vector<double> amounts;
+    for (const auto& x : xs) amounts.push_back(x[static_cast<size_t>(term)]);
+    std::sort(amounts.begin(), amounts.end());
+    std::set<double> candidates;
+    for (size_t i = kMinRowsPerSideOfThreshold; i + kMinRowsPerSideOfThreshold <= amounts.size(); ++i)
+      if (amounts[i] > amounts[i - 1]) candidates.insert(amounts[i - 1]);  // rows at or below it pay nothing
+    Solved bestWith;
+    Layout chosen;
+    for (double at : candidates) {
+      Layout with = l;
+      with.thresholds.emplace_back(term, at);
+      if (Solved s = solve(with, rows, xs, pastCapacity); s.cost < bestWith.cost) bestWith = std::move(s), chosen = with;
+    }
+    if (!chosen.thresholds.empty() && gains(bestWith.cost, best.cost)) best = std::move(bestWith), l = chosen;
   }
   FitResult out;
   out.converged = best.converged;

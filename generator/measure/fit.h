@@ -47,6 +47,14 @@ struct FitOptions {
   // the share of their cost the device does not overlap with the other pipes. Unset: the
   // form's own (outsidePipesOf).
   std::optional<std::vector<int>> outsidePipes;
+  // Terms that may cost more per unit past a threshold (DeviceProfile::thresholds), each tried
+  // at every threshold the rows part (kMinRowsPerSideOfThreshold) and kept where it lowers the
+  // error by kMinTermGain. Lavapipe: `locations` (docs/device-profiles.md, "A price past a threshold").
+  std::vector<int> thresholds;
+  // Whether bench's floors are rows of the fit (fitDeviceProfile). Their inputs are read and summed
+  // at once; where a device prices an input by the shader around it (lavapipe past 14 inputs), a
+  // floor prices inputs as no plan pays them.
+  bool floors = true;
   FitOptions() = default;
   FitOptions(ProfileForm f, bool cache = false, bool sizes = false, bool share = false)
       : form(f), constantCache(cache), drawSizes(sizes), pipeSumShare(share) {}
@@ -74,6 +82,9 @@ struct FitResult {
 // terms scaled by joints per warp), and keeps the best C where it lowers the weighted squared
 // error by kMinTermGain of the fit without it; else the profile has no constant_cache.
 constexpr size_t kMinRowsPerSideOfCapacity = 3;
+// A threshold (FitOptions::thresholds) is tried between two distinct amounts of its term with at
+// least this many rows on each side, at the lower amount (rows at or below it pay nothing more).
+constexpr size_t kMinRowsPerSideOfThreshold = 3;
 // The pipes' sum share (`pipeSumShare`, roofline and raster forms; DeviceProfile::pipeSumShare):
 // one more parameter s in [0, 1], a row costing additive + (1 - s) x slowest pipe + s x every
 // pipe; fitted whenever asked (a share below kLeastPipeSumShare is written as none), before

@@ -41,9 +41,7 @@ void parseTermWeights(const YamlCtx& c, const YAML::Node& w, const char* section
   c.expectMap(w, section);
   for (auto it = w.begin(); it != w.end(); ++it) {
     const std::string key = c.scalar(it->first, "weight name");
-    int term = -1;
-    for (int t = 0; t < kTermCount; ++t)
-      if (key == termName(t)) term = t;
+    const int term = termByName(key);
     if (term < 0) {
       std::string known;
       for (int t = 0; t < kTermCount; ++t) known += fmt::format("{}{}", t ? ", " : "", termName(t));
@@ -171,6 +169,8 @@ double DeviceProfile::predictNanoseconds(const TermAmounts& amounts, double vert
     slowest = std::max(slowest, x);
     sum += x;
   }
+  for (const Threshold& h : thresholds)
+    ns += h.nanoseconds * std::max(0.0, feature(scaledBy[static_cast<size_t>(h.term)]) * double(amounts[static_cast<size_t>(h.term)]) - h.at);
   return ns + (1 - pipeSumShare) * slowest + pipeSumShare * sum;
 }
 
@@ -179,7 +179,7 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
   YAML::Node root = parseYaml(text, file);
   c.expectMap(root, "device profile");
   c.checkKeys(root, {"device", "unit", "weights", "draw_weights", "vertices_per_draw", "pipes", "pipe_sum_share", "scaled_by",
-                     "workload_defaults", "constant_cache", "draw_sizes", "notes"});
+                     "workload_defaults", "constant_cache", "thresholds", "draw_sizes", "notes"});
   DeviceProfile prof;
   prof.file = file;
   std::array<bool, kTermCount> named{};  // the terms the profile states anywhere
@@ -268,9 +268,7 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
     c.expectMap(scaled, "scaled_by");
     for (auto it = scaled.begin(); it != scaled.end(); ++it) {
       const std::string key = c.scalar(it->first, "term name");
-      int term = -1;
-      for (int t = 0; t < kTermCount; ++t)
-        if (key == termName(t)) term = t;
+      const int term = termByName(key);
       if (term < 0) c.fail(it->first, fmt::format("scaled_by: unknown cost term '{}'", key));
       prof.scaledBy[static_cast<size_t>(term)] = featureOf(it->second);
       named[static_cast<size_t>(term)] = true;
@@ -307,6 +305,36 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
     if (!priced)
       c.fail(cache, "constant_cache: no term is scaled_by joints_per_warp, so the cache's misses would price nothing");
   }
+  if (const YAML::Node thresholds = root["thresholds"]) {
+    c.expectMap(thresholds, "thresholds");
+    for (auto it = thresholds.begin(); it != thresholds.end(); ++it) {
+      const std::string key = c.scalar(it->first, "term name");
+      const int term = termByName(key);
+      if (term < 0) c.fail(it->first, fmt::format("thresholds: unknown cost term '{}'", key));
+      if (term == kTermVertices)
+        c.fail(it->first, "thresholds: 'vertices' is 1 in every program, so a threshold on it would be a constant");
+      const YAML::Node& h = it->second;
+      c.expectMap(h, fmt::format("threshold '{}'", key).c_str());
+      c.checkKeys(h, {"at", "ns"});
+      if (!h["at"] || !h["ns"])
+        c.fail(h, fmt::format("threshold '{}': needs 'at' (the units priced as the weights say) and 'ns' (what each unit "
+                              "past them costs more)",
+                              key));
+      if (prof.thresholds.size() == kMaxProfileThresholds)
+        c.fail(it->first, fmt::format("thresholds: '{}' is one more than the {} a profile may state (each doubles what the "
+                                      "search weighs)",
+                                      key, kMaxProfileThresholds));
+      DeviceProfile::Threshold th;
+      th.term = term;
+      th.at = parseNumber(c, h["at"], fmt::format("threshold '{}' 'at'", key), "units", "", -HUGE_VAL, kMaxWorkloadFeature);
+      if (th.at < 0) c.fail(h["at"], fmt::format("threshold '{}' 'at' is {:g}: it counts units of the term, 0 or more", key, th.at));
+      th.nanoseconds = parseNumber(c, h["ns"], fmt::format("threshold '{}' 'ns'", key), "nanoseconds", "ns", 0, kMaxProfileWeightNs);
+      prof.thresholds.push_back(th);
+      named[static_cast<size_t>(term)] = true;
+    }
+    std::sort(prof.thresholds.begin(), prof.thresholds.end(),
+              [](const DeviceProfile::Threshold& a, const DeviceProfile::Threshold& b) { return a.term < b.term; });
+  }
   // A profile written before table reads were counted apart (it names neither table term) priced
   // them as buffer loads: so it still does.
   if (!named[kTermBufferTableLoads] && !named[kTermBufferTableVec4Loads]) priceTableReadsAsBufferLoads(prof);
@@ -337,9 +365,20 @@ TermWeights profileWeights(const DeviceProfile& priced) {
   return w;
 }
 
-std::vector<TermWeights> profileComponents(const DeviceProfile& priced) {
-  DeviceProfile scratch;
-  const DeviceProfile& profile = pricedAt(priced, priced.verticesPerDraw, scratch);
+namespace {
+
+// A threshold's line in femtoseconds: its price per unit on the term, less price x at on the fixed
+// `vertices` (1 in every program), so that above zero it is the hinge max(0, amount - at) x ns.
+TermWeights thresholdLine(const DeviceProfile& profile, const DeviceProfile::Threshold& h) {
+  TermWeights w{};
+  w[static_cast<size_t>(h.term)] = std::llround(h.nanoseconds * profile.feature(profile.scaledBy[static_cast<size_t>(h.term)]) *
+                                                kFemtosecondsPerNanosecond);
+  w[kTermVertices] = -std::llround(h.nanoseconds * h.at * kFemtosecondsPerNanosecond);
+  return w;
+}
+
+// The components without the thresholds: one per pipe (the additive weights alone without pipes).
+std::vector<TermWeights> pipeComponents(const DeviceProfile& profile) {
   const TermWeights additive = profileWeights(profile);
   if (profile.pipes.empty()) return {additive};
   // max_k [(1 - s) P_k + s sum_j P_j] = (1 - s) max_k P_k + s sum_j P_j: the blend is a max of sums too.
@@ -355,6 +394,27 @@ std::vector<TermWeights> profileComponents(const DeviceProfile& priced) {
                            kFemtosecondsPerNanosecond);
     out.push_back(w);
   }
+  return out;
+}
+
+}  // namespace
+
+std::vector<TermWeights> profileComponents(const DeviceProfile& priced) {
+  DeviceProfile scratch;
+  const DeviceProfile& profile = pricedAt(priced, priced.verticesPerDraw, scratch);
+  const std::vector<TermWeights> pipes = pipeComponents(profile);
+  // sum over h of max(0, line_h) = max over subsets S of sum over h in S of line_h: each pipe's
+  // component once per subset.
+  std::vector<TermWeights> out;
+  for (size_t subset = 0; subset < (size_t{1} << profile.thresholds.size()); ++subset)
+    for (TermWeights w : pipes) {
+      for (size_t h = 0; h < profile.thresholds.size(); ++h)
+        if (subset & (size_t{1} << h)) {
+          const TermWeights line = thresholdLine(profile, profile.thresholds[h]);
+          for (size_t t = 0; t < kTermCount; ++t) w[t] += line[t];
+        }
+      out.push_back(w);
+    }
   return out;
 }
 
@@ -376,7 +436,9 @@ void applyPortableProfiles(Problem& p, const std::vector<DeviceProfile>& profile
 
 TermAmounts planTermAmounts(const Plan& plan, const Problem& p) { return planAmounts(p, plan.actions); }
 
-PlanCostPrediction predictPlanCost(const Plan& plan, const Problem& p, const DeviceProfile& profile) {
+PlanCostPrediction predictPlanCost(const Plan& plan, const Problem& p, const DeviceProfile& priced) {
+  DeviceProfile scratch;
+  const DeviceProfile& profile = pricedAt(priced, priced.verticesPerDraw, scratch);
   PlanCostPrediction out;
   out.amounts = planTermAmounts(plan, p);
   const TermWeights w = profileWeights(profile);
@@ -384,12 +446,19 @@ PlanCostPrediction predictPlanCost(const Plan& plan, const Problem& p, const Dev
     out.nanoseconds[t] = static_cast<double>(w[t]) * static_cast<double>(out.amounts[t]) / kFemtosecondsPerNanosecond;
     out.totalNanoseconds += out.nanoseconds[t];
   }
+  // Each hinge as the search weighs it (exact in femtoseconds), so the total is the plan's cost.
+  for (const DeviceProfile::Threshold& h : profile.thresholds) {
+    const double ns = static_cast<double>(std::max<int64_t>(0, weighTerms(thresholdLine(profile, h), out.amounts))) /
+                      kFemtosecondsPerNanosecond;
+    out.thresholdNanoseconds.push_back(ns);
+    out.totalNanoseconds += ns;
+  }
   if (profile.pipes.empty()) return out;
   // Each pipe's time: its component less the additive part (exact in femtoseconds), priced
-  // with no share of the others; the total is the largest component as the search prices it.
+  // with no share of the others; the total adds the largest component as the search prices it.
   DeviceProfile pure = profile;
   pure.pipeSumShare = 0;
-  const std::vector<TermWeights> pipesAlone = profileComponents(pure), comps = profileComponents(profile);
+  const std::vector<TermWeights> pipesAlone = pipeComponents(pure), comps = pipeComponents(profile);
   const int64_t additive = weighTerms(w, out.amounts);
   double slowest = 0;
   int64_t largest = 0;
@@ -452,6 +521,13 @@ std::string describePlanCost(const Plan& plan, const Problem& p, const DevicePro
   if (profile.pipeSumShare > 0)
     out += fmt::format("    {:<26} {:>8} {:>10} {:>9.3f}\n", fmt::format("other pipes x {:g}", profile.pipeSumShare), "", "",
                        c.otherPipesNanoseconds);
+  for (size_t h = 0; h < profile.thresholds.size(); ++h) {
+    const DeviceProfile::Threshold& th = profile.thresholds[h];
+    out += fmt::format("    {:<26} {:>8} {:>10.6f} {:>9.3f}\n", fmt::format("{} past {:g}", termName(th.term), th.at),
+                       fmt::format("{:g}", std::max(0.0, profile.feature(profile.scaledBy[static_cast<size_t>(th.term)]) *
+                                                              double(c.amounts[static_cast<size_t>(th.term)]) - th.at)),
+                       th.nanoseconds, c.thresholdNanoseconds[h]);
+  }
   if (profile.workload.known()) out += fmt::format("    workload: {}\n", describeWorkload(profile.workload));
   if (profile.constantCacheEntries > 0) {
     out += fmt::format("    constant cache: {:.1f} palette entries per warp{} against its {:g}: {}\n",

@@ -64,6 +64,17 @@ struct DeviceProfile {
   // per-address reads miss). 0 entries: no such term (every profile before session 21).
   double constantCacheEntries = 0;
   double constantCacheMissFactor = 1;
+  // Prices past a threshold (docs/device-profiles.md, "A price past a threshold"): past `at` units of
+  // a term (times its workload feature) each unit costs `nanoseconds` more per vertex, a hinge
+  // max(0, amount - at) x ns added to the cost. On lavapipe a vertex input past the 14th costs
+  // about 4 ns more. A sum of hinges is a max of weighted sums (profileComponents), so the search
+  // stays exact. None: every profile before session 29.
+  struct Threshold {
+    int term = 0;
+    double at = 0;
+    double nanoseconds = 0;
+  };
+  std::vector<Threshold> thresholds;  // one per term at most, in term order
   // The workload priced for (search/workload.h): set by whoever generates for a known mesh.
   Workload workload;
   // Weights fitted on meshes of several sizes (docs/device-profiles.md, "Draw sizes"): each
@@ -93,7 +104,8 @@ struct DeviceProfile {
   // the constant cache's capacity; else 1.
   double constantCacheFactor() const;
   // Predicted ns per vertex of these amounts on a mesh drawn `vertices` at a time (unrounded
-  // weights; the search's own figure is predictPlanCost's): the additive part plus the slowest pipe.
+  // weights; the search's own figure is predictPlanCost's): the additive part, the slowest pipe
+  // and what the thresholds add.
   double predictNanoseconds(const TermAmounts& amounts, double vertices) const;
 };
 // Where a draw of `vertices` falls among ascending draw sizes: the last size at or below it
@@ -111,8 +123,10 @@ DrawSizeBlend blendDrawSizes(const std::vector<double>& sizes, double vertices);
 constexpr double kMaxVerticesPerDraw = 1e9;
 constexpr double kMaxProfileDrawWeightNs = 1e6;
 
-// Most pipes a roofline profile may have, and the largest workload default it may state.
+// Most pipes a roofline profile may have, most thresholds (each doubles the search's components),
+// and the largest workload default it may state.
 constexpr size_t kMaxProfilePipes = 8;
+constexpr size_t kMaxProfileThresholds = 3;
 constexpr double kMaxWorkloadFeature = 1e6;
 
 // Search cost units of a profile: femtoseconds (1e-6 ns); a weight is rounded to one.
@@ -135,6 +149,9 @@ TermWeights profileWeights(const DeviceProfile& profile);
 // The search's components (Problem::componentWeights): one per pipe k, each the additive
 // weights plus (1 - s) x pipe k's plus s x every pipe's (s = pipeSumShare), whose largest is
 // additive + (1 - s) x slowest + s x sum; the additive weights alone for a profile without pipes.
+// With thresholds, each of those once per subset of the thresholds, the subset's hinges added as
+// their lines (ns per unit on the term, less ns x at on the fixed `vertices`): the largest is the
+// sum of the hinges above zero.
 std::vector<TermWeights> profileComponents(const DeviceProfile& profile);
 // Prices the problem's actions, inputs and fixed terms under the profile (priceProblem, or
 // priceProblemByMax for a roofline).
@@ -152,6 +169,7 @@ struct PlanCostPrediction {
   std::array<double, kTermCount> nanoseconds{};  // rounded additive weight x amount, per term
   std::vector<double> pipeNanoseconds;           // per pipe of a roofline profile
   int slowestPipe = -1;                          // the pipe that bounds the program (-1: none)
+  std::vector<double> thresholdNanoseconds;      // per threshold: what its hinge adds (0 at or below it)
   // What the other pipes add beside the slowest: pipeSumShare x their sum (0 in a pure roofline).
   double otherPipesNanoseconds = 0;
   double totalNanoseconds = 0;                   // equals plan cost / kFemtosecondsPerNanosecond

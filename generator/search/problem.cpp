@@ -40,6 +40,12 @@ const char* termName(int term) {
   return term >= 0 && term < kTermCount ? names[term] : "?";
 }
 
+int termByName(const std::string& name) {
+  for (int t = 0; t < kTermCount; ++t)
+    if (name == termName(t)) return t;
+  return -1;
+}
+
 int64_t weighTerms(const TermWeights& w, const TermAmounts& a) {
   // Saturates far below INT64_MAX so that sums of a plan's costs cannot overflow either.
   constexpr int64_t kCap = INT64_MAX / 1024;

@@ -71,6 +71,7 @@ enum CostTerm {
 using TermAmounts = std::array<int64_t, kTermCount>;
 // "arithmetic", "locations", ...: the keys of a device profile's `weights:`.
 const char* termName(int term);
+int termByName(const std::string& name);  // termName's inverse; -1 for no term
 // Search cost units per unit of each term (int64: A* stays exact). Without a profile the
 // unit is the instruction slot; a profile's unit is the femtosecond (docs/device-profiles.md).
 using TermWeights = std::array<int64_t, kTermCount>;

@@ -633,6 +633,20 @@ device_profile)
   expect 2 "--outside-pipes an unknown term" -- "$SG" calibrate --from-log pu.log --form raster --outside-pipes locations,bogus
   grep -q "'bogus' is not a term any pipe of the raster form prices" last.err && ok "names the term" || fail "$(cat last.err)"
   expect 2 "--outside-pipes with the additive form" -- "$SG" calibrate --from-log pu.log --outside-pipes locations
+  # --threshold TERM: a price per unit past a threshold the fit chooses; --no-floors fits the probes and
+  # plans only. On lavapipe's training log of session 17 the inputs past 15 cost more, and under that
+  # profile the Dawn face reads its skin from a storage buffer: the plan lavapipe runs fastest
+  # (docs/device-profiles.md, "A price past a threshold").
+  LP=$SRC/bench/data/lavapipe-rounds17/train.log
+  expect 0 "--threshold locations --no-floors" -- "$SG" calibrate --from-log "$LP" --threshold locations --no-floors --near-best-weight 0 -o past.yaml
+  grep -q "^  locations: { at: [0-9]*, ns: [0-9.]* }$" past.yaml && grep -q "(not the floors': --no-floors)" past.yaml &&
+    ok "the profile states the threshold and that the floors were left out" || fail "$(grep -A2 '^thresholds' past.yaml)"
+  expect 0 "explain the Dawn face under it" -- "$SG" explain --rig "$SRC/examples/dawn/face.rig.yaml" -f "$SRC/examples/dawn/face.frag" -r "$SRC/examples/dawn/rules.yaml" --device-profile past.yaml --mesh dawn
+  grep -q "skin.matrix <- skin_matrix_blend_buffered_influences" last.out && grep -q "locations past " last.out &&
+    ok "the skin from a storage buffer, the threshold's line shown" || fail "$(grep -E 'skin.matrix <-|past' last.out)"
+  expect 2 "--threshold an unknown term" -- "$SG" calibrate --from-log "$LP" --threshold bogus
+  grep -q "'bogus' is not a term a threshold may price" last.err && ok "names the term" || fail "$(cat last.err)"
+  expect 2 "--threshold vertices" -- "$SG" calibrate --from-log "$LP" --threshold vertices
   printf 'device: "x"\nweights: [1\n' > bad-profile.yaml
   expect 1 "--plans-under a malformed profile" -- "$SG" calibrate "${PU[@]}" --plans-under bad-profile.yaml
   grep -q '^bad-profile.yaml:[0-9]*:[0-9]*: error' last.err && ! grep -q 'corpus-' last.out &&

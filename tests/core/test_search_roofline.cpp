@@ -67,16 +67,20 @@ void addWay(Problem& p, const char* name, int locations, int loads) {
 }
 
 // From the definition: the cheapest feasible subset (exhaustiveMinimum), its amounts the fired
-// actions' terms, each distinct item's terms once and the fixed terms, its cost the largest
-// component's weighted sum.
+// actions' terms, each distinct item's terms once and the fixed terms (firedAmounts), its cost the
+// largest component's weighted sum.
+TermAmounts firedAmounts(const Problem& p, const std::vector<bool>& fired, const std::set<int>& items) {
+  TermAmounts amounts = p.fixedTerms;
+  for (size_t a = 0; a < fired.size(); ++a)
+    if (fired[a])
+      for (size_t t = 0; t < kTermCount; ++t) amounts[t] += p.actions[a].terms[t];
+  for (int i : items)
+    for (size_t t = 0; t < kTermCount; ++t) amounts[t] += p.resources[i].terms[t];
+  return amounts;
+}
 int64_t exhaustiveLargest(const Problem& p) {
   return exhaustiveMinimum(p, [&](const std::vector<bool>& fired, const std::set<int>& items) {
-    TermAmounts amounts = p.fixedTerms;
-    for (size_t a = 0; a < fired.size(); ++a)
-      if (fired[a])
-        for (size_t t = 0; t < kTermCount; ++t) amounts[t] += p.actions[a].terms[t];
-    for (int i : items)
-      for (size_t t = 0; t < kTermCount; ++t) amounts[t] += p.resources[i].terms[t];
+    const TermAmounts amounts = firedAmounts(p, fired, items);
     int64_t cost = 0;
     for (const TermWeights& w : p.componentWeights) {
       int64_t c = 0;
@@ -316,9 +320,10 @@ TEST(SearchRoofline, PipesThatOverlapImperfectlyPayAShareOfTheOthers) {
 }
 
 // The search's components of a profile with a share reproduce its definition (additive + (1 - s)
-// x slowest pipe + s x every pipe, DeviceProfile::predictNanoseconds) for random pipes, shares,
-// additive weights (on terms in pipes too) and amounts: the largest component is that sum, to the
-// femtosecond rounding of each weight.
+// x slowest pipe + s x every pipe + each threshold's max(0, amount - at) x ns,
+// DeviceProfile::predictNanoseconds) for random pipes, shares, thresholds, additive weights (on
+// terms in pipes too) and amounts: the largest component is that sum, to the femtosecond rounding
+// of each weight.
 TEST(SearchRooflineProperty, ComponentsOfASharedProfileAreItsDefinition) {
   std::mt19937 rng(33);
   auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
@@ -337,6 +342,10 @@ TEST(SearchRooflineProperty, ComponentsOfASharedProfileAreItsDefinition) {
       prof.pipes.push_back(pipe);
     }
     prof.pipeSumShare = instance % 3 == 0 ? 0 : uniform(0, 1);
+    // Prices past a threshold on up to three terms (DeviceProfile::thresholds).
+    for (size_t t = 0; t < kTermCount && prof.thresholds.size() < size_t(instance % 4); ++t)
+      if (t != kTermVertices && t != kTermFragments && uniform(0, 1) < 0.3)
+        prof.thresholds.push_back({static_cast<int>(t), std::floor(uniform(0, 150)), uniform(0, 2)});
     TermAmounts a{};
     a[kTermVertices] = 1;
     for (size_t t = 0; t < kTermCount; ++t)
@@ -346,9 +355,110 @@ TEST(SearchRooflineProperty, ComponentsOfASharedProfileAreItsDefinition) {
     int64_t units = 0;
     for (int64_t x : a) units += x;
     EXPECT_NEAR(static_cast<double>(largest) / kFemtosecondsPerNanosecond, prof.predictNanoseconds(a, 1000),
-                1e-6 * static_cast<double>(units) + 1e-9)
-        << "instance " << instance << ", share " << prof.pipeSumShare;
+                1e-6 * static_cast<double>(units + 1) * double(1 + prof.thresholds.size()) + 1e-9)
+        << "instance " << instance << ", share " << prof.pipeSumShare << ", thresholds " << prof.thresholds.size();
   }
+}
+
+// A price past a threshold (DeviceProfile::thresholds): 0.1 ns per location and 1 per buffer load,
+// and 2 ns more per location past 14. "attributes" reads 16 locations: 1.6 + 2 x 2 = 5.6 ns;
+// "buffered" 14 and 2 loads: 1.4 + 2 = 3.4. Without the threshold: 1.6 against 3.4. Every engine
+// follows it, and the prediction shows the hinge on a line of its own.
+TEST(SearchRoofline, AThresholdPricesOnlyTheUnitsPastIt) {
+  for (bool threshold : {false, true}) {
+    for (bool pipes : {false, true}) {
+      DeviceProfile prof;
+      prof.device = "test";
+      prof.nanoseconds[kTermLocations] = 0.1;
+      if (pipes) {  // the loads in a pipe of their own beside an empty one: the same prices
+        prof = twoPipes({"memory", kTermBufferLoads, 1}, {"alu", kTermArithmetic, 1});
+        prof.nanoseconds[kTermLocations] = 0.1;
+      } else {
+        prof.nanoseconds[kTermBufferLoads] = 1;
+      }
+      if (threshold) prof.thresholds.push_back({kTermLocations, 14, 2});
+      Problem p = oneGoal();
+      p.fixedTerms[kTermVertices] = 1;
+      addWay(p, "attributes", 16, 0);
+      addWay(p, "buffered", 14, 2);
+      applyDeviceProfile(p, prof);
+      const double ns = threshold ? 3.4 : 1.6;
+      for (const char* engine : {"auto", "ip", "forward"}) {
+        auto plan = solveWith(p, engine);
+        ASSERT_TRUE(plan) << engine;
+        EXPECT_EQ(p.actions[plan->actions[0]].name, threshold ? "buffered" : "attributes") << engine << (pipes ? ", pipes" : "");
+        EXPECT_EQ(plan->cost, std::llround(ns * kFemtosecondsPerNanosecond)) << engine;
+        EXPECT_DOUBLE_EQ(predictPlanCost(*plan, p, prof).totalNanoseconds, ns) << engine;
+      }
+      if (threshold) {  // the attributes' plan as the prediction shows it: 2 locations past 14, 4 ns
+        Plan attributes;
+        attributes.actions = {0};
+        const PlanCostPrediction c = predictPlanCost(attributes, p, prof);
+        ASSERT_EQ(c.thresholdNanoseconds.size(), 1u);
+        EXPECT_DOUBLE_EQ(c.thresholdNanoseconds[0], 4);
+        EXPECT_DOUBLE_EQ(c.totalNanoseconds, 5.6);
+        const std::string text = describePlanCost(attributes, p, prof);
+        EXPECT_NE(text.find("locations past 14"), std::string::npos) << text;
+      }
+    }
+  }
+}
+
+// Every engine against the exhaustive solver under random profiles with thresholds, the cost
+// computed from the definition (additive + slowest pipe + each max(0, amount - at) x price), not
+// from the search's components: small integer femtosecond weights, so nothing is rounded.
+TEST(SearchRooflineProperty, ThresholdsMatchExhaustiveSolverFromTheDefinition) {
+  int binding = 0;
+  for (uint64_t seed = 1; seed <= 150; ++seed) {
+    SCOPED_TRACE(::testing::Message() << "seed " << seed);
+    Problem p = sgtest::randomLibrary(sgtest::LibraryShape{8 + static_cast<int>(seed % 9), seed, 2, 4});
+    sgtest::addRandomProfile(p, seed);
+    std::mt19937_64 rng(seed * 31 + 7);
+    auto pick = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    constexpr double fs = 1.0 / kFemtosecondsPerNanosecond;
+    DeviceProfile prof;
+    for (int t : {kTermArithmetic, kTermLocations, kTermBufferLoads, kTermOutputs, kTermVertices}) prof.nanoseconds[size_t(t)] = pick(0, 12) * fs;
+    if (seed % 2) {
+      prof = twoPipes({"memory", kTermBufferLoads, pick(1, 20) * fs}, {"alu", kTermArithmetic, pick(1, 6) * fs});
+      prof.nanoseconds[kTermLocations] = pick(0, 12) * fs;
+    }
+    prof.thresholds.push_back({kTermLocations, double(pick(0, 6)), pick(1, 40) * fs});
+    if (seed % 3 == 0) prof.thresholds.push_back({kTermArithmetic, double(pick(0, 30)), pick(1, 10) * fs});
+    applyDeviceProfile(p, prof);
+    auto definition = [&](const TermAmounts& a) {
+      auto fsOf = [](double ns) { return std::llround(ns * kFemtosecondsPerNanosecond); };
+      int64_t cost = 0, slowest = 0;
+      for (size_t t = 0; t < kTermCount; ++t) cost += fsOf(prof.nanoseconds[t]) * a[t];
+      for (const DeviceProfile::Pipe& pipe : prof.pipes) {
+        int64_t x = 0;
+        for (size_t t = 0; t < kTermCount; ++t) x += fsOf(pipe.nanoseconds[t]) * a[t];
+        slowest = std::max(slowest, x);
+      }
+      for (const DeviceProfile::Threshold& h : prof.thresholds)
+        cost += fsOf(h.nanoseconds) * std::max<int64_t>(0, a[size_t(h.term)] - static_cast<int64_t>(h.at));
+      return cost + slowest;
+    };
+    const int64_t opt = exhaustiveMinimum(
+        p, [&](const std::vector<bool>& fired, const std::set<int>& items) { return definition(firedAmounts(p, fired, items)); });
+    if (opt == kNone) continue;
+    for (const char* h : {"blind", "hmax", "landmarks", "lmcut"}) {
+      SearchStats st;
+      auto plan = regressionSearch(p, h, &st);
+      ASSERT_TRUE(plan) << h;
+      EXPECT_EQ(plan->cost, opt) << h;
+      EXPECT_EQ(definition(planAmounts(p, plan->actions)), opt) << h;
+      EXPECT_LE(st.initialH, opt) << h;
+    }
+    for (const char* engine : {"ip", "forward", "auto"}) {
+      auto plan = solveWith(p, engine);
+      ASSERT_TRUE(plan) << engine;
+      EXPECT_EQ(plan->cost, opt) << engine;
+    }
+    // Some optimum reads past a threshold, or avoids it at a price: the hinge is not idle.
+    auto plan = solveWith(p, "auto");
+    binding += plan && planAmounts(p, plan->actions)[kTermLocations] > static_cast<int64_t>(prof.thresholds[0].at);
+  }
+  EXPECT_GE(binding, 20);
 }
 
 // A profile's constant cache: a warp whose palette footprint is past its capacity pays the miss

@@ -553,6 +553,93 @@ TEST(Calibrate, TheFitFindsTheConstantCachesCapacityAndItsMissPrice) {
   EXPECT_DOUBLE_EQ(hit, 10);
 }
 
+// A CPU device whose vertex inputs cost more past the 14th (lavapipe's, docs/device-profiles.md, "A
+// price past a threshold"), one mesh size: 4 ns a vertex, 0.3 per location and 4 more per location
+// past 14, 1.2 per storage-buffer vec4 load, 0.3 per slot, 1 per output component. A rig's floor
+// ("floor + every input fetched") reads every input and sums it at once: it pays no more past 14.
+namespace past14 {
+constexpr double kVertex = 4, kLocation = 0.3, kPast = 4, kVec4 = 1.2, kSlot = 0.3, kOutput = 1;
+double ns(const TermAmounts& a, bool floor) {
+  const double past = floor ? 0 : std::max(0.0, double(a[kTermLocations]) - 14);
+  return kVertex + kLocation * double(a[kTermLocations]) + kPast * past + kVec4 * double(a[kTermBufferVec4Loads]) +
+         kSlot * double(a[kTermArithmetic]) + kOutput * double(a[kTermOutputs]);
+}
+std::vector<CalibrationSample> rows(uint32_t seed, int n, double pastNs = kPast) {
+  std::mt19937 rng(seed);
+  auto pick = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+  std::vector<CalibrationSample> out;
+  for (int i = 0; i < n; ++i) {
+    CalibrationSample s;
+    s.mesh = "dawn";
+    s.vertices = 180000;
+    s.validated = true;
+    s.rig = fmt::format("rig{}", i / 4);
+    const bool floor = i % 4 == 3;
+    s.label = floor ? "floor + every input fetched" : fmt::format("plan: forced {}", i);
+    s.amounts[kTermLocations] = pick(1, 24);
+    s.amounts[kTermAttributeBytes] = 16 * s.amounts[kTermLocations];
+    s.amounts[kTermBufferVec4Loads] = floor || pick(0, 1) ? 0 : pick(1, 20);
+    s.amounts[kTermArithmetic] = floor ? s.amounts[kTermLocations] : pick(20, 200);
+    s.amounts[kTermOutputs] = 4 * pick(1, 8);
+    s.amounts[kTermVertices] = 1;
+    s.measuredNs = ns(s.amounts, floor) + (floor ? 0 : (pastNs - kPast) * std::max(0.0, double(s.amounts[kTermLocations]) - 14));
+    out.push_back(s);
+  }
+  return out;
+}
+}  // namespace past14
+
+// The fit finds where an input starts to cost more and what it costs past there, from the plans (the
+// floors, which do not pay it, left out); the form without a threshold cannot say it and chooses
+// the wrong plan; and a device without such a step gets no threshold.
+TEST(Calibrate, TheFitFindsWhereAVertexInputStartsToCostMore) {
+  const std::vector<CalibrationSample> train = past14::rows(1, 240), test = past14::rows(2, 80);
+  std::vector<CalibrationSample> testPlans = test;
+  std::erase_if(testPlans, [](const CalibrationSample& s) { return s.label.find("floor") != std::string::npos; });
+  FitOptions opts;
+  opts.thresholds = {kTermLocations};
+  opts.floors = false;
+  const DeviceProfile p = fitDeviceProfile(train, "past-14 device", 180000, 0, opts);
+  ASSERT_EQ(p.thresholds.size(), 1u);
+  EXPECT_EQ(p.thresholds[0].term, kTermLocations);
+  EXPECT_EQ(p.thresholds[0].at, 14);
+  EXPECT_NEAR(p.thresholds[0].nanoseconds, past14::kPast, 0.01);
+  EXPECT_NEAR(p.nanoseconds[kTermLocations] + 16 * p.nanoseconds[kTermAttributeBytes], past14::kLocation, 0.01);
+  EXPECT_NEAR(p.nanoseconds[kTermBufferVec4Loads], past14::kVec4, 0.01);
+  EXPECT_LT(rmsRelativeError(p, testPlans), 0.001);
+  // The Dawn face's choice: 16 locations, against 14 with the skin's two from a storage buffer (2 vec4
+  // loads, 8 slots more). The device: 4.8 + 8 = 12.8 ns against 4.2 + 2.4 + 2.4 = 9.0 (the rest alike).
+  TermAmounts attributes{}, buffered{};
+  attributes[kTermVertices] = buffered[kTermVertices] = 1;
+  attributes[kTermLocations] = 16, attributes[kTermAttributeBytes] = 256, attributes[kTermArithmetic] = 100;
+  buffered[kTermLocations] = 14, buffered[kTermAttributeBytes] = 224, buffered[kTermArithmetic] = 108;
+  buffered[kTermBufferVec4Loads] = 2;
+  EXPECT_NEAR(p.predictNanoseconds(attributes, 180000) - p.predictNanoseconds(buffered, 180000), 12.8 - 9.0, 0.05);
+  // Without a threshold the fit spreads the step over every location and keeps the attributes.
+  const DeviceProfile plain = fitDeviceProfile(train, "past-14 device", 180000, 0, FitOptions{});
+  EXPECT_TRUE(plain.thresholds.empty());
+  EXPECT_LT(plain.predictNanoseconds(attributes, 180000), plain.predictNanoseconds(buffered, 180000));
+  EXPECT_GT(rmsRelativeError(plain, testPlans), 0.02);
+  // With the floors in the fit, whose inputs past 14 cost nothing more, no price fits both: the
+  // plans are predicted worse.
+  FitOptions withFloors = opts;
+  withFloors.floors = true;
+  const DeviceProfile floored = fitDeviceProfile(train, "past-14 device", 180000, 0, withFloors);
+  EXPECT_GT(rmsRelativeError(floored, testPlans), 0.02);
+  // A device without the step: no threshold kept.
+  const DeviceProfile flat = fitDeviceProfile(past14::rows(1, 240, 0), "flat device", 180000, 0, opts);
+  EXPECT_TRUE(flat.thresholds.empty());
+  // Written and read back, the profile prices as fitted.
+  CalibrationReport r;
+  r.profile = p;
+  r.floors = false;
+  const std::string yaml = deviceProfileYaml(r);
+  EXPECT_NE(yaml.find("not the floors'"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("thresholds:"), std::string::npos) << yaml;
+  const DeviceProfile back = parseDeviceProfile(yaml, "past14.yaml");
+  for (const auto& s : testPlans) EXPECT_NEAR(back.predictNanoseconds(s.amounts, 180000), p.predictNanoseconds(s.amounts, 180000), 1e-4);
+}
+
 // A device whose large draws pay more per location and per vertex than its small ones (its
 // attributes stream from memory instead of a cache), with one price per fragment at every size.
 std::vector<CalibrationSample> twoSizeRows(uint32_t seed, int n) {
