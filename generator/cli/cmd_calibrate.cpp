@@ -359,7 +359,7 @@ void registerCalibrate(CLI::App& app, CliState& state) {
   sub->add_option("--threshold", cmd->thresholdTerms,
                   "Fit a price per unit of this term past a threshold, the threshold chosen by the fit among the amounts the "
                   "samples part, kept where it lowers the fit's error; repeat for up to 3 terms (docs/device-profiles.md, "
-                  "\"A price past a threshold\": lavapipe's inputs past the 14th)");
+                  "\"A price past a threshold\": lavapipe's inputs past the 15th)");
   sub->add_flag("--no-floors", cmd->noFloors,
                 "Fit the probes and the rigs' plans, not bench's floors (which read every input and sum it at once: on "
                 "lavapipe they price an input as no plan pays it; docs/device-profiles.md)");

@@ -14,7 +14,8 @@
 // memory: storage-buffer loads; constant: uniform loads at a per-vertex index; alu: arithmetic;
 // output: outputs), which the device overlaps. The raster form prices what the per-draw weights
 // stood in for on the H200 (docs/device-profiles.md, "The rasterizer's share"): the fragments a
-// draw covers, counted by the device.
+// draw covers, counted by the device. Any form may add hinges max(0, x_t - at) x w_h on terms
+// asked for (FitOptions::thresholds), each `at` chosen on a grid of the rows' amounts.
 #pragma once
 #include <optional>
 #include <string>
@@ -52,7 +53,7 @@ struct FitOptions {
   // error by kMinTermGain. Lavapipe: `locations` (docs/device-profiles.md, "A price past a threshold").
   std::vector<int> thresholds;
   // Whether bench's floors are rows of the fit (fitDeviceProfile). Their inputs are read and summed
-  // at once; where a device prices an input by the shader around it (lavapipe past 14 inputs), a
+  // at once; where a device prices an input by the shader around it (lavapipe past 15 inputs), a
   // floor prices inputs as no plan pays them.
   bool floors = true;
   FitOptions() = default;

@@ -313,7 +313,7 @@ DeviceProfile parseDeviceProfile(const std::string& text, const std::string& fil
       if (term < 0) c.fail(it->first, fmt::format("thresholds: unknown cost term '{}'", key));
       if (term == kTermVertices)
         c.fail(it->first, "thresholds: 'vertices' is 1 in every program, so a threshold on it would be a constant");
-      const YAML::Node& h = it->second;
+      const YAML::Node h = it->second;  // a copy: the iterator's pair is a temporary
       c.expectMap(h, fmt::format("threshold '{}'", key).c_str());
       c.checkKeys(h, {"at", "ns"});
       if (!h["at"] || !h["ns"])

@@ -66,8 +66,8 @@ struct DeviceProfile {
   double constantCacheMissFactor = 1;
   // Prices past a threshold (docs/device-profiles.md, "A price past a threshold"): past `at` units of
   // a term (times its workload feature) each unit costs `nanoseconds` more per vertex, a hinge
-  // max(0, amount - at) x ns added to the cost. On lavapipe a vertex input past the 14th costs
-  // about 4 ns more. A sum of hinges is a max of weighted sums (profileComponents), so the search
+  // max(0, amount - at) x ns added to the cost. On lavapipe a vertex input past the 15th costs
+  // about 9 ns more. A sum of hinges is a max of weighted sums (profileComponents), so the search
   // stays exact. None: every profile before session 29.
   struct Threshold {
     int term = 0;
