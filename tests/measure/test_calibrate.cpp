@@ -179,6 +179,8 @@ TEST(Calibrate, TwoMeshSizesSeparatePerDrawFromPerVertexCosts) {
             s.amounts[kTermBufferLoads] = loads;
             s.amounts[kTermOutputs] = outputs;
             s.amounts[kTermVertices] = 1;
+            // As calibrate counts it: 1 per vertex outside the raster form, so no per-draw weight of its own.
+            s.amounts[kTermFragments] = 1;
             s.measuredNs = 0;
             for (int t = 0; t < kTermCount; ++t)
               s.measuredNs += (perVertex[t] + perDraw[t] / vertices) * double(s.amounts[size_t(t)]);
