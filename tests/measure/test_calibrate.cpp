@@ -566,7 +566,9 @@ double ns(const TermAmounts& a, bool floor) {
   return kVertex + kLocation * double(a[kTermLocations]) + kPast * past + kVec4 * double(a[kTermBufferVec4Loads]) +
          kSlot * double(a[kTermArithmetic]) + kOutput * double(a[kTermOutputs]);
 }
-std::vector<CalibrationSample> rows(uint32_t seed, int n, double pastNs = kPast) {
+// vec4PastNs: a second step, each storage-buffer vec4 load past 12 costing that much more (lavapipe's
+// loads past 18, session 30).
+std::vector<CalibrationSample> rows(uint32_t seed, int n, double pastNs = kPast, double vec4PastNs = 0) {
   std::mt19937 rng(seed);
   auto pick = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
   std::vector<CalibrationSample> out;
@@ -584,7 +586,8 @@ std::vector<CalibrationSample> rows(uint32_t seed, int n, double pastNs = kPast)
     s.amounts[kTermArithmetic] = floor ? s.amounts[kTermLocations] : pick(20, 200);
     s.amounts[kTermOutputs] = 4 * pick(1, 8);
     s.amounts[kTermVertices] = 1;
-    s.measuredNs = ns(s.amounts, floor) + (floor ? 0 : (pastNs - kPast) * std::max(0.0, double(s.amounts[kTermLocations]) - 14));
+    s.measuredNs = ns(s.amounts, floor) + (floor ? 0 : (pastNs - kPast) * std::max(0.0, double(s.amounts[kTermLocations]) - 14)) +
+                   vec4PastNs * std::max(0.0, double(s.amounts[kTermBufferVec4Loads]) - 12);
     out.push_back(s);
   }
   return out;
@@ -640,6 +643,41 @@ TEST(Calibrate, TheFitFindsWhereAVertexInputStartsToCostMore) {
   EXPECT_NE(yaml.find("thresholds:"), std::string::npos) << yaml;
   const DeviceProfile back = parseDeviceProfile(yaml, "past14.yaml");
   for (const auto& s : testPlans) EXPECT_NEAR(back.predictNanoseconds(s.amounts, 180000), p.predictNanoseconds(s.amounts, 180000), 1e-4);
+}
+
+// Two steps at once, on two terms (lavapipe's inputs past the 15th and buffer vec4 loads past the 18th):
+// the fit finds both where each is and what each costs; with only the first, the second's price is
+// spread over every load and the plans are predicted worse.
+TEST(Calibrate, TwoThresholdsAreFittedTogether) {
+  constexpr double kVec4Past = 2;
+  const std::vector<CalibrationSample> train = past14::rows(3, 320, past14::kPast, kVec4Past);
+  std::vector<CalibrationSample> testPlans = past14::rows(4, 80, past14::kPast, kVec4Past);
+  std::erase_if(testPlans, [](const CalibrationSample& s) { return s.label.find("floor") != std::string::npos; });
+  FitOptions opts;
+  opts.thresholds = {kTermBufferVec4Loads, kTermLocations};  // in any order: the profile keeps term order
+  opts.floors = false;
+  const DeviceProfile p = fitDeviceProfile(train, "two-step device", 180000, 0, opts);
+  ASSERT_EQ(p.thresholds.size(), 2u);
+  EXPECT_EQ(p.thresholds[0].term, kTermLocations);
+  EXPECT_EQ(p.thresholds[0].at, 14);
+  EXPECT_NEAR(p.thresholds[0].nanoseconds, past14::kPast, 0.01);
+  EXPECT_EQ(p.thresholds[1].term, kTermBufferVec4Loads);
+  EXPECT_EQ(p.thresholds[1].at, 12);
+  EXPECT_NEAR(p.thresholds[1].nanoseconds, kVec4Past, 0.01);
+  EXPECT_NEAR(p.nanoseconds[kTermBufferVec4Loads], past14::kVec4, 0.01);
+  EXPECT_LT(rmsRelativeError(p, testPlans), 0.001);
+  FitOptions one = opts;
+  one.thresholds = {kTermLocations};
+  const DeviceProfile onlyInputs = fitDeviceProfile(train, "two-step device", 180000, 0, one);
+  ASSERT_EQ(onlyInputs.thresholds.size(), 1u);
+  EXPECT_GT(rmsRelativeError(onlyInputs, testPlans), 0.01);
+  // Twenty vec4 loads against twelve: the device pays 8 x (1.2 + 2) = 25.6 ns more, each load past 12 at
+  // its price and the step's; the one-threshold fit prices the eight well below that.
+  TermAmounts many{}, few{};
+  many[kTermVertices] = few[kTermVertices] = 1;
+  many[kTermBufferVec4Loads] = 20, few[kTermBufferVec4Loads] = 12;
+  EXPECT_NEAR(p.predictNanoseconds(many, 180000) - p.predictNanoseconds(few, 180000), 8 * (past14::kVec4 + kVec4Past), 0.1);
+  EXPECT_LT(onlyInputs.predictNanoseconds(many, 180000) - onlyInputs.predictNanoseconds(few, 180000), 8 * (past14::kVec4 + kVec4Past) - 1);
 }
 
 // A device whose large draws pay more per location and per vertex than its small ones (its
