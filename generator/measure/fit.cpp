@@ -409,41 +409,27 @@ FitResult fitProfile(const std::vector<FitRow>& rows, const FitOptions& options)
     }
   }
   // Prices past a threshold (docs/device-profiles.md, "A price past a threshold"): for each term
-  // asked, in term order, each threshold between two distinct amounts of the rows
-  // (kMinRowsPerSideOfThreshold rows at least on each side) with its price as one more parameter;
-  // the best is kept where it explains kMinTermGain of the squared error. Each was placed with the
-  // later ones unmodelled, so each is then placed again with the others fixed, until none moves.
-  auto thresholdCandidates = [&](int term) {
+  // asked, in term order (the profile must not depend on the order of the flags), each threshold
+  // between two distinct amounts of the rows (kMinRowsPerSideOfThreshold rows at least on each
+  // side) with its price as one more parameter; the best is kept where it explains kMinTermGain of
+  // the squared error.
+  std::vector<int> thresholdTerms = options.thresholds;
+  std::sort(thresholdTerms.begin(), thresholdTerms.end());
+  for (int term : thresholdTerms) {
     std::vector<double> amounts;
     for (const auto& x : xs) amounts.push_back(x[static_cast<size_t>(term)]);
     std::sort(amounts.begin(), amounts.end());
     std::set<double> candidates;
     for (size_t i = kMinRowsPerSideOfThreshold; i + kMinRowsPerSideOfThreshold <= amounts.size(); ++i)
       if (amounts[i] > amounts[i - 1]) candidates.insert(amounts[i - 1]);  // rows at or below it pay nothing
-    return candidates;
-  };
-  std::vector<int> thresholdTerms = options.thresholds;
-  std::sort(thresholdTerms.begin(), thresholdTerms.end());
-  for (int term : thresholdTerms) {
     Solved bestWith;
     Layout chosen;
-    for (double at : thresholdCandidates(term)) {
+    for (double at : candidates) {
       Layout with = l;
       with.thresholds.emplace_back(term, at);
       if (Solved s = solve(with, rows, xs, pastCapacity); s.cost < bestWith.cost) bestWith = std::move(s), chosen = with;
     }
     if (!chosen.thresholds.empty() && gains(bestWith.cost, best.cost)) best = std::move(bestWith), l = chosen;
-  }
-  for (bool moved = l.thresholds.size() > 1; moved;) {
-    moved = false;
-    for (size_t h = 0; h < l.thresholds.size(); ++h)
-      for (double at : thresholdCandidates(l.thresholds[h].first)) {
-        if (at == l.thresholds[h].second) continue;
-        Layout with = l;
-        with.thresholds[h].second = at;
-        if (Solved s = solve(with, rows, xs, pastCapacity); s.cost < best.cost * (1 - 1e-9))
-          best = std::move(s), l = std::move(with), moved = true;
-      }
   }
   FitResult out;
   out.converged = best.converged;
