@@ -44,6 +44,7 @@ json rowJson(const GpuBenchRow& r) {
           {"has_amounts", r.hasAmounts},
           {"plan_cost", r.planCost},
           {"spirv_instructions", r.spirvInstructions},
+          {"program", r.program},
           {"validation", r.validation},
           {"amounts", r.amounts},
           {"predicted", r.predictedNsPerVertex},
@@ -63,6 +64,7 @@ GpuBenchRow rowFrom(const json& j) {
   r.hasAmounts = j.at("has_amounts");
   r.planCost = j.at("plan_cost");
   r.spirvInstructions = j.at("spirv_instructions");
+  r.program = j.at("program");
   r.validation = j.at("validation");
   r.amounts = j.at("amounts").get<TermAmounts>();
   r.predictedNsPerVertex = j.at("predicted");

@@ -122,6 +122,9 @@ struct CalibrationSample {
   // shadedVerticesPerVertex; -1: not counted); its fragments are workload.fragmentsPerVertex.
   double shadedPerVertex = -1;
   double predictedNs = -1;  // under the fitted profile
+  // The timed SPIR-V's hash (GpuBenchRow::program; "" in logs before session 31): where the log
+  // timed one program in several runs, the held-out check counts it at its best (predictRigs).
+  std::string program;
 };
 
 struct CalibrationFit {

@@ -11,6 +11,7 @@
 #include <set>
 
 #include "analysis/cost.h"
+#include "common/content_hash.h"
 #include "common/glsl_compile.h"
 #include "common/input_file.h"
 #include "measure/fit.h"
@@ -22,6 +23,15 @@
 
 namespace sg {
 namespace {
+
+// GpuBenchRow::program: the words as little-endian bytes, so a log names a program alike on every host.
+std::string programId(const std::vector<uint32_t>& words) {
+  std::string bytes;
+  bytes.reserve(words.size() * 4);
+  for (uint32_t w : words)
+    for (int shift = 0; shift < 32; shift += 8) bytes.push_back(char((w >> shift) & 0xff));
+  return sha256Hex(bytes).substr(0, 16);
+}
 
 // One program to time: its render and capture builds (fed by programInputs).
 struct Program {
@@ -356,6 +366,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     if (p.render.in.profile)
       p.row.predictedNsPerVertex = predictPlanCost(p.render.plan, p.render.in.problem, *p.render.in.profile).totalNanoseconds;
     p.row.spirvInstructions = countInstructions(p.render.spirv.words);
+    p.row.program = programId(p.render.spirv.words);
     programs.push_back(std::move(p));
     return true;
   };
@@ -388,6 +399,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     p.capture = handWrittenProgram(addCaptureQualifiers(text, opts.handPortPath, chosenCapture.glsl), opts.handPortPath,
                                    chosenCapture, env);
     p.row.spirvInstructions = countInstructions(p.render.spirv.words);
+    p.row.program = programId(p.render.spirv.words);
     programs.push_back(std::move(p));
   }
   for (bool allInputs : {false, true}) {
@@ -397,6 +409,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     p.render = handWrittenProgram(floorShader(chosen, false, allInputs), "floor.vert", chosen, env);
     p.capture = handWrittenProgram(floorShader(chosenCapture, true, allInputs), "floor.vert", chosenCapture, env);
     p.row.spirvInstructions = countInstructions(p.render.spirv.words);
+    p.row.program = programId(p.render.spirv.words);
     p.row.hasAmounts = true;
     p.row.amounts = floorAmounts(p.render, chosen.in.problem, env);
     if (chosen.in.profile)

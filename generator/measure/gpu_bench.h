@@ -47,6 +47,9 @@ struct GpuBenchRow {
   bool hasAmounts = false;         // amounts known: the plans and the floors
   int64_t planCost = 0;
   size_t spirvInstructions = 0;    // of the render build
+  // The render build's SPIR-V, hashed (SHA-256, first 16 hex digits): the same program timed in
+  // two runs (a profile's plan among another plan's alternatives) is known as one.
+  std::string program;
   // Validation on the device before timing: "pass", "FAIL: <output ...>" (then not timed),
   // or "" for the floors, which write constants on purpose.
   std::string validation;

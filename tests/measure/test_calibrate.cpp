@@ -824,6 +824,14 @@ TEST(Calibrate, TheCheckStatesTheChosenPlansRatioWithinEachRound) {
   }
   EXPECT_EQ(back.size(), timed);
   for (const auto& s : back) EXPECT_GE(s.medianRoundNs, s.measuredNs) << s.label;
+  // And the program each row timed (its SPIR-V's hash), for the held-out check to match across runs.
+  std::vector<std::string> programs;
+  for (const auto& s : r.samples)
+    if (s.validated) programs.push_back(s.program);
+  for (size_t i = 0; i < back.size() && i < programs.size(); ++i) {
+    EXPECT_EQ(back[i].program, programs[i]) << back[i].label;
+    EXPECT_EQ(back[i].program.size(), 16u) << back[i].label;
+  }
   for (const auto& c : r.checks) {
     ASSERT_GT(c.plans, 1u) << c.rig;
     EXPECT_EQ(c.byRound.rounds, 2u) << c.rig;

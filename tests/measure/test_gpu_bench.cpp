@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <regex>
+#include <set>
 
 #include "common/input_file.h"
 #include "measure/gpu_bench.h"
@@ -173,6 +175,33 @@ TEST(GpuBench, BufferFedAlternativesAreValidatedAndTimed) {
     EXPECT_GT(row.rasterOffNsPerVertex, 0) << row.label;
   }
   EXPECT_GE(bufferRows, 3u);
+  // Each row names its SPIR-V (16 hex digits of its SHA-256), and every row is another program.
+  std::set<std::string> programs;
+  for (const auto& row : rep.rows) {
+    EXPECT_TRUE(std::regex_match(row.program, std::regex("[0-9a-f]{16}"))) << row.label << ": " << row.program;
+    programs.insert(row.program);
+  }
+  EXPECT_EQ(programs.size(), rep.rows.size());
+}
+
+TEST(GpuBench, AProgramHasTheSameNameInEveryRun) {
+  // calibrate's held-out check matches one program timed in two runs by it (HeldOut,
+  // AProgramTimedInTwoRunsCountsAtItsBestTiming): the same inputs name the same programs.
+  sg::GpuBenchOptions b = quickBench(sourcePath("examples/dawn/rules.yaml"));
+  b.alternatives = false;
+  b.floor = true;
+  const sg::GpuBenchReport first = sg::runGpuBench(b), second = sg::runGpuBench(b);
+  ASSERT_EQ(first.rows.size(), 3u);  // the plan and the two floors
+  ASSERT_EQ(second.rows.size(), first.rows.size());
+  for (size_t i = 0; i < first.rows.size(); ++i) {
+    EXPECT_EQ(first.rows[i].label, second.rows[i].label);
+    EXPECT_EQ(first.rows[i].program, second.rows[i].program) << first.rows[i].label;
+  }
+  EXPECT_NE(first.rows[0].program, first.rows[1].program);
+  // Another plan of the same rig is another program: the influences read from a storage buffer.
+  b.render.gen.bannedRules = {"skin_matrix_blend"};
+  const sg::GpuBenchReport banned = sg::runGpuBench(b);
+  EXPECT_NE(banned.rows[0].program, first.rows[0].program);
 }
 
 TEST(GpuBench, AProgramThatFailsOnTheDeviceIsReportedAndNotTimed) {
