@@ -468,8 +468,9 @@ double medianOfFinite(std::vector<double> v) {
 
 std::string heldOutSummary(const LeaveOneRigOut& loo, const char* what = "leave-one-rig-out") {
   return fmt::format("{} over {} (rig, mesh) pairs: median Spearman {:.3f}, worst chosen / fastest {:.3f}, "
-                     "RMS relative error median {:.1f} %, max {:.1f} %{}",
+                     "RMS relative error median {:.1f} %, max {:.1f} %, each pair's level divided out: median {:.1f} %{}",
                      what, loo.rows.size(), loo.medianSpearman, loo.worstChosenOverFastest, 100 * loo.medianRms, 100 * loo.maxRms,
+                     100 * loo.medianRmsWithinPair,
                      loo.pairsWithATieForLeast == 0 ? ""
                                                  : fmt::format("; in {} the least prediction is shared (the slowest of those "
                                                                "plans counted)",
@@ -557,6 +558,15 @@ std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& sample
       sq += rel * rel;
     }
     h.rmsRelativeError = std::sqrt(sq / double(h.plans));
+    double logLevel = 0;
+    for (size_t i = 0; i < h.plans; ++i) logLevel += std::log(h.predicted[i] / h.measured[i]);
+    h.level = std::exp(logLevel / double(h.plans));
+    double within = 0;
+    for (size_t i = 0; i < h.plans; ++i) {
+      const double rel = (h.predicted[i] / h.level - h.measured[i]) / h.measured[i];
+      within += rel * rel;
+    }
+    h.rmsWithinPair = std::sqrt(within / double(h.plans));
     // The chosen plan: the least predicted; where several share it, the slowest of them (which
     // one the search returns depends on the order it meets them, not on the profile).
     const double least = *std::min_element(h.predicted.begin(), h.predicted.end());
@@ -587,8 +597,9 @@ std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& sample
 LeaveOneRigOut summarise(std::vector<HeldOutRig> rows) {
   LeaveOneRigOut out;
   out.rows = std::move(rows);
-  std::vector<double> rho, rms;
+  std::vector<double> rho, rms, within;
   for (const auto& h : out.rows) {
+    within.push_back(h.rmsWithinPair);
     if (h.ownPlan) ++out.pairsWithOwnPlan, out.ownPlansByNameOnly += h.ownPlanByNameOnly;
     else if (h.tiedForLeast > 1) ++out.pairsWithATieForLeast;
     rho.push_back(h.spearman);
@@ -598,6 +609,7 @@ LeaveOneRigOut summarise(std::vector<HeldOutRig> rows) {
   }
   out.medianSpearman = medianOfFinite(rho);
   out.medianRms = medianOfFinite(rms);
+  out.medianRmsWithinPair = medianOfFinite(within);
   return out;
 }
 
@@ -643,15 +655,17 @@ namespace {
 // One table of held-out predictions (rig, mesh, plans and the figures), then its summary.
 std::string heldOutTable(const LeaveOneRigOut& t, const char* what, const char* meaning, const char* rigColumn) {
   if (t.rows.empty()) return "";
-  std::string s = fmt::format("\n{}: {}\n\n| {} | mesh | plans | Spearman | chosen / fastest | RMS relative error |\n"
-                              "|---|---|---:|---:|---:|---:|\n",
+  std::string s = fmt::format("\n{}: {}\n\n| {} | mesh | plans | Spearman | chosen / fastest | RMS relative error | "
+                              "level (predicted / measured) | RMS, the level divided out |\n"
+                              "|---|---|---:|---:|---:|---:|---:|---:|\n",
                               what, meaning, rigColumn);
   for (const auto& h : t.rows)
-    s += fmt::format("| {} | {} | {} | {:.3f} | {:.3f}{} | {:.1f} % |\n", h.rig, h.mesh, h.plans, h.spearman, h.chosenOverFastest,
+    s += fmt::format("| {} | {} | {} | {:.3f} | {:.3f}{} | {:.1f} % | {:.3f} | {:.1f} % |\n", h.rig, h.mesh, h.plans, h.spearman,
+                     h.chosenOverFastest,
                      h.ownPlan            ? std::string(" (its plan)")
                      : h.tiedForLeast > 1 ? fmt::format(" ({} tied)", h.tiedForLeast)
                                           : std::string(),
-                     100 * h.rmsRelativeError);
+                     100 * h.rmsRelativeError, h.level, 100 * h.rmsWithinPair);
   return s + heldOutSummary(t, what) + "\n";
 }
 

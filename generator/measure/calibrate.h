@@ -163,10 +163,16 @@ struct HeldOutRig {
   bool ownPlan = false;
   bool ownPlanByNameOnly = false;  // its label had no fingerprint (ownPlanLabels' second)
   double rmsRelativeError = NAN;
+  // The pair's level: the geometric mean of predicted over measured, and the RMS relative error
+  // left with the predictions divided by it. A choice turns on the second alone (every plan of a
+  // pair is scaled alike); on the GPUs most of the RMS error is the first (docs/device-profiles.md).
+  double level = NAN;
+  double rmsWithinPair = NAN;
 };
 struct LeaveOneRigOut {
   std::vector<HeldOutRig> rows;  // by rig, then mesh
   double medianSpearman = NAN, worstChosenOverFastest = NAN, medianRms = NAN, maxRms = NAN;
+  double medianRmsWithinPair = NAN;  // of HeldOutRig::rmsWithinPair
   size_t pairsWithATieForLeast = 0;  // rows whose least prediction several plans share (tie rule applied)
   size_t pairsWithOwnPlan = 0;       // rows counting the profile's own plan (HeldOutRig::ownPlan)
   size_t ownPlansByNameOnly = 0;     // of them, found by the name-only label of older logs

@@ -1,6 +1,7 @@
 // Leave-one-rig-out (measure/calibrate.h) on the samples of a real H200 calibration
 // (bench/data/h200-calibrate-alike.log): each rig's plans predicted by a fit that never saw
 // that rig, and the figures computed as stated.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -158,6 +159,31 @@ TEST(HeldOut, PlanUnderLabelNamesTheProfileFilesStemAndContents) {
   std::ofstream(dir + "/h100.yaml") << "abd";  // one byte more or less is another profile
   EXPECT_NE(planUnderLabel(dir + "/h100.yaml"), "plan under h100@ba7816bf8f01: ");
   EXPECT_THROW(planUnderLabel(dir + "/no-such-profile.yaml"), std::exception);
+}
+
+// A pair's level (the geometric mean of predicted over measured) and the error left with it divided
+// out, by hand on predictions 5, 5 and 7 against 5, 6 and 5.5; a device twice as slow on every plan
+// moves the level and the RMS error, not what is left, which is what a choice turns on.
+TEST(HeldOut, APairsLevelIsDividedOutOfItsErrorAsDefined) {
+  const DeviceProfile p = twoPipeRoofline();
+  const std::vector<CalibrationSample> samples = {plan("plan: generated", 4, 0, 5), plan("plan: forced x", 4, 4, 6),
+                                                  plan("plan: forced y", 6, 0, 5.5)};
+  const LeaveOneRigOut check = checkHeldOut(samples, p);
+  ASSERT_EQ(check.rows.size(), 1u);
+  const double level = std::cbrt(5.0 / 5 * 5.0 / 6 * 7.0 / 5.5);
+  EXPECT_NEAR(check.rows[0].level, level, 1e-12);
+  const double within = std::sqrt((std::pow(5 / level / 5 - 1, 2) + std::pow(5 / level / 6 - 1, 2) + std::pow(7 / level / 5.5 - 1, 2)) / 3);
+  EXPECT_NEAR(check.rows[0].rmsWithinPair, within, 1e-12);
+  EXPECT_NEAR(check.medianRmsWithinPair, within, 1e-12);
+  std::vector<CalibrationSample> slower = samples;
+  for (auto& s : slower) s.measuredNs *= 2;
+  const LeaveOneRigOut twice = checkHeldOut(slower, p);
+  EXPECT_NEAR(twice.rows[0].level, level / 2, 1e-12);
+  EXPECT_NEAR(twice.rows[0].rmsWithinPair, within, 1e-12);
+  EXPECT_GT(std::abs(twice.rows[0].rmsRelativeError - check.rows[0].rmsRelativeError), 0.1);
+  const std::string text = formatHeldOutCheck(check);
+  EXPECT_NE(text.find(fmt::format("| {:.3f} | {:.1f} % |", level, 100 * within)), std::string::npos) << text;
+  EXPECT_NE(text.find(fmt::format("each pair's level divided out: median {:.1f} %", 100 * within)), std::string::npos) << text;
 }
 
 // calibrate --evaluate PROFILE on a log timed with --plans-under PROFILE: the log holds the plan
