@@ -3,8 +3,9 @@
 "level (predicted / measured)" column) and the logs it checked, and prints, per mesh, the correlation of
 log(level) with features of the pair: each term amount of its fastest plan, its joints per warp,
 fragments per vertex, the fastest time, and the size of the request's fragment shader (instructions of
-its optimised SPIR-V, from FRAGSIZES: lines "NAME COUNT").
-  Usage: levels.py EVALUATE.txt FRAGSIZES LOG...
+its optimised SPIR-V, from FRAGSIZES: lines "NAME COUNT") and the rig's deformers (DEFORMERS: lines
+"NAME BONES INFLUENCES MORPH_TARGETS").
+  Usage: levels.py EVALUATE.txt FRAGSIZES DEFORMERS LOG...
 """
 import math, sys, collections
 
@@ -38,8 +39,9 @@ def corr(a, b):
 
 level = levels(sys.argv[1])
 frag = dict(l.split() for l in open(sys.argv[2]))
+deformers = {l.split()[0]: [float(x) for x in l.split()[1:]] for l in open(sys.argv[3])}
 fastest = {}
-for log in sys.argv[3:]:
+for log in sys.argv[4:]:
     for r in rows(log):
         key = (r['rig'], r['mesh'])
         if key in level and (key not in fastest or float(r['measured ns/vertex']) < float(fastest[key]['measured ns/vertex'])):
@@ -55,6 +57,8 @@ for mesh in sorted({m for _, m in fastest}):
     feats['fragments per vertex'] = [float(fastest[k].get('fragments per vertex', 'nan').replace('—', 'nan')) for k in keys]
     feats['fastest ns/vertex'] = [float(fastest[k]['measured ns/vertex']) for k in keys]
     feats['fragment shader instructions'] = [float(frag.get(k[0].replace('.rig.yaml', ''), 'nan')) for k in keys]
+    for i, name in enumerate(['bones', 'influences', 'morph targets']):
+        feats['the rig\'s ' + name] = [deformers.get(k[0].replace('.rig.yaml', ''), [math.nan] * 3)[i] for k in keys]
     spread = sorted(level[k] for k in keys)
     print(f"{mesh}: {len(keys)} pairs, level from {spread[0]:.3f} to {spread[-1]:.3f} (median {spread[len(spread) // 2]:.3f})")
     for name, x in feats.items():
