@@ -526,8 +526,11 @@ std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& sample
     // best: on a CPU device a whole run can drift 20-60 % (bench/data/lavapipe-many-inputs30), and
     // the own plan at its run's time against the fastest of every run would read drift as a miss.
     std::map<std::string, double> bestOfProgram;
+    // (Structured bindings are named through references: clang cannot capture them before C++20.)
+    const std::string &pairRig = r, &pairRequest = request, &pairMesh = mesh;
     auto isPlanOfPair = [&](const CalibrationSample& s) {
-      return s.rig == r && s.request == request && s.mesh == mesh && isPlanSample(s) && s.validated && s.measuredNs > 0;
+      return s.rig == pairRig && s.request == pairRequest && s.mesh == pairMesh && isPlanSample(s) && s.validated &&
+             s.measuredNs > 0;
     };
     for (const auto& s : samples)
       if (isPlanOfPair(s) && !s.program.empty()) {
