@@ -372,6 +372,9 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   };
   addGenerated("generated");
   const GenerateResult chosen = programs.front().render, chosenCapture = programs.front().capture;  // programs grows
+  // A portable choice's alternatives are priced by their regret against each device's optimum
+  // of the unbanned problem, as the chosen plan is: comparable plan costs.
+  in.portableBest = chosen.in.portableBest;
   if (opts.alternatives) {
     const Problem& p = chosen.in.problem;
     for (int a : chosen.plan.actions) {

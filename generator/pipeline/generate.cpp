@@ -239,17 +239,19 @@ Plan searchUnderOptions(LoadedInputs& in, const GenerateOptions& opts, SearchSta
   dropOversizedBuffers(in.problem, opts.maxVertices, opts.maxStorageBufferBytes);
   const SearchOptions search{opts.searchEngine, opts.heuristic, opts.searchLimits};
   if (in.profile && !in.portable.empty()) {
-    // Least worst-case regret: each device's own optimum first, under the same limits.
+    // Least worst-case regret: each device's own optimum first, under the same bans and limits,
+    // unless the caller gave the optima to measure regret against (LoadedInputs::portableBest).
     std::vector<DeviceProfile> all{*in.profile};
     all.insert(all.end(), in.portable.begin(), in.portable.end());
-    std::vector<int64_t> best;
-    for (const DeviceProfile& d : all) {
-      LoadedInputs one = in;
-      applyDeviceProfile(one.problem, d);
-      best.push_back(searchStage(one, search, nullptr).cost);
+    if (in.portableBest.size() != all.size()) {
+      in.portableBest.clear();
+      for (const DeviceProfile& d : all) {
+        LoadedInputs one = in;
+        applyDeviceProfile(one.problem, d);
+        in.portableBest.push_back(searchStage(one, search, nullptr).cost);
+      }
     }
-    applyPortableProfiles(in.problem, all, best);
-    in.portableBest = best;
+    applyPortableProfiles(in.problem, all, in.portableBest);
   }
   return searchStage(in, search, stats);
 }

@@ -27,7 +27,10 @@ struct LoadedInputs {
   // and these is minimised; searchStage's caller prices it, pipeline/generate.cpp).
   std::vector<DeviceProfile> portable;
   // Each device's optimum (`profile` first, then `portable`), fs per vertex: set by the search
-  // of a portable choice, for the regret report (describePortable).
+  // of a portable choice, for the regret report (describePortable). Given before the search
+  // (one per device), regret is measured against these instead: bench prices each forced
+  // alternative against the optima of the unbanned problem, so that its regret compares with
+  // the chosen plan's (searched under its bans, each device's optimum would be its own).
   std::vector<int64_t> portableBest;
   // The workload the problem is priced for (GenerateOptions::workload): reports show it.
   Workload workload;

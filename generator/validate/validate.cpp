@@ -583,6 +583,9 @@ ValidateReport Validator::run(const ValidationScene& scene, const GenerateOption
     // alternative (ban every other producer) and check it computes the same outputs.
     const Problem& p = chosen.in.problem;
     std::set<std::vector<std::string>> seenPlans{report.runs.front().rules};
+    // A portable choice's alternatives: the least regret against the unbanned optima, the
+    // programs bench times (LoadedInputs::portableBest).
+    in.portableBest = chosen.in.portableBest;
     for (int a : chosen.plan.actions) {
       int fact = p.actions[a].add;
       std::vector<std::string> producers;
