@@ -24,13 +24,9 @@
 namespace sg {
 namespace {
 
-// GpuBenchRow::program: the words as little-endian bytes, so a log names a program alike on every host.
+// GpuBenchRow::program: the module's bytes as a .spv file holds them (generate, build's cache).
 std::string programId(const std::vector<uint32_t>& words) {
-  std::string bytes;
-  bytes.reserve(words.size() * 4);
-  for (uint32_t w : words)
-    for (int shift = 0; shift < 32; shift += 8) bytes.push_back(char((w >> shift) & 0xff));
-  return sha256Hex(bytes).substr(0, 16);
+  return sha256Hex(std::string_view(reinterpret_cast<const char*>(words.data()), words.size() * 4)).substr(0, 16);
 }
 
 // One program to time: its render and capture builds (fed by programInputs).
