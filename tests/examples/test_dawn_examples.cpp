@@ -141,6 +141,23 @@ TEST_P(DawnValidation, ValidatesWithCrossCheckOnLavapipe) {
       for (const auto& o : run.outputs) EXPECT_TRUE(o.floatCheck.ran && o.floatCheck.pass) << run.label << " " << o.name;
 }
 
+// A portable choice's alternatives are searched for the least regret against the unbanned
+// optima, as bench times them (GpuBench.APortableChoicesAlternativesArePricedByRegretAgainstTheUnbannedOptima):
+// each is one of the plans the chosen one is the least of, so its plan cost is no less.
+TEST(DawnValidationPortable, CrossCheckedAlternativesAreNoCheaperThanTheChosenPlan) {
+  ValidateOptions vo;
+  vo.gen = dawnOptions(kDawn + "face.rig.yaml", "face.frag");
+  vo.gen.deviceProfilePath = std::string(SG_SOURCE_DIR) + "/devices/nvidia-h200-roofline.yaml";
+  vo.gen.portableProfilePaths = {std::string(SG_SOURCE_DIR) + "/devices/llvmpipe-2core.yaml"};
+  vo.crossCheck = true;
+  Validator v(vo);
+  const ValidateReport report = v.run(proceduralScene(loadRigFile(vo.gen.rigPath), "head", 7, 2));
+  EXPECT_TRUE(report.pass) << formatReport(report);
+  ASSERT_GE(report.runs.size(), 3u) << formatReport(report);
+  EXPECT_GT(report.runs[0].planCost, 1000000000);  // a regret above 1, in units of 10^-9
+  for (const auto& run : report.runs) EXPECT_GE(run.planCost, report.runs[0].planCost) << run.label;
+}
+
 INSTANTIATE_TEST_SUITE_P(Examples, DawnValidation,
                          ::testing::Values(std::make_pair("face.rig.yaml", "face.frag"),
                                            std::make_pair("face-packed.rig.yaml", "face.frag"),  // encoded, halves, bytes
