@@ -89,6 +89,7 @@ struct Harness::Impl {
   uint32_t queueFamily = 0;
   VkQueue queue = VK_NULL_HANDLE;
   bool memoryBudget = false;  // VK_EXT_memory_budget enabled
+  bool executableStatistics = false;  // VK_KHR_pipeline_executable_properties enabled
   std::unique_ptr<setup::Device> setup;  // what program set-up needs (vk_setup.h)
 
   static VKAPI_ATTR VkBool32 VKAPI_CALL onMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
@@ -245,6 +246,22 @@ struct Harness::Impl {
     std::vector<const char*> exts{VK_EXT_TRANSFORM_FEEDBACK_EXTENSION_NAME};
     memoryBudget = hasDeviceExtension(dev.pd, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
     if (memoryBudget) exts.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+    // Where the device has it, the compiler's statistics of each timed program (bench's
+    // "driver statistics"). Capturing them must not change the compiled pipeline (the
+    // extension's VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR), so timings stay comparable.
+    VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR execFeat{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
+    if (hasDeviceExtension(dev.pd, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME)) {
+      VkPhysicalDeviceFeatures2 query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+      query.pNext = &execFeat;
+      vkGetPhysicalDeviceFeatures2(dev.pd, &query);
+      execFeat.pNext = nullptr;
+      executableStatistics = execFeat.pipelineExecutableInfo == VK_TRUE;
+      if (executableStatistics) {
+        exts.push_back(VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
+        xfbFeat.pNext = &execFeat;
+      }
+    }
     VkDeviceCreateInfo ci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
     ci.pNext = &f2;
     ci.queueCreateInfoCount = 1;
@@ -254,7 +271,7 @@ struct Harness::Impl {
     check(vkCreateDevice(dev.pd, &ci, nullptr, &device), "vkCreateDevice");
     vkGetDeviceQueue(device, queueFamily, 0, &queue);
 
-    setup = std::make_unique<setup::Device>(Harness::Handles{dev.pd, device, queueFamily, queue, memoryBudget});
+    setup = std::make_unique<setup::Device>(Harness::Handles{dev.pd, device, queueFamily, queue, memoryBudget, executableStatistics});
   }
 
   void destroy() {
@@ -301,7 +318,7 @@ std::string Harness::driver() const { return impl_->dev.driver; }
 bool Harness::validationEnabled() const { return impl_->validation; }
 const VkPhysicalDeviceLimits& Harness::limits() const { return impl_->dev.props.limits; }
 Harness::Handles Harness::handles() const {
-  return {impl_->dev.pd, impl_->device, impl_->queueFamily, impl_->queue, impl_->memoryBudget};
+  return {impl_->dev.pd, impl_->device, impl_->queueFamily, impl_->queue, impl_->memoryBudget, impl_->executableStatistics};
 }
 
 RunResult Harness::run(const RunRequest& req) {

@@ -68,6 +68,9 @@ class Harness {
     uint32_t queueFamily;
     VkQueue queue;
     bool memoryBudget;  // VK_EXT_memory_budget enabled: heaps' usage and budget can be asked
+    // VK_KHR_pipeline_executable_properties enabled: the driver's statistics of a compiled
+    // pipeline (registers, instructions, ...) can be asked (ProgramObjects::vertexStatistics)
+    bool executableStatistics = false;
   };
   Handles handles() const;
 

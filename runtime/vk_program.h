@@ -66,4 +66,12 @@ struct ProgramInputs {
   InputMemory memory = InputMemory::DeviceLocal;  // where the buffers above live on the device
 };
 
+// One statistic a driver reports of the vertex stage it compiled a program into
+// (VK_KHR_pipeline_executable_properties): "Register Count" = 32. Each driver names its own;
+// `executable` is the driver's name of the compiled stage where it has several for one.
+struct ShaderStatistic {
+  std::string executable, name;
+  double value = 0;
+};
+
 }  // namespace sg::rt

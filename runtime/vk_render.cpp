@@ -105,6 +105,7 @@ Timing Renderer::time(const DrawRequest& r, const TimingRequest& t) {
   Timing out;
   out.verticesPerDraw = r.vertexCount;
   out.inputMemory = o.inputMemory();
+  out.vertexStatistics = o.vertexStatistics();
   for (uint32_t f = 0; f < t.frames; ++f) {
     if (f > 0) o.restart();
     vkCmdResetQueryPool(o.cmd(), queries, 0, 2);

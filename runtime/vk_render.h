@@ -54,6 +54,9 @@ struct Timing {
   std::vector<double> cpuNs;
   uint32_t verticesPerDraw = 0;  // vertex shader invocations asked for per draw (unique vertices)
   std::string inputMemory;       // the memory types the inputs were in ("type 1 (device-local) of heap 0 (...)")
+  // What the driver says it compiled the vertex stage into (registers, instructions, ...),
+  // where it offers VK_KHR_pipeline_executable_properties; empty elsewhere (lavapipe 22.3).
+  std::vector<ShaderStatistic> vertexStatistics;
 };
 
 // What one draw of a request made the device do (a pipeline statistics query): vertex shader

@@ -93,6 +93,13 @@ Device::Device(const Harness::Handles& handles) : h(handles) {
   beginXfb = reinterpret_cast<PFN_vkCmdBeginTransformFeedbackEXT>(vkGetDeviceProcAddr(h.device, "vkCmdBeginTransformFeedbackEXT"));
   endXfb = reinterpret_cast<PFN_vkCmdEndTransformFeedbackEXT>(vkGetDeviceProcAddr(h.device, "vkCmdEndTransformFeedbackEXT"));
   if (!bindXfb || !beginXfb || !endXfb) throw std::runtime_error("vulkan: transform feedback entry points are missing");
+  if (h.executableStatistics) {
+    executableProperties = reinterpret_cast<PFN_vkGetPipelineExecutablePropertiesKHR>(
+        vkGetDeviceProcAddr(h.device, "vkGetPipelineExecutablePropertiesKHR"));
+    executableStatistics = reinterpret_cast<PFN_vkGetPipelineExecutableStatisticsKHR>(
+        vkGetDeviceProcAddr(h.device, "vkGetPipelineExecutableStatisticsKHR"));
+    if (!executableProperties || !executableStatistics) executableProperties = nullptr, executableStatistics = nullptr;
+  }
 }
 
 uint32_t chooseMemoryType(const VkPhysicalDeviceMemoryProperties& memory, uint32_t allowed, VkMemoryPropertyFlags required,
@@ -588,7 +595,42 @@ void ProgramObjects::createPipeline() {
   gp.pColorBlendState = rasterize_ ? &cb : nullptr;
   gp.layout = pipelineLayout_;
   gp.renderPass = renderPass_;
+  if (d_.executableStatistics) gp.flags |= VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR;
   check(vkCreateGraphicsPipelines(d_.h.device, VK_NULL_HANDLE, 1, &gp, nullptr, &pipeline_), "vkCreateGraphicsPipelines");
+}
+
+std::vector<ShaderStatistic> ProgramObjects::vertexStatistics() const {
+  std::vector<ShaderStatistic> out;
+  if (!d_.executableStatistics) return out;
+  VkPipelineInfoKHR pipeline{VK_STRUCTURE_TYPE_PIPELINE_INFO_KHR};
+  pipeline.pipeline = pipeline_;
+  uint32_t n = 0;
+  check(d_.executableProperties(d_.h.device, &pipeline, &n, nullptr), "vkGetPipelineExecutablePropertiesKHR");
+  std::vector<VkPipelineExecutablePropertiesKHR> executables(n, {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_PROPERTIES_KHR});
+  check(d_.executableProperties(d_.h.device, &pipeline, &n, executables.data()), "vkGetPipelineExecutablePropertiesKHR");
+  for (uint32_t e = 0; e < n; ++e) {
+    if (!(executables[e].stages & VK_SHADER_STAGE_VERTEX_BIT)) continue;
+    VkPipelineExecutableInfoKHR which{VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_INFO_KHR};
+    which.pipeline = pipeline_;
+    which.executableIndex = e;
+    uint32_t m = 0;
+    check(d_.executableStatistics(d_.h.device, &which, &m, nullptr), "vkGetPipelineExecutableStatisticsKHR");
+    std::vector<VkPipelineExecutableStatisticKHR> stats(m, {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_STATISTIC_KHR});
+    check(d_.executableStatistics(d_.h.device, &which, &m, stats.data()), "vkGetPipelineExecutableStatisticsKHR");
+    for (uint32_t k = 0; k < m; ++k) {
+      const auto& st = stats[k];
+      double v = 0;
+      switch (st.format) {
+        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_BOOL32_KHR: v = st.value.b32 ? 1 : 0; break;
+        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_INT64_KHR: v = double(st.value.i64); break;
+        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_UINT64_KHR: v = double(st.value.u64); break;
+        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_FLOAT64_KHR: v = st.value.f64; break;
+        default: continue;
+      }
+      out.push_back({executables[e].name, st.name, v});
+    }
+  }
+  return out;
 }
 
 void ProgramObjects::upload() {

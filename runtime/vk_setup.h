@@ -29,6 +29,9 @@ struct Device {
   PFN_vkCmdBindTransformFeedbackBuffersEXT bindXfb = nullptr;
   PFN_vkCmdBeginTransformFeedbackEXT beginXfb = nullptr;
   PFN_vkCmdEndTransformFeedbackEXT endXfb = nullptr;
+  // Set where the harness enabled VK_KHR_pipeline_executable_properties (Handles::executableStatistics).
+  PFN_vkGetPipelineExecutablePropertiesKHR executableProperties = nullptr;
+  PFN_vkGetPipelineExecutableStatisticsKHR executableStatistics = nullptr;
 
   explicit Device(const Harness::Handles& handles);
   // Memory of the type chooseMemoryType picks; `type` (optional) receives its index.
@@ -89,6 +92,9 @@ class ProgramObjects {
   void upload();
   // Where the inputs live (describeMemoryType of each distinct type, "; "-separated).
   std::string inputMemory() const;
+  // The driver's statistics of the vertex stage's compiled executables, in the driver's
+  // order; empty where the device does not offer them (Device::executableStatistics).
+  std::vector<ShaderStatistic> vertexStatistics() const;
   // Starts recording again after a submit (a new frame).
   void restart();
   // Begins the render pass and binds the pipeline, the descriptor sets and the vertex/index buffers.

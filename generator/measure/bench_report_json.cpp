@@ -37,6 +37,8 @@ Workload workloadFrom(const json& j) {
 }
 
 json rowJson(const GpuBenchRow& r) {
+  json statistics = json::array();
+  for (const auto& st : r.driverStatistics) statistics.push_back({{"executable", st.executable}, {"name", st.name}, {"value", st.value}});
   return {{"label", r.label},
           {"rules", r.rules},
           {"bans", r.bans},
@@ -53,7 +55,8 @@ json rowJson(const GpuBenchRow& r) {
           {"raster_on_wall", r.rasterOnWallNsPerVertex},
           {"raster_off_cpu", r.rasterOffCpuNsPerVertex},
           {"raster_off_wall", r.rasterOffWallNsPerVertex},
-          {"rounds", r.roundNsPerVertex}};
+          {"rounds", r.roundNsPerVertex},
+          {"driver_statistics", statistics}};
 }
 GpuBenchRow rowFrom(const json& j) {
   GpuBenchRow r;
@@ -74,6 +77,8 @@ GpuBenchRow rowFrom(const json& j) {
   r.rasterOffCpuNsPerVertex = j.at("raster_off_cpu");
   r.rasterOffWallNsPerVertex = j.at("raster_off_wall");
   r.roundNsPerVertex = j.at("rounds").get<std::vector<double>>();
+  for (const auto& st : j.value("driver_statistics", json::array()))
+    r.driverStatistics.push_back({st.at("executable"), st.at("name"), st.at("value")});
   return r;
 }
 

@@ -749,6 +749,7 @@ std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, cons
     optional("fragments per vertex", s.workload.fragmentsPerVertex);
     optional("palette entries per warp", s.workload.paletteEntriesPerWarp);
     if (const std::string* id = at(cells, "SPIR-V SHA-256"); id && *id != "—") s.program = *id;
+    if (const std::string* st = at(cells, "driver statistics"); st && *st != "—") s.driverStatistics = *st;
     s.validated = true;
     samples.push_back(s);
   }
@@ -871,6 +872,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
             const std::vector<double>& clock = hostClock ? tm.cpuNs : tm.frameNs;
             std::vector<double> frames(clock.begin() + 1, clock.end());
             rounds.push_back(medianOf(frames) / (double(t.drawsPerFrame) * double(tm.verticesPerDraw)));
+            if (s.driverStatistics.empty()) s.driverStatistics = describeDriverStatistics(tm.vertexStatistics);
           }
           s.measuredNs = *std::min_element(rounds.begin(), rounds.end());
           s.medianRoundNs = medianOf(rounds);
@@ -960,6 +962,7 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
           if (s.validated && !row.roundNsPerVertex.empty()) s.medianRoundNs = medianOf(row.roundNsPerVertex);
           s.shadedPerVertex = br.shadedVerticesPerVertex;
           s.program = row.program;
+          s.driverStatistics = describeDriverStatistics(row.driverStatistics);
           rep.samples.push_back(std::move(s));
         }
       }
@@ -1107,9 +1110,9 @@ std::string formatCalibration(const CalibrationReport& r) {
   std::string s = fmt::format("device: {} (driver: {}); clock: {}\n\n| mesh | rig | program | ", r.device, r.driver, r.clock);
   for (int t = 0; t < kTermCount; ++t) s += fmt::format("{} | ", termName(t));
   s += "measured ns/vertex | predicted | joints per warp | vertices per draw | median round ns/vertex | "
-       "shaded vertices per vertex | fragments per vertex | palette entries per warp | SPIR-V SHA-256 |\n|---|---|---|";
+       "shaded vertices per vertex | fragments per vertex | palette entries per warp | SPIR-V SHA-256 | driver statistics |\n|---|---|---|";
   for (int t = 0; t < kTermCount; ++t) s += "---:|";
-  s += "---:|---:|---:|---:|---:|---:|---:|---:|---|\n";
+  s += "---:|---:|---:|---:|---:|---:|---:|---:|---|---|\n";
   for (const auto& x : r.samples) {
     s += fmt::format("| {} | {} | {} | ", x.mesh, x.rig.empty() ? "—" : x.rig, x.label);
     for (int t = 0; t < kTermCount; ++t) s += fmt::format("{} | ", x.amounts[size_t(t)]);
@@ -1125,7 +1128,9 @@ std::string formatCalibration(const CalibrationReport& r) {
     // A warp's palette footprint (shown, not priced): a later fit's feature, kept with the timing.
     s += x.workload.paletteEntriesPerWarp > 0 ? fmt::format("{:.4f} | ", x.workload.paletteEntriesPerWarp) : "— | ";
     // Which SPIR-V was timed: one program timed in two runs (two plans' alternatives) is matched by it.
-    s += x.program.empty() ? "— |\n" : x.program + " |\n";
+    s += x.program.empty() ? "— | " : x.program + " | ";
+    // What the driver compiled it into, where it says (registers: its occupancy).
+    s += x.driverStatistics.empty() ? "— |\n" : x.driverStatistics + " |\n";
   }
   s += "\nfitted (ns per unit per vertex; draw weights: ns per unit per draw):\n" + weightLines(r.profile);
   for (const auto& f : r.fits) s += fitLine(f) + "\n";

@@ -125,6 +125,9 @@ struct CalibrationSample {
   // The timed SPIR-V's hash (GpuBenchRow::program; "" in logs before session 31): where the log
   // timed one program in several runs, the held-out check counts it at its best (predictRigs).
   std::string program;
+  // What the driver compiled its vertex stage into (describeDriverStatistics; "" where the
+  // device does not say, and in logs before session 32): read by analyses, not priced.
+  std::string driverStatistics;
 };
 
 struct CalibrationFit {

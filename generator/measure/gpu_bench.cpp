@@ -484,6 +484,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
         t.rasterize = true;
         rt::Timing tm = renderer.time(req, t);
         noteMemory(tm);
+        if (p.row.driverStatistics.empty()) p.row.driverStatistics = tm.vertexStatistics;
         best(p.row, &GpuBenchRow::rasterOnNsPerVertex, perVertex(tm.frameNs, tm.verticesPerDraw));
         best(p.row, &GpuBenchRow::rasterOnWallNsPerVertex, perVertex(tm.wallNs, tm.verticesPerDraw));
       }
@@ -494,6 +495,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
         t.captureStride = p.capture.glsl.captureStride;
         rt::Timing tm = renderer.time(req, t);
         noteMemory(tm);
+        if (!opts.rasterOn && p.row.driverStatistics.empty()) p.row.driverStatistics = tm.vertexStatistics;
         best(p.row, &GpuBenchRow::rasterOffNsPerVertex, perVertex(tm.frameNs, tm.verticesPerDraw));
         best(p.row, &GpuBenchRow::rasterOffWallNsPerVertex, perVertex(tm.wallNs, tm.verticesPerDraw));
         best(p.row, &GpuBenchRow::rasterOffCpuNsPerVertex, perVertex(tm.cpuNs, tm.verticesPerDraw));
@@ -530,6 +532,33 @@ std::string inputMemoryLine(rt::InputMemory placement, const std::string& memory
   return fmt::format("inputs: {}, in {}",
                      placement == rt::InputMemory::DeviceLocal ? "device-local (a staging copy)" : "mapped (written in place)",
                      memoryTypes.empty() ? "no buffer" : memoryTypes);
+}
+
+namespace {
+// A statistic's value as the driver gave it: whole numbers without a fraction.
+std::string statisticValue(double v) {
+  return v == std::floor(v) && std::fabs(v) < 1e15 ? fmt::format("{:.0f}", v) : fmt::format("{:.6g}", v);
+}
+// Its name, prefixed by its executable's where the vertex stage compiled into several; the
+// cell separator '|' of the tables never appears in it.
+std::string statisticName(const std::vector<rt::ShaderStatistic>& all, const rt::ShaderStatistic& st) {
+  const bool several = std::any_of(all.begin(), all.end(), [&](const rt::ShaderStatistic& o) { return o.executable != all.front().executable; });
+  std::string name = several && st.executable != all.front().executable ? st.executable + ": " + st.name : st.name;
+  std::replace(name.begin(), name.end(), '|', '/');
+  std::replace(name.begin(), name.end(), '\n', ' ');
+  return name;
+}
+}  // namespace
+
+std::string describeDriverStatistics(const std::vector<rt::ShaderStatistic>& statistics) {
+  std::string s;
+  for (const auto& st : statistics) {
+    std::string name = statisticName(statistics, st);
+    std::replace(name.begin(), name.end(), ';', ',');
+    std::replace(name.begin(), name.end(), '=', '-');
+    s += (s.empty() ? "" : "; ") + name + "=" + statisticValue(st.value);
+  }
+  return s;
 }
 
 std::string formatGpuBench(const GpuBenchReport& r) {
@@ -574,6 +603,31 @@ std::string formatGpuBench(const GpuBenchReport& r) {
     s += fmt::format("device profile: predicted vs measured ({}; within 0.5 %: ties) Spearman {:.2f}; the generated program takes "
                      "{:.3f}x the fastest generated one{}\n",
                      r.predictionClock, r.spearmanPredictedOn, r.generatedOverFastestOn, describeRoundSpread(r.byRound));
+  // What the driver compiled each vertex stage into, where it says (one column per statistic,
+  // in the order the driver first gave them).
+  std::vector<std::string> names;
+  for (const auto& row : r.rows)
+    for (const auto& st : row.driverStatistics) {
+      const std::string name = statisticName(row.driverStatistics, st);
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+    }
+  if (!names.empty()) {
+    s += "\nthe driver's statistics of each program's vertex stage (VK_KHR_pipeline_executable_properties)\n\n| program |";
+    for (const auto& n : names) s += " " + n + " |";
+    s += "\n|---|";
+    for (size_t i = 0; i < names.size(); ++i) s += "---:|";
+    s += "\n";
+    for (const auto& row : r.rows) {
+      s += "| " + row.label + " |";
+      for (const auto& n : names) {
+        auto it = std::find_if(row.driverStatistics.begin(), row.driverStatistics.end(),
+                               [&](const rt::ShaderStatistic& st) { return statisticName(row.driverStatistics, st) == n; });
+        s += " " + (it == row.driverStatistics.end() ? std::string("—") : statisticValue(it->value)) + " |";
+      }
+      s += "\n";
+    }
+    s += "\n";
+  }
   // The device's own answer, for a build that wants it: which plan to pin, and how.
   if (r.fastestPlan > 0) {
     const GpuBenchRow& f = r.rows[size_t(r.fastestPlan)];

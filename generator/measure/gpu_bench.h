@@ -50,6 +50,10 @@ struct GpuBenchRow {
   // The render build's SPIR-V, hashed (SHA-256, first 16 hex digits): the same program timed in
   // two runs (a profile's plan among another plan's alternatives) is known as one.
   std::string program;
+  // What the driver compiled the render build's vertex stage into (the capture build's without
+  // raster on): registers, instructions, ... as the driver names them; empty where the device
+  // does not offer VK_KHR_pipeline_executable_properties (lavapipe 22.3).
+  std::vector<rt::ShaderStatistic> driverStatistics;
   // Validation on the device before timing: "pass", "FAIL: <output ...>" (then not timed),
   // or "" for the floors, which write constants on purpose.
   std::string validation;
@@ -150,6 +154,9 @@ std::string describeRoundSpread(const RoundSpread& spread);
 std::string inputMemoryLine(rt::InputMemory placement, const std::string& memoryTypes);
 
 std::string formatGpuBench(const GpuBenchReport& report);
+// "Register Count=32; Binary Size=4096": a row's driver statistics on one line (calibrate's log);
+// a statistic of a second compiled vertex executable is prefixed "<its name>: "; "" for none.
+std::string describeDriverStatistics(const std::vector<rt::ShaderStatistic>& statistics);
 
 // Correlations (exposed for tests): NaN if fewer than 3 points or no variance.
 double pearson(const std::vector<double>& x, const std::vector<double>& y);

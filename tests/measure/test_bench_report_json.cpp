@@ -42,6 +42,9 @@ GpuBenchReport everyFieldSet() {
     row.hasAmounts = true;
     row.planCost = 97 + i;
     row.spirvInstructions = 412;
+    row.program = i == 0 ? "9fff1df2c2f42099" : "";
+    // As a driver may give them: a second vertex executable, a fraction, a 64-bit count.
+    if (i == 0) row.driverStatistics = {{"VS", "Register Count", 40}, {"VS, fast path", "Register Count", 0.5}, {"VS", "Instructions", 9007199254740993.0}};
     row.validation = i == 2 ? "FAIL: output 3 differs" : "pass";
     for (size_t t = 0; t < row.amounts.size(); ++t) row.amounts[t] = int64_t(t * 7 + i) - 3;
     row.predictedNsPerVertex = i == 1 ? -1 : 0.1 + 0.2;  // 0.30000000000000004: no decimal rounding
@@ -102,6 +105,13 @@ TEST(BenchReportJson, EveryFieldComesBackAsWritten) {
     EXPECT_EQ(x.hasAmounts, y.hasAmounts);
     EXPECT_EQ(x.planCost, y.planCost);
     EXPECT_EQ(x.spirvInstructions, y.spirvInstructions);
+    EXPECT_EQ(x.program, y.program);
+    ASSERT_EQ(x.driverStatistics.size(), y.driverStatistics.size());
+    for (size_t k = 0; k < x.driverStatistics.size(); ++k) {
+      EXPECT_EQ(x.driverStatistics[k].executable, y.driverStatistics[k].executable);
+      EXPECT_EQ(x.driverStatistics[k].name, y.driverStatistics[k].name);
+      same(x.driverStatistics[k].value, y.driverStatistics[k].value, "driver statistic");
+    }
     EXPECT_EQ(x.validation, y.validation);
     EXPECT_EQ(x.amounts, y.amounts);
     same(x.predictedNsPerVertex, y.predictedNsPerVertex, "predicted");

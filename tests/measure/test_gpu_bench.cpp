@@ -222,6 +222,32 @@ TEST(GpuBench, APortableChoicesAlternativesArePricedByRegretAgainstTheUnbannedOp
     if (row.hasCost) EXPECT_GE(row.planCost, chosen.planCost) << row.label;
 }
 
+TEST(GpuBench, TheDriversStatisticsAreTabledPerProgramWhereItGivesThem) {
+  // A driver names its own statistics (VK_KHR_pipeline_executable_properties): bench tables them
+  // by name in the order first given, "—" where a program's driver said nothing of one, and
+  // writes no table where no program has any (lavapipe 22.3 offers none).
+  sg::GpuBenchReport rep;
+  rep.rows.resize(3);
+  rep.rows[0].label = "generated";
+  rep.rows[0].driverStatistics = {{"VS", "Register Count", 40}, {"VS", "Binary Size", 4096}};
+  rep.rows[1].label = "forced a for b";
+  rep.rows[1].driverStatistics = {{"VS", "Binary Size", 5120}, {"VS", "Spill|Fill", 1.5}, {"VS", "Register Count", 32}};
+  rep.rows[2].label = "floor";
+  const std::string text = sg::formatGpuBench(rep);
+  EXPECT_NE(text.find("| program | Register Count | Binary Size | Spill/Fill |\n|---|---:|---:|---:|\n"
+                      "| generated | 40 | 4096 | — |\n| forced a for b | 32 | 5120 | 1.5 |\n| floor | — | — | — |\n"),
+            std::string::npos)
+      << text;
+  // calibrate's log holds them on one line in the driver's order; a second executable's are named
+  // by it, and the log's separators never appear inside a name.
+  EXPECT_EQ(sg::describeDriverStatistics(rep.rows[1].driverStatistics), "Binary Size=5120; Spill/Fill=1.5; Register Count=32");
+  EXPECT_EQ(sg::describeDriverStatistics({{"VS", "Registers", 24}, {"VS fast", "Registers; used", 16}, {"VS", "a=b", 2}}),
+            "Registers=24; VS fast: Registers, used=16; a-b=2");
+  EXPECT_EQ(sg::describeDriverStatistics({}), "");
+  for (auto& row : rep.rows) row.driverStatistics.clear();
+  EXPECT_EQ(sg::formatGpuBench(rep).find("driver's statistics"), std::string::npos);
+}
+
 TEST(GpuBench, AProgramThatFailsOnTheDeviceIsReportedAndNotTimed) {
   // Eye direction reversed: the plan compiles and runs but computes the wrong outputs.
   RulesCopy rules("bench_eye");
