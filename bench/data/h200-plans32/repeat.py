@@ -18,7 +18,7 @@ def rows(path):
         out[key]=min(m,out.get(key,1e9))
     return out
 logs={p:rows(p) for p in sys.argv[1:]}
-name=lambda p: next(x for x in p.split('/') if x.startswith(('h100','h200')))
+name=lambda p: [x for x in p.split('/') if x.startswith(('h100','h200'))][-1]
 for a,b in itertools.combinations(sys.argv[1:],2):
     A,B=logs[a],logs[b]
     common=[k for k in A if k in B]
