@@ -599,6 +599,20 @@ void ProgramObjects::createPipeline() {
   check(vkCreateGraphicsPipelines(d_.h.device, VK_NULL_HANDLE, 1, &gp, nullptr, &pipeline_), "vkCreateGraphicsPipelines");
 }
 
+namespace {
+// Vulkan's two-call enumeration (count, then fill `out` from `blank`, whose sType is set);
+// false where the driver refuses either call.
+template <typename T, typename Query>
+bool enumerate(Query query, const T& blank, std::vector<T>& out) {
+  uint32_t n = 0;
+  if (query(&n, nullptr) != VK_SUCCESS) return false;
+  out.assign(n, blank);
+  if (query(&n, out.data()) != VK_SUCCESS) return false;
+  out.resize(n);
+  return true;
+}
+}  // namespace
+
 std::vector<ShaderStatistic> ProgramObjects::vertexStatistics() const {
   // Best effort: statistics describe a timing and never fail it, so a query the driver refuses
   // gives none (a bench row then says nothing of what was compiled).
@@ -606,21 +620,20 @@ std::vector<ShaderStatistic> ProgramObjects::vertexStatistics() const {
   if (!d_.executableStatistics) return out;
   VkPipelineInfoKHR pipeline{VK_STRUCTURE_TYPE_PIPELINE_INFO_KHR};
   pipeline.pipeline = pipeline_;
-  uint32_t n = 0;
-  if (d_.executableProperties(d_.h.device, &pipeline, &n, nullptr) != VK_SUCCESS) return {};
-  std::vector<VkPipelineExecutablePropertiesKHR> executables(n, {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_PROPERTIES_KHR});
-  if (d_.executableProperties(d_.h.device, &pipeline, &n, executables.data()) != VK_SUCCESS) return {};
-  for (uint32_t e = 0; e < n; ++e) {
+  std::vector<VkPipelineExecutablePropertiesKHR> executables;
+  if (!enumerate([&](uint32_t* n, VkPipelineExecutablePropertiesKHR* p) { return d_.executableProperties(d_.h.device, &pipeline, n, p); },
+                 {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_PROPERTIES_KHR}, executables))
+    return {};
+  for (uint32_t e = 0; e < executables.size(); ++e) {
     if (!(executables[e].stages & VK_SHADER_STAGE_VERTEX_BIT)) continue;
     VkPipelineExecutableInfoKHR which{VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_INFO_KHR};
     which.pipeline = pipeline_;
     which.executableIndex = e;
-    uint32_t m = 0;
-    if (d_.executableStatistics(d_.h.device, &which, &m, nullptr) != VK_SUCCESS) return {};
-    std::vector<VkPipelineExecutableStatisticKHR> stats(m, {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_STATISTIC_KHR});
-    if (d_.executableStatistics(d_.h.device, &which, &m, stats.data()) != VK_SUCCESS) return {};
-    for (uint32_t k = 0; k < m; ++k) {
-      const auto& st = stats[k];
+    std::vector<VkPipelineExecutableStatisticKHR> stats;
+    if (!enumerate([&](uint32_t* n, VkPipelineExecutableStatisticKHR* p) { return d_.executableStatistics(d_.h.device, &which, n, p); },
+                   {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_STATISTIC_KHR}, stats))
+      return {};
+    for (const auto& st : stats) {
       double v = 0;
       switch (st.format) {
         case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_BOOL32_KHR: v = st.value.b32 ? 1 : 0; break;

@@ -535,28 +535,30 @@ std::string inputMemoryLine(rt::InputMemory placement, const std::string& memory
 }
 
 namespace {
+// A program's statistics as (name, value) cells: a statistic of a second compiled vertex
+// executable named "<its name>: <statistic>"; the tables' separator '|' never in a name.
+std::vector<std::pair<std::string, double>> statisticCells(const std::vector<rt::ShaderStatistic>& all) {
+  std::vector<std::pair<std::string, double>> cells;
+  for (const auto& st : all) {
+    std::string name = st.executable == all.front().executable ? st.name : st.executable + ": " + st.name;
+    std::replace(name.begin(), name.end(), '|', '/');
+    std::replace(name.begin(), name.end(), '\n', ' ');
+    cells.emplace_back(std::move(name), st.value);
+  }
+  return cells;
+}
 // A statistic's value as the driver gave it: whole numbers without a fraction.
 std::string statisticValue(double v) {
   return v == std::floor(v) && std::fabs(v) < 1e15 ? fmt::format("{:.0f}", v) : fmt::format("{:.6g}", v);
-}
-// Its name, prefixed by its executable's where the vertex stage compiled into several; the
-// cell separator '|' of the tables never appears in it.
-std::string statisticName(const std::vector<rt::ShaderStatistic>& all, const rt::ShaderStatistic& st) {
-  const bool several = std::any_of(all.begin(), all.end(), [&](const rt::ShaderStatistic& o) { return o.executable != all.front().executable; });
-  std::string name = several && st.executable != all.front().executable ? st.executable + ": " + st.name : st.name;
-  std::replace(name.begin(), name.end(), '|', '/');
-  std::replace(name.begin(), name.end(), '\n', ' ');
-  return name;
 }
 }  // namespace
 
 std::string describeDriverStatistics(const std::vector<rt::ShaderStatistic>& statistics) {
   std::string s;
-  for (const auto& st : statistics) {
-    std::string name = statisticName(statistics, st);
+  for (auto [name, value] : statisticCells(statistics)) {
     std::replace(name.begin(), name.end(), ';', ',');
     std::replace(name.begin(), name.end(), '=', '-');
-    s += (s.empty() ? "" : "; ") + name + "=" + statisticValue(st.value);
+    s += (s.empty() ? "" : "; ") + name + "=" + statisticValue(value);
   }
   return s;
 }
@@ -605,24 +607,24 @@ std::string formatGpuBench(const GpuBenchReport& r) {
                      r.predictionClock, r.spearmanPredictedOn, r.generatedOverFastestOn, describeRoundSpread(r.byRound));
   // What the driver compiled each vertex stage into, where it says (one column per statistic,
   // in the order the driver first gave them).
+  std::vector<std::vector<std::pair<std::string, double>>> cells;
   std::vector<std::string> names;
-  for (const auto& row : r.rows)
-    for (const auto& st : row.driverStatistics) {
-      const std::string name = statisticName(row.driverStatistics, st);
-      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
-    }
+  for (const auto& row : r.rows) {
+    cells.push_back(statisticCells(row.driverStatistics));
+    for (const auto& cell : cells.back())
+      if (std::find(names.begin(), names.end(), cell.first) == names.end()) names.push_back(cell.first);
+  }
   if (!names.empty()) {
     s += "\nthe driver's statistics of each program's vertex stage (VK_KHR_pipeline_executable_properties)\n\n| program |";
     for (const auto& n : names) s += " " + n + " |";
     s += "\n|---|";
     for (size_t i = 0; i < names.size(); ++i) s += "---:|";
     s += "\n";
-    for (const auto& row : r.rows) {
-      s += "| " + row.label + " |";
+    for (size_t i = 0; i < r.rows.size(); ++i) {
+      s += "| " + r.rows[i].label + " |";
       for (const auto& n : names) {
-        auto it = std::find_if(row.driverStatistics.begin(), row.driverStatistics.end(),
-                               [&](const rt::ShaderStatistic& st) { return statisticName(row.driverStatistics, st) == n; });
-        s += " " + (it == row.driverStatistics.end() ? std::string("—") : statisticValue(it->value)) + " |";
+        auto it = std::find_if(cells[i].begin(), cells[i].end(), [&](const auto& cell) { return cell.first == n; });
+        s += " " + (it == cells[i].end() ? std::string("—") : statisticValue(it->second)) + " |";
       }
       s += "\n";
     }
