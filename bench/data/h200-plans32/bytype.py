@@ -1,26 +1,21 @@
-import math,sys,collections
-def cells(l): return [c.strip() for c in l.strip().strip('|').split('|')]
-def corr(a,b):
-    n=len(a); ma,mb=sum(a)/n,sum(b)/n
-    sa=math.sqrt(sum((x-ma)**2 for x in a)); sb=math.sqrt(sum((y-mb)**2 for y in b))
-    return sum((x-ma)*(y-mb) for x,y in zip(a,b))/(sa*sb)
-data=collections.defaultdict(list)
+#!/usr/bin/env python3
+"""Session 32: each own plan's log(predicted / measured) against joints per warp, by where it reads the palette (8 or
+more uniform loads at a per-vertex index, or storage-buffer table loads). Usage: bytype.py LOG..."""
+import collections, math, sys
+from tables import corr, log_rows, number
+
+data = collections.defaultdict(list)
 for log in sys.argv[1:]:
-    cols=None
-    for line in open(log):
-        if not line.startswith('|'): continue
-        c=cells(line)
-        if c[:3]==['mesh','rig','program']: cols={k:i for i,k in enumerate(c)}; continue
-        if cols is None or c[0].startswith('---') or c[1]=='—' or 'plan under' not in c[2]: continue
-        try: m=float(c[cols['measured ns/vertex']]); p=float(c[cols['predicted']]); j=float(c[cols['joints per warp']])
-        except: continue
-        u=int(c[cols['indexed_uniform_loads']]); t=int(c[cols['buffer_table_loads']])
-        kind='uniform palette' if u>=8 else 'table palette' if t>=8 else 'no/small palette'
-        data[(c[0],kind)].append((j,math.log(p/m),m,p))
-for (mesh,kind),v in sorted(data.items()):
-    if len(v)<3: continue
-    x=[a for a,_,_,_ in v]; y=[b for _,b,_,_ in v]
-    # slope of log(p/m) on log(jpw)
-    lx=[math.log(max(a,0.5)) for a in x]; mx=sum(lx)/len(lx); my=sum(y)/len(y)
-    slope=sum((a-mx)*(b-my) for a,b in zip(lx,y))/sum((a-mx)**2 for a in lx)
-    print(f"{mesh:5s} {kind:17s} n={len(v):3d} r(log(pred/meas), jpw)={corr(x,y):+.2f} slope on log jpw {slope:+.2f}; mean log(pred/meas) {my:+.3f}")
+    for r in log_rows(log):
+        p, m, j = number(r, 'predicted'), number(r, 'measured ns/vertex'), number(r, 'joints per warp')
+        if 'plan under' not in r['program'] or None in (p, m, j): continue
+        kind = ('uniform palette' if int(r['indexed_uniform_loads']) >= 8 else
+                'table palette' if int(r['buffer_table_loads']) >= 8 else 'no/small palette')
+        data[(r['mesh'], kind)].append((j, math.log(p / m)))
+for (mesh, kind), v in sorted(data.items()):
+    if len(v) < 3: continue
+    x = [a for a, _ in v]; y = [b for _, b in v]
+    # the slope of log(predicted / measured) on log(joints per warp)
+    lx = [math.log(max(a, 0.5)) for a in x]; mx = sum(lx) / len(lx); my = sum(y) / len(y)
+    slope = sum((a - mx) * (b - my) for a, b in zip(lx, y)) / sum((a - mx) ** 2 for a in lx)
+    print(f"{mesh:5s} {kind:17s} n={len(v):3d} r(log(pred/meas), jpw)={corr(x, y):+.2f} slope on log jpw {slope:+.2f}; mean log(pred/meas) {my:+.3f}")

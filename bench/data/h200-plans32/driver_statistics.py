@@ -6,32 +6,11 @@ Prints the statistics' names and ranges, then for each numeric statistic:
   - across pairs: r of log(level) with the pair's mean of log(statistic) over its plans;
   - within pairs: r of each plan's residual, log(predicted / measured) less log(level), with its
     log(statistic) less the pair's mean (what a price per statistic could still explain of a choice).
-  Usage: statistics.py EVALUATE.txt LOG...
+  Usage: driver_statistics.py EVALUATE.txt LOG...
 """
-import math, sys, collections
+import collections, math, sys
+from tables import corr, levels, log_rows, number
 
-def cells(line):
-    return [c.strip() for c in line.strip().strip('|').split('|')]
-
-def levels(path):
-    out, on = {}, False
-    for line in open(path):
-        if line.startswith('| rig | mesh |'): on = True; continue
-        if on and line.startswith('| ') and not line.startswith('|---'):
-            c = cells(line)
-            out[(c[0], c[1])] = float(c[6])
-    return out
-
-def rows(path):
-    cols = None
-    for line in open(path):
-        if not line.startswith('|'): continue
-        c = cells(line)
-        if c[:3] == ['mesh', 'rig', 'program']: cols = {k: i for i, k in enumerate(c)}; continue
-        if cols is None or c[0].startswith('---') or c[1] == '—' or 'floor' in c[2]: continue
-        try: float(c[cols['measured ns/vertex']]); float(c[cols['predicted']])
-        except (ValueError, IndexError, KeyError): continue
-        yield {k: c[i] for k, i in cols.items() if i < len(c)}
 
 def parse(stats):
     out = {}
@@ -42,22 +21,15 @@ def parse(stats):
         except ValueError: pass
     return out
 
-def corr(a, b):
-    n = len(a)
-    if n < 3: return float('nan')
-    ma, mb = sum(a) / n, sum(b) / n
-    sa = math.sqrt(sum((x - ma) ** 2 for x in a)); sb = math.sqrt(sum((y - mb) ** 2 for y in b))
-    return float('nan') if sa == 0 or sb == 0 else sum((x - ma) * (y - mb) for x, y in zip(a, b)) / (sa * sb)
-
 level = levels(sys.argv[1])
 plans = collections.defaultdict(dict)  # (rig, mesh) -> program -> (predicted, best measured, statistics)
 for log in sys.argv[2:]:
-    for r in rows(log):
+    for r in log_rows(log):
         key = (r['rig'], r['mesh'])
-        if key not in level: continue
+        pred, meas = number(r, 'predicted'), number(r, 'measured ns/vertex')
+        if key not in level or 'floor' in r['program'] or pred is None or meas is None: continue
         prog = r.get('SPIR-V SHA-256') or r['program']
         st = parse(r.get('driver statistics', ''))
-        pred, meas = float(r['predicted']), float(r['measured ns/vertex'])
         if prog in plans[key] and plans[key][prog][1] <= meas: continue
         plans[key][prog] = (pred, meas, st)
 names = collections.OrderedDict()
