@@ -9,6 +9,7 @@
 #include <fstream>
 #include <unistd.h>
 #include <map>
+#include <numeric>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -522,6 +523,7 @@ std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& sample
     size_t own = kNone;  // the profile's own plan, where the log timed it
     bool ownByNameOnly = false;  // found by a label after the first of ownPlanLabels
     double ownNs = NAN, fastestNs = INFINITY;
+    std::string ownLabel, ownProgram;
     // A program the log timed in several runs (each plan's alternatives are one run) counts at its
     // best: on a CPU device a whole run can drift 20-60 % (bench/data/lavapipe-many-inputs30), and
     // the own plan at its run's time against the fastest of every run would read drift as a miss.
@@ -539,15 +541,23 @@ std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& sample
       }
     for (const auto& s : samples) {
       if (!isPlanOfPair(s)) continue;
-      fastestNs = std::min(fastestNs, s.measuredNs);
       const auto [kept, added] = seen.emplace(s.amounts, h.measured.size());
+      if (s.measuredNs < fastestNs) fastestNs = s.measuredNs, h.fastest = kept->second;
       if (const auto label = std::find(ownPlanLabels.begin(), ownPlanLabels.end(), s.label);
           own == kNone && label != ownPlanLabels.end()) {
         own = kept->second;
         ownNs = s.program.empty() ? s.measuredNs : bestOfProgram.at(s.program);
+        ownLabel = s.label;
+        ownProgram = s.program;
         ownByNameOnly = label != ownPlanLabels.begin();
       }
-      if (!added) continue;
+      if (!added) {
+        ++h.timings[kept->second];
+        continue;
+      }
+      h.labels.push_back(s.label);
+      h.programs.push_back(s.program);
+      h.timings.push_back(1);
       DeviceProfile at = profile;
       at.workload = s.workload;
       h.predicted.push_back(at.predictNanoseconds(s.amounts, s.vertices));
@@ -583,13 +593,18 @@ std::vector<HeldOutRig> predictRigs(const std::vector<CalibrationSample>& sample
     double chosenNs = h.measured[chosen];
     if (own != kNone) {
       if (h.predicted[own] <= least * (1 + kPredictedTie)) {
+        chosen = own;
         chosenNs = ownNs;
+        h.labels[own] = ownLabel;
+        h.programs[own] = ownProgram;
         h.ownPlan = true;
         h.ownPlanByNameOnly = ownByNameOnly;
       } else if (ownPlanNotLeast) {
         ++*ownPlanNotLeast;
       }
     }
+    h.chosen = chosen;
+    h.chosenNs = chosenNs;
     h.chosenOverFastest = chosenNs / fastestNs;
     h.spearman = spearmanWithinSpread(h.predicted, h.measured, 0.005);
     rows.push_back(std::move(h));
@@ -681,6 +696,30 @@ std::string formatLeaveOneRigOut(const LeaveOneRigOut& loo) {
 
 std::string formatHeldOutCheck(const LeaveOneRigOut& check) {
   return heldOutTable(check, "held-out check", "rigs and requests no fit saw, their plans predicted by the profile", "rig");
+}
+
+std::string formatHeldOutPlans(const LeaveOneRigOut& check) {
+  if (check.rows.empty()) return "";
+  std::string s =
+      "\nheld-out plans: each pair's plans by predicted time; predicted / measured over the pair's level is the error a "
+      "choice turns on\n\n| rig | mesh | plan | program | predicted ns | measured ns | predicted / measured | over the level "
+      "| |\n|---|---|---|---|---:|---:|---:|---:|---|\n";
+  for (const auto& h : check.rows) {
+    std::vector<size_t> order(h.plans);
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return h.predicted[a] < h.predicted[b]; });
+    for (size_t i : order) {
+      std::string marks = i == h.chosen ? (h.ownPlan ? "chosen (its plan)" : "chosen") : "";
+      if (i == h.fastest) marks += marks.empty() ? "fastest" : ", fastest";
+      if (h.timings[i] > 1) marks += fmt::format("{}{} timings alike", marks.empty() ? "" : ", ", h.timings[i]);
+      const double measured = i == h.chosen ? h.chosenNs : h.measured[i];
+      const double ratio = h.predicted[i] / measured;
+      s += fmt::format("| {} | {} | {} | {} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {} |\n", h.rig, h.mesh, h.labels[i],
+                       h.programs[i].empty() ? "—" : h.programs[i], h.predicted[i], measured, ratio, ratio / h.level,
+                       marks);
+    }
+  }
+  return s;
 }
 
 std::vector<CalibrationSample> parseCalibrationSamples(std::istream& table, const std::map<std::string, double>& meshVertices,

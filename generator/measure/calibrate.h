@@ -155,6 +155,15 @@ struct HeldOutRig {
   std::string rig, mesh;  // rig: "RIG (REQUEST)" where the rig was timed under several requests
   size_t plans = 0;                  // distinct validated plans (by their term amounts)
   std::vector<double> predicted, measured;  // ns per vertex, per plan
+  // Per plan, of its first timing (plans of the same term amounts are one plan): its log label,
+  // its program's hash ("" in logs before session 31) and how many timings it stands for.
+  std::vector<std::string> labels, programs;
+  std::vector<size_t> timings;
+  // The plan counted as the choice (the own plan, or the slowest of a tie for the least prediction)
+  // and its measured time. Where it is the own plan, its label and program are the own timing's.
+  size_t chosen = 0;
+  double chosenNs = NAN;
+  size_t fastest = 0;  // the plan of the pair's fastest timing
   double spearman = NAN;             // predicted against measured (within 0.5 %: ties)
   double chosenOverFastest = NAN;    // measured time of the least-predicted plan / the fastest
   // Plans sharing the least predicted time (a roofline prices plans whose extra work hides under
@@ -203,6 +212,10 @@ std::string planUnderLabel(const std::string& profilePath);
 // such a row may have been searched under an earlier profile of that name.
 std::vector<std::string> ownPlanLabels(const std::string& profilePath);
 std::string formatHeldOutCheck(const LeaveOneRigOut& check);
+// Every plan of every pair (calibrate --evaluate --per-plan): predicted and measured ns per vertex,
+// their ratio, and that ratio over the pair's level, the part of the error a choice turns on;
+// a pair's plans by predicted time, its chosen and fastest marked.
+std::string formatHeldOutPlans(const LeaveOneRigOut& check);
 
 struct CalibrationReport {
   std::string device, driver;

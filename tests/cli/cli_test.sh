@@ -621,6 +621,15 @@ device_profile)
   expect 0 "--evaluate an edited profile of the same name" -- "$SG" calibrate --evaluate edited/nvidia-h200-raster.yaml --check-log pu.log
   [ "$own" -eq 3 ] && ! grep -q '(its plan)' last.out && ok "its own plan counted in 3 pairs, an edited profile's in none" ||
     fail "own plans: $own under the profile, $(grep -c '(its plan)' last.out) under the edited one"
+  # --per-plan lists each pair's plans: as many rows as the pairs' plan counts add up to, one chosen per pair.
+  expect 0 "--evaluate --per-plan" -- "$SG" calibrate --evaluate "$SRC/devices/nvidia-h200-raster.yaml" --check-log pu.log --per-plan
+  pairs=$(sed -n '/^held-out check/,/^held-out check over/p' last.out | grep -E '^\| corpus-' | wc -l)
+  plans=$(sed -n '/^held-out check/,/^held-out check over/p' last.out | grep -E '^\| corpus-' | awk -F'|' '{ n += $4 } END { print n }')
+  rows=$(sed -n '/^held-out plans/,$p' last.out | grep -cE '^\| corpus-')
+  chosen=$(sed -n '/^held-out plans/,$p' last.out | grep -c '| chosen (its plan)')
+  [ "$pairs" -eq 3 ] && [ "$rows" -eq "$plans" ] && [ "$chosen" -eq 3 ] && ok "every plan listed ($rows), each pair's own plan marked" ||
+    fail "pairs $pairs, plans $plans, rows $rows, chosen $chosen"
+  expect 2 "--per-plan without --check-log (a usage error)" -- "$SG" calibrate --evaluate "$SRC/devices/nvidia-h200-raster.yaml" --per-plan
   # --outside-pipes: the raster form prices locations and buffer loads outside the pipes too by
   # default; "none" is the form before (every term inside its pipe); names are checked.
   expect 0 "--outside-pipes none" -- "$SG" calibrate --from-log pu.log --form raster --outside-pipes none -o inside.yaml

@@ -271,6 +271,44 @@ TEST(HeldOut, AProgramTimedInTwoRunsCountsAtItsBestTiming) {
   EXPECT_DOUBLE_EQ(apart.rows[0].chosenOverFastest, 6.0 / 5.0);
 }
 
+// calibrate --evaluate --per-plan: every plan of a pair by predicted time, its ratio of predicted to
+// measured and that ratio over the pair's level, by hand; the chosen plan shows the own timing.
+TEST(HeldOut, EveryPlanIsListedWithItsErrorOverThePairsLevel) {
+  const DeviceProfile p = twoPipeRoofline();
+  const std::string own = "plan under r: generated";
+  auto identified = [](CalibrationSample s, const std::string& program) {
+    s.program = program;
+    return s;
+  };
+  // Predicted: a 1 + 4 = 5, b 1 + 6 = 7, c 1 + max(2, 1.5) = 3. Measured at best: a 5.0, b 5.2, c 4.0
+  // (its second timing; the first 4.4). The own plan is c's amounts' second timing: its program d, 4.6.
+  const std::vector<CalibrationSample> runs = {
+      identified(plan("plan: generated", 4, 0, 5.0), "a"), identified(plan("plan: forced y", 6, 0, 5.2), "b"),
+      identified(plan("plan: forced z", 2, 3, 4.4), "c"),  identified(plan("plan: forced z again", 2, 3, 4.0), "c"),
+      identified(plan(own, 2, 3, 4.6), "d")};
+  const LeaveOneRigOut check = checkHeldOut(runs, p, {own});
+  ASSERT_EQ(check.rows.size(), 1u);
+  const HeldOutRig& h = check.rows[0];
+  ASSERT_EQ(h.plans, 3u);
+  EXPECT_TRUE(h.ownPlan);
+  EXPECT_DOUBLE_EQ(h.chosenOverFastest, 4.6 / 4.0);
+  const double level = std::cbrt(5.0 / 5.0 * 7.0 / 5.2 * 3.0 / 4.0);
+  ASSERT_NEAR(h.level, level, 1e-12);
+  const std::string text = formatHeldOutPlans(check);
+  // c first (least predicted): the own timing's label and program, its own time; then a, then b.
+  const std::string rowC = fmt::format("| r.rig.yaml | head | {} | d | 3.000 | 4.600 | {:.3f} | {:.3f} | chosen (its plan), fastest, 3 timings alike |",
+                                       own, 3.0 / 4.6, 3.0 / 4.6 / level);
+  const std::string rowA = fmt::format("| r.rig.yaml | head | plan: generated | a | 5.000 | 5.000 | 1.000 | {:.3f} |  |", 1.0 / level);
+  const std::string rowB = fmt::format("| r.rig.yaml | head | plan: forced y | b | 7.000 | 5.200 | {:.3f} | {:.3f} |  |", 7.0 / 5.2, 7.0 / 5.2 / level);
+  const size_t c = text.find(rowC), a = text.find(rowA), b = text.find(rowB);
+  ASSERT_NE(c, std::string::npos) << rowC << "\n" << text;
+  ASSERT_NE(a, std::string::npos) << rowA << "\n" << text;
+  ASSERT_NE(b, std::string::npos) << rowB << "\n" << text;
+  EXPECT_LT(c, a);
+  EXPECT_LT(a, b);
+  EXPECT_EQ(formatHeldOutPlans({}), "");
+}
+
 // The tie rule counted in the one pair of predictions 5, 5 and 7 measured 5, 6 and 5.5: 6 / 5, and
 // `notLeast` pairs whose own plan was not the least predicted.
 void expectTheSlowestOfTheTie(const LeaveOneRigOut& check, size_t notLeast) {
