@@ -126,6 +126,12 @@ CalibrationSample plan(const std::string& label, int locations, int bufferLoads,
   return s;
 }
 
+// `s` as the timing of the program whose SPIR-V hashes to `program`.
+CalibrationSample identified(CalibrationSample s, const std::string& program) {
+  s.program = program;
+  return s;
+}
+
 // A roofline prices plans whose extra work hides under the same slowest pipe alike; the search
 // may return any of them, so the check must not count the one that happens to come first.
 TEST(HeldOut, PlansSharingTheLeastPredictionCountAtTheSlowestOfThem) {
@@ -241,10 +247,6 @@ TEST(HeldOut, TheProfilesOwnPlanIsCountedWhereTheLogTimedIt) {
 TEST(HeldOut, AProgramTimedInTwoRunsCountsAtItsBestTiming) {
   const DeviceProfile p = twoPipeRoofline();
   const std::string own = "plan under r: generated";
-  auto identified = [](CalibrationSample s, const std::string& program) {
-    s.program = program;
-    return s;
-  };
   // The slot plan's run (fast): programs a (5.0) and b (5.2). The profile's run (slow, x1.5): its
   // plan is program a again (7.5), its alternative b (7.8). Predicted: a 5, b 7.
   const std::vector<CalibrationSample> runs = {
@@ -276,10 +278,6 @@ TEST(HeldOut, AProgramTimedInTwoRunsCountsAtItsBestTiming) {
 TEST(HeldOut, EveryPlanIsListedWithItsErrorOverThePairsLevel) {
   const DeviceProfile p = twoPipeRoofline();
   const std::string own = "plan under r: generated";
-  auto identified = [](CalibrationSample s, const std::string& program) {
-    s.program = program;
-    return s;
-  };
   // Predicted: a 1 + 4 = 5, b 1 + 6 = 7, c 1 + max(2, 1.5) = 3. Measured at best: a 5.0, b 5.2, c 4.0
   // (its second timing; the first 4.4). The own plan is c's amounts' second timing: its program d, 4.6.
   const std::vector<CalibrationSample> runs = {
