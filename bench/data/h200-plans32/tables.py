@@ -35,6 +35,17 @@ def levels(path):
     return out
 
 
+def plan_rows(path):
+    """Each row of `calibrate --evaluate --per-plan`'s table ("held-out plans") as {column header: cell}."""
+    cols, inside = None, False
+    for line in open(path):
+        if line.startswith('held-out plans'): inside = True; continue
+        if not inside or not line.startswith('|') or line.startswith('|---'): continue
+        c = cells(line)
+        if c[:3] == ['rig', 'mesh', 'plan']: cols = c; continue
+        if cols: yield dict(zip(cols, c))
+
+
 def corr(a, b):
     """Pearson's r; NaN for fewer than 3 points or no spread."""
     n = len(a)
