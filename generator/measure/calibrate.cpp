@@ -468,9 +468,11 @@ double medianOfFinite(std::vector<double> v) {
 }
 
 std::string heldOutSummary(const LeaveOneRigOut& loo, const char* what = "leave-one-rig-out") {
-  return fmt::format("{} over {} (rig, mesh) pairs: median Spearman {:.3f}, worst chosen / fastest {:.3f}, "
-                     "RMS relative error median {:.1f} %, max {:.1f} %, each pair's level divided out: median {:.1f} %{}",
-                     what, loo.rows.size(), loo.medianSpearman, loo.worstChosenOverFastest, 100 * loo.medianRms, 100 * loo.maxRms,
+  return fmt::format("{} over {} (rig, mesh) pairs: median Spearman {:.3f}, worst chosen / fastest {:.3f} (within 5 % "
+                     "in {}, within 10 % in {}), RMS relative error median {:.1f} %, max {:.1f} %, each pair's level divided "
+                     "out: median {:.1f} %{}",
+                     what, loo.rows.size(), loo.medianSpearman, loo.worstChosenOverFastest, loo.within5Percent,
+                     loo.within10Percent, 100 * loo.medianRms, 100 * loo.maxRms,
                      100 * loo.medianRmsWithinPair,
                      loo.pairsWithATieForLeast == 0 ? ""
                                                  : fmt::format("; in {} the least prediction is shared (the slowest of those "
@@ -623,6 +625,8 @@ LeaveOneRigOut summarise(std::vector<HeldOutRig> rows) {
     rho.push_back(h.spearman);
     rms.push_back(h.rmsRelativeError);
     if (!(out.worstChosenOverFastest >= h.chosenOverFastest)) out.worstChosenOverFastest = h.chosenOverFastest;
+    out.within5Percent += h.chosenOverFastest <= 1.05;
+    out.within10Percent += h.chosenOverFastest <= 1.10;
     if (!(out.maxRms >= h.rmsRelativeError)) out.maxRms = h.rmsRelativeError;
   }
   out.medianSpearman = medianOfFinite(rho);

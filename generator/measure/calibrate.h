@@ -185,6 +185,9 @@ struct LeaveOneRigOut {
   std::vector<HeldOutRig> rows;  // by rig, then mesh
   double medianSpearman = NAN, worstChosenOverFastest = NAN, medianRms = NAN, maxRms = NAN;
   double medianRmsWithinPair = NAN;  // of HeldOutRig::rmsWithinPair
+  // Rows whose chosen plan is within 5 % and within 10 % of the fastest (issue 33's bars for a GPU
+  // and for lavapipe): chosenOverFastest <= 1.05, <= 1.10.
+  size_t within5Percent = 0, within10Percent = 0;
   size_t pairsWithATieForLeast = 0;  // rows whose least prediction several plans share (tie rule applied)
   size_t pairsWithOwnPlan = 0;       // rows counting the profile's own plan (HeldOutRig::ownPlan)
   size_t ownPlansByNameOnly = 0;     // of them, found by the name-only label of older logs

@@ -53,6 +53,7 @@ TEST(HeldOut, FiguresFollowTheirDefinitions) {
   const LeaveOneRigOut loo = leaveOneRigOut(recorded(), "H200", 180000, 4);
   std::vector<double> rho, rms;
   double worst = 0;
+  size_t within5 = 0, within10 = 0;
   for (const auto& h : loo.rows) {
     SCOPED_TRACE(h.rig + " on " + h.mesh);
     ASSERT_EQ(h.predicted.size(), h.plans);
@@ -81,6 +82,8 @@ TEST(HeldOut, FiguresFollowTheirDefinitions) {
     rho.push_back(h.spearman);
     rms.push_back(h.rmsRelativeError);
     worst = std::max(worst, h.chosenOverFastest);
+    within5 += chosen / fastest <= 1.05;
+    within10 += chosen / fastest <= 1.10;
   }
   std::sort(rho.begin(), rho.end());
   std::sort(rms.begin(), rms.end());
@@ -88,6 +91,11 @@ TEST(HeldOut, FiguresFollowTheirDefinitions) {
   EXPECT_DOUBLE_EQ(loo.medianRms, 0.5 * (rms[1] + rms[2]));
   EXPECT_DOUBLE_EQ(loo.maxRms, rms.back());
   EXPECT_DOUBLE_EQ(loo.worstChosenOverFastest, worst);
+  EXPECT_EQ(loo.within5Percent, within5);
+  EXPECT_EQ(loo.within10Percent, within10);
+  EXPECT_NE(formatLeaveOneRigOut(loo).find(fmt::format("{:.3f} (within 5 % in {}, within 10 % in {})", worst, within5, within10)),
+            std::string::npos)
+      << formatLeaveOneRigOut(loo);
   // One rig alone cannot be held out: nothing would be left to fit its plans with.
   std::vector<CalibrationSample> one;
   for (const auto& s : recorded())

@@ -36,7 +36,7 @@ checks() {  # SET: --check-log arguments
 }
 train() { case $1 in h200-23) echo "$tmp/h23/train.log" ;; h200-18) echo "$tmp/h18/train.log" ;;
                      h100-26) echo "$tmp/h27/train.log" ;; h100-28) echo "$here/s2/train.log" ;; esac; }
-headline() { grep -E "^held-out check over" "$1" | sed -E 's/^held-out check over ([0-9]+) .*median Spearman ([0-9.]+), worst chosen \/ fastest ([0-9.]+), RMS relative error median ([0-9.]+) %.*/\1 pairs: Spearman \2, worst \3, RMS \4 %/'; }
+headline() { grep -E "^held-out check over" "$1" | sed -E 's/^held-out check over ([0-9]+) .*median Spearman ([0-9.]+), worst chosen \/ fastest ([0-9.]+).*, RMS relative error median ([0-9.]+) %.*/\1 pairs: Spearman \2, worst \3, RMS \4 %/'; }
 over() { awk -F'|' '/^held-out check/{h=1} h && /^\| / && $6 ~ /[0-9]/ {split($6,a," "); if (a[1]+0 > 1.05) {n++; s=s sprintf("%s%s %s; ", $2, $3, a[1])}} END{printf "%d over 5 %%: %s\n", n+0, s}' "$1" | tr -s ' '; }
 : > "$here/summary.txt"
 for form in default none; do

@@ -23,5 +23,5 @@ esac; }
 over() { awk -F'|' '/^held-out check/{h=1} h && /^\| / && $6 ~ /[0-9]/ {split($6,a," "); if (a[1]+0 > 1.05) {n++; s=s sprintf("%s%s %s; ", $2, $3, a[1])}} END{printf "%d over: %s\n", n+0, s}' "$1" | tr -s ' '; }
 for c in h23 h18 h28 h29 h30; do
   $sg calibrate --evaluate $out/p.yaml $(checks $c) > $out/check-$c.txt
-  echo "$tag $c: $(grep -E '^held-out check over' $out/check-$c.txt | sed -E 's/.*over ([0-9]+) .*median Spearman ([0-9.]+), worst chosen \/ fastest ([0-9.]+), RMS relative error median ([0-9.]+) %.*/\1 pairs Sp \2 worst \3 RMS \4/') | $(over $out/check-$c.txt)"
+  echo "$tag $c: $(grep -E '^held-out check over' $out/check-$c.txt | sed -E 's/.*over ([0-9]+) .*median Spearman ([0-9.]+), worst chosen \/ fastest ([0-9.]+).*, RMS relative error median ([0-9.]+) %.*/\1 pairs Sp \2 worst \3 RMS \4/') | $(over $out/check-$c.txt)"
 done
