@@ -39,7 +39,7 @@ struct CalibrateCommand {
   bool noFloors = false;                    // --no-floors
   std::vector<std::string> fromLogs, checkLogs;
   std::string evaluate;  // --evaluate PROFILE: the held-out check of an existing profile
-  bool perPlan = false;  // --per-plan: the check's every plan too
+  bool perPlan = false;  // --per-plan: every plan of the held-out figures too
   std::string writeCorpus;  // --write-corpus DIR: the corpus's files, no device
   bool oneProcess = false;  // --one-process: every rig timed in this process
   // A fresh process timing one rig for its parent (cli/fresh_process.h): the rig, as JSON, and
@@ -83,6 +83,12 @@ struct CalibrateCommand {
     return all;
   }
 
+  // --per-plan: every plan of the report's leave-one-rig-out and held-out check ("" without it).
+  std::string perPlanTables(const CalibrationReport& rep) const {
+    if (!perPlan) return "";
+    return formatHeldOutPlans(rep.heldOut, "leave-one-rig-out") + formatHeldOutPlans(rep.check, "held-out check");
+  }
+
   int refit() {
     CalibrationReport rep;
     rep.samples = readLogs(fromLogs, &rep.device);
@@ -96,8 +102,7 @@ struct CalibrateCommand {
     rep.fits = evaluateFit(rep.samples, rep.profile, {"dawn", "head"});
     rep.heldOut = leaveOneRigOut(rep.samples, rep.device, 180000, co.nearBestPower, co.fit);
     if (!checkLogs.empty()) rep.check = checkHeldOut(readLogs(checkLogs, nullptr), rep.profile);
-    std::cout << formatCalibration(rep);
-    if (perPlan) std::cout << formatHeldOutPlans(rep.check);
+    std::cout << formatCalibration(rep) << perPlanTables(rep);
     if (!output.empty()) {
       std::vector<InputFile> inputs;
       for (const auto& f : fromLogs) inputs.push_back({f, "a log"});
@@ -182,8 +187,6 @@ struct CalibrateCommand {
       throw CLI::ValidationError("--pipe-sum-share", "needs --form roofline or raster (the share is of the pipes a program does not wait for)");
     if (co.fit.drawSizes && co.fit.form != ProfileForm::Raster)
       throw CLI::ValidationError("--draw-sizes", "needs --form raster (the other forms price a draw's size by their per-draw weights)");
-    if (perPlan && checkLogs.empty())
-      throw CLI::ValidationError("--per-plan", "needs --check-log (the plans it lists are the check's)");
     if (!writeCorpus.empty()) return writeCorpusFiles();
     if (!fromLogs.empty()) return refit();
     if (!evaluate.empty()) {
@@ -192,8 +195,7 @@ struct CalibrateCommand {
       rep.profile = loadDeviceProfile(evaluate);
       // A log timed with --plans-under this profile holds the plan its search returned.
       rep.check = checkHeldOut(readLogs(checkLogs, nullptr), rep.profile, ownPlanLabels(evaluate));
-      std::cout << formatHeldOutCheck(rep.check);
-      if (perPlan) std::cout << formatHeldOutPlans(rep.check);
+      std::cout << formatHeldOutCheck(rep.check) << perPlanTables(rep);
       return 0;
     }
     co.validationLayers = !noLayers;
@@ -273,7 +275,7 @@ struct CalibrateCommand {
     // after the first, kill a run that had just stopped and was writing what it timed (exit 130
     // under the sanitizers, cli_device_profile). The profile is written atomically either way.
     CalibrationReport rep = calibrateDevice(co);
-    std::cout << formatCalibration(rep);
+    std::cout << formatCalibration(rep) << perPlanTables(rep);
     size_t failed = 0;
     for (const auto& s : rep.samples) failed += !s.validated;
     if (!output.empty()) {
@@ -342,8 +344,8 @@ void registerCalibrate(CLI::App& app, CliState& state) {
                   "With --check-log: predict the logs' plans with this device profile (no fit, no device)")
       ->check(CLI::ExistingFile);
   sub->add_flag("--per-plan", cmd->perPlan,
-                "With --check-log: also list every plan of the check, predicted, measured, and their ratio over its "
-                "pair's level (the error a choice turns on)");
+                "Also list every plan of the leave-one-rig-out and held-out (--check-log) figures: predicted, measured, "
+                "and their ratio over its pair's level (the error a choice turns on)");
   sub->add_flag("--no-probes", cmd->noProbes, "With --rig: time only the rigs' programs (samples for another fit)");
   sub->add_option("--form", cmd->form, "The model fitted: additive (default), roofline, or raster (the roofline with the fragments a draw covers priced instead of per-draw weights; docs/device-profiles.md)")
       ->check(CLI::IsMember({"additive", "roofline", "raster"}));

@@ -702,12 +702,13 @@ std::string formatHeldOutCheck(const LeaveOneRigOut& check) {
   return heldOutTable(check, "held-out check", "rigs and requests no fit saw, their plans predicted by the profile", "rig");
 }
 
-std::string formatHeldOutPlans(const LeaveOneRigOut& check) {
+std::string formatHeldOutPlans(const LeaveOneRigOut& check, const char* what) {
   if (check.rows.empty()) return "";
-  std::string s =
-      "\nheld-out plans: each pair's plans by predicted time; predicted / measured over the pair's level is the error a "
+  std::string s = fmt::format(
+      "\n{}, every plan: each pair's plans by predicted time; predicted / measured over the pair's level is the error a "
       "choice turns on\n\n| rig | mesh | plan | program | predicted ns | measured ns | predicted / measured | over the level "
-      "| |\n|---|---|---|---|---:|---:|---:|---:|---|\n";
+      "| |\n|---|---|---|---|---:|---:|---:|---:|---|\n",
+      what);
   for (const auto& h : check.rows) {
     std::vector<size_t> order(h.plans);
     std::iota(order.begin(), order.end(), size_t(0));

@@ -215,10 +215,11 @@ std::string planUnderLabel(const std::string& profilePath);
 // such a row may have been searched under an earlier profile of that name.
 std::vector<std::string> ownPlanLabels(const std::string& profilePath);
 std::string formatHeldOutCheck(const LeaveOneRigOut& check);
-// Every plan of every pair (calibrate --evaluate --per-plan): predicted and measured ns per vertex,
-// their ratio, and that ratio over the pair's level, the part of the error a choice turns on;
-// a pair's plans by predicted time, its chosen and fastest marked.
-std::string formatHeldOutPlans(const LeaveOneRigOut& check);
+// Every plan of every pair (calibrate --per-plan): predicted and measured ns per vertex, their ratio,
+// and that ratio over the pair's level, the part of the error a choice turns on; a pair's plans by
+// predicted time, its chosen and fastest marked. `what` names the figures ("held-out check",
+// "leave-one-rig-out").
+std::string formatHeldOutPlans(const LeaveOneRigOut& check, const char* what = "held-out check");
 
 struct CalibrationReport {
   std::string device, driver;

@@ -623,13 +623,19 @@ device_profile)
     fail "own plans: $own under the profile, $(grep -c '(its plan)' last.out) under the edited one"
   # --per-plan lists each pair's plans: as many rows as the pairs' plan counts add up to, one chosen per pair.
   expect 0 "--evaluate --per-plan" -- "$SG" calibrate --evaluate "$SRC/devices/nvidia-h200-raster.yaml" --check-log pu.log --per-plan
-  pairs=$(sed -n '/^held-out check/,/^held-out check over/p' last.out | grep -E '^\| corpus-' | wc -l)
-  plans=$(sed -n '/^held-out check/,/^held-out check over/p' last.out | grep -E '^\| corpus-' | awk -F'|' '{ n += $4 } END { print n }')
-  rows=$(sed -n '/^held-out plans/,$p' last.out | grep -cE '^\| corpus-')
-  chosen=$(sed -n '/^held-out plans/,$p' last.out | grep -c '| chosen (its plan)')
+  pairs=$(sed -n '/^held-out check:/,/^held-out check over/p' last.out | grep -E '^\| corpus-' | wc -l)
+  plans=$(sed -n '/^held-out check:/,/^held-out check over/p' last.out | grep -E '^\| corpus-' | awk -F'|' '{ n += $4 } END { print n }')
+  rows=$(sed -n '/^held-out check, every plan/,$p' last.out | grep -cE '^\| corpus-')
+  chosen=$(sed -n '/^held-out check, every plan/,$p' last.out | grep -c '| chosen (its plan)')
   [ "$pairs" -eq 3 ] && [ "$rows" -eq "$plans" ] && [ "$chosen" -eq 3 ] && ok "every plan listed ($rows), each pair's own plan marked" ||
     fail "pairs $pairs, plans $plans, rows $rows, chosen $chosen"
-  expect 2 "--per-plan without --check-log (a usage error)" -- "$SG" calibrate --evaluate "$SRC/devices/nvidia-h200-raster.yaml" --per-plan
+  # A refit's leave-one-rig-out lists its plans too, one chosen per pair; without the flag, no plan table.
+  expect 0 "--from-log --per-plan" -- "$SG" calibrate --from-log pu.log --per-plan
+  pairs=$(sed -n '/^leave-one-rig-out:/,/^leave-one-rig-out over/p' last.out | grep -E '^\| corpus-' | wc -l)
+  chosen=$(sed -n '/^leave-one-rig-out, every plan/,$p' last.out | grep -cE '\| chosen( \(its plan\))?( \||, )')
+  [ "$pairs" -eq 3 ] && [ "$chosen" -eq 3 ] && ok "the leave-one-rig-out's plans listed, one chosen a pair" ||
+    fail "pairs $pairs, chosen $chosen"
+  "$SG" calibrate --from-log pu.log | grep -q "every plan" && fail "a plan table without --per-plan" || ok "no plan table without --per-plan"
   # --outside-pipes: the raster form prices locations and buffer loads outside the pipes too by
   # default; "none" is the form before (every term inside its pipe); names are checked.
   expect 0 "--outside-pipes none" -- "$SG" calibrate --from-log pu.log --form raster --outside-pipes none -o inside.yaml

@@ -36,10 +36,10 @@ def levels(path):
 
 
 def plan_rows(path):
-    """Each row of `calibrate --evaluate --per-plan`'s table ("held-out plans") as {column header: cell}."""
+    """Each row of `calibrate --evaluate --per-plan`'s table ("held-out check, every plan") as {column header: cell}."""
     cols, inside = None, False
     for line in open(path):
-        if line.startswith('held-out plans'): inside = True; continue
+        if line.startswith('held-out check, every plan'): inside = True; continue
         if not inside or not line.startswith('|') or line.startswith('|---'): continue
         c = cells(line)
         if c[:3] == ['rig', 'mesh', 'plan']: cols = c; continue
