@@ -190,8 +190,10 @@ struct Harness::Impl {
     for (const DeviceInfo& info : infos) {
       std::string name = info.props.deviceName;
       available += (available.empty() ? "'" : ", '") + name + "'";
-      bool match = options.deviceName.empty() ? info.driverID == VK_DRIVER_ID_MESA_LLVMPIPE
-                                              : name.find(options.deviceName) != std::string::npos;
+      // "lavapipe" is the Mesa driver's name, not its device's ("llvmpipe (LLVM ...)").
+      const bool lavapipe = options.deviceName.empty() || options.deviceName == "lavapipe";
+      bool match = lavapipe ? info.driverID == VK_DRIVER_ID_MESA_LLVMPIPE
+                            : name.find(options.deviceName) != std::string::npos;
       if (!match) continue;
       if (!info.xfb) {
         if (!matchedWithoutXfb) matchedWithoutXfb = &info;

@@ -37,7 +37,7 @@ struct RunResult {
 };
 
 struct HarnessOptions {
-  std::string deviceName;   // substring of the device name; empty = lavapipe (VK_DRIVER_ID_MESA_LLVMPIPE)
+  std::string deviceName;   // substring of the device name; empty or "lavapipe" = VK_DRIVER_ID_MESA_LLVMPIPE
   bool validation = true;   // enable VK_LAYER_KHRONOS_validation if it is installed
 };
 

@@ -203,7 +203,8 @@ void registerRender(CLI::App& app, CliState& state) {
   sub->add_option("--morph-weight", cmd->morphWeight,
                   "Weight of every morph target: in the rest pose (default 0.5), or for a glTF rig in place of the "
                   "animation's (default: the animation's)")
-      ->check(finiteNumber(false));
+      ->check(finiteNumber(false))
+      ->check(CLI::Range(0.0, 1000.0));  // far past 1, float32 outputs overflow (a length of 1e20 squares to inf)
   sub->add_option("--yaw", cmd->ro.camera.yawDegrees, "Camera yaw in degrees around +Y (0: the face)")
       ->check(CLI::Range(-360.0f, 360.0f));
   sub->add_option("--pitch", cmd->ro.camera.pitchDegrees, "Camera pitch in degrees")->check(CLI::Range(-89.0f, 89.0f));

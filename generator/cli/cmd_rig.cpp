@@ -64,7 +64,7 @@ struct RigImportCommand {
     GltfImport imp = importGltf(ref.file, o);
     std::string yaml = rigYaml(imp, ref.file, output);
     if (!quiet)
-      for (const auto& n : imp.notes) std::cerr << fmt::format("{}: warning: {}\n", ref.file, n);
+      for (const auto& n : imp.notes) std::cerr << fmt::format("{}: note: {}\n", ref.file, n);
     for (const auto& d : imp.rig.importDiagnostics) std::cerr << formatDiagnostic(d) << "\n";
     if (output.empty() || output == "-") {
       std::cout << yaml;
@@ -103,7 +103,7 @@ struct RigImportCommand {
       e["joints"] = imp.joints;
       e["morph_targets"] = imp.morphTargets;
       if (!quiet)
-        for (const auto& n : imp.notes) std::cerr << fmt::format("{}: warning: {}\n", part.ref, n);
+        for (const auto& n : imp.notes) std::cerr << fmt::format("{}: note: {}\n", part.ref, n);
       for (const auto& d : imp.rig.importDiagnostics) std::cerr << formatDiagnostic(d) << "\n";
     });
     failIfPartsFailed(model, parts.size(), failed);

@@ -267,7 +267,8 @@ void registerValidate(CLI::App& app, CliState& state) {
   sub->add_option("--morph-weight", cmd->morphWeight,
                   "glTF rig: every morph target at this weight in place of the animation's (an expression held "
                   "through the motion)")
-      ->check(finiteNumber(false));
+      ->check(finiteNumber(false))
+      ->check(CLI::Range(0.0, 1000.0));  // far past 1, float32 outputs overflow (a length of 1e20 squares to inf)
   sub->add_flag("--cross-check", cmd->crossCheck, "Also force and check every alternative derivation");
   sub->add_option("--via", cmd->via,
                   "What runs: spirv (default: the GLSL's SPIR-V), or hlsl (the HLSL `generate --emit hlsl` writes, "

@@ -1,6 +1,7 @@
 #include "measure/gpu_bench.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
@@ -597,10 +598,23 @@ std::string formatGpuBench(const GpuBenchReport& r) {
                      cell(row.rasterOnWallNsPerVertex, gen ? gen->rasterOnWallNsPerVertex : -1),
                      cell(row.rasterOffWallNsPerVertex, gen ? gen->rasterOffWallNsPerVertex : -1),
                      cpuClock ? " " + cell(row.rasterOffCpuNsPerVertex, gen ? gen->rasterOffCpuNsPerVertex : -1) + " |" : "");
-  s += fmt::format("\nplan cost vs time over the {} generated programs that passed: raster on (timestamps) Pearson {:.2f}, Spearman {:.2f}; "
-                   "raster off (timestamps) Pearson {:.2f}, Spearman {:.2f}; raster off (host) Pearson {:.2f}, Spearman {:.2f}\n",
-                   std::count_if(r.rows.begin(), r.rows.end(), [](const GpuBenchRow& x) { return x.hasCost && x.validation == "pass"; }), r.pearsonOn,
-                   r.spearmanOn, r.pearsonOff, r.spearmanOff, r.pearsonOffWall, r.spearmanOffWall);
+  // Only the modes that were timed; a correlation needs 3 programs (pearson() is NaN below).
+  const auto passed =
+      std::count_if(r.rows.begin(), r.rows.end(), [](const GpuBenchRow& x) { return x.hasCost && x.validation == "pass"; });
+  auto timed = [&](double GpuBenchRow::*clock) {
+    return std::any_of(r.rows.begin(), r.rows.end(), [&](const GpuBenchRow& x) { return x.*clock >= 0; });
+  };
+  auto corr = [](const char* what, double p, double sp) {
+    return std::isnan(p) && std::isnan(sp) ? fmt::format("{} n/a", what)
+                                           : fmt::format("{} Pearson {:.2f}, Spearman {:.2f}", what, p, sp);
+  };
+  std::vector<std::string> modes;
+  if (timed(&GpuBenchRow::rasterOnNsPerVertex)) modes.push_back(corr("raster on (timestamps)", r.pearsonOn, r.spearmanOn));
+  if (timed(&GpuBenchRow::rasterOffNsPerVertex)) modes.push_back(corr("raster off (timestamps)", r.pearsonOff, r.spearmanOff));
+  if (timed(&GpuBenchRow::rasterOffWallNsPerVertex))
+    modes.push_back(corr("raster off (host)", r.pearsonOffWall, r.spearmanOffWall));
+  s += fmt::format("\nplan cost vs time over the {} generated programs that passed{}: {}\n", passed,
+                   passed < 3 ? " (a correlation needs 3)" : "", fmt::join(modes, "; "));
   if (!std::isnan(r.spearmanPredictedOn) || !std::isnan(r.generatedOverFastestOn))
     s += fmt::format("device profile: predicted vs measured ({}; within 0.5 %: ties) Spearman {:.2f}; the generated program takes "
                      "{:.3f}x the fastest generated one{}\n",

@@ -153,7 +153,10 @@ Plan searchStage(const LoadedInputs& in, const SearchOptions& opts, SearchStats*
                                  "from storage buffers) stays within them",
                                  in.rig.name, broken.empty() ? "more than the limits allow" : broken));
   }
-  if (std::vector<Diagnostic> all = unreachableInputs(in); !all.empty()) throwAll(std::move(all), in.notes);
+  // A glTF import's notes say which of the model's attributes the rig does not carry.
+  std::vector<Diagnostic> notes = in.notes;
+  for (const std::string& n : in.rig.importNotes) notes.push_back({Severity::Note, SourceLoc{in.rig.file, 0, 0}, n, ""});
+  if (std::vector<Diagnostic> all = unreachableInputs(in); !all.empty()) throwAll(std::move(all), notes);
   std::string why = formatUnreachable(p, analyzeUnreachable(p, in.rules, in.varyings));
   // Point at the first fragment input whose request cannot be met.
   SourceLoc at{in.fragment.file, 0, 0};
@@ -165,7 +168,7 @@ Plan searchStage(const LoadedInputs& in, const SearchOptions& opts, SearchStats*
     }
   if (!why.empty() && why.back() == '\n') why.pop_back();
   InputError err(at, fmt::format("the request cannot be met for rig '{}':\n{}", in.rig.name, why));
-  err.related = in.notes;
+  err.related = notes;
   throw err;
 }
 

@@ -522,17 +522,28 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
   }
   if (const auto* a = accessorOf("COLOR_0")) {
     std::optional<VertexFormat> f;
+    const bool rgb = a->type == TINYGLTF_TYPE_VEC3;
     if (a->type == TINYGLTF_TYPE_VEC4) {
       if (a->componentType == TINYGLTF_COMPONENT_TYPE_FLOAT) f = VertexFormat::Float32x4;
       else if (a->componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && a->normalized) f = VertexFormat::Unorm8x4;
       else if (a->componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT && a->normalized) f = VertexFormat::Unorm16x4;
+    } else if (rgb && a->componentType == TINYGLTF_COMPONENT_TYPE_FLOAT) {
+      f = VertexFormat::Float32x3;  // read as a vec4: the device supplies alpha 1, as glTF means
     }
     if (f) {
-      rig.attributes.push_back(makeAttribute("color0", *f, {{"vertex.color0", ""}}, file));
+      RigAttribute attr = makeAttribute("color0", *f, {{"vertex.color0", ""}}, file);
+      attr.shaderType = Type::Vec4;
+      rig.attributes.push_back(std::move(attr));
       carried("COLOR_0", "color0", *f);
-      data.streams["vertex.color0"] = reader.stream(readAttr("COLOR_0"), 0, 4, where + " attribute COLOR_0");
+      auto colours = reader.stream(readAttr("COLOR_0"), 0, rgb ? 3 : 4, where + " attribute COLOR_0");
+      if (rgb)
+        for (auto& c : colours) c[3] = 1.0f;
+      data.streams["vertex.color0"] = std::move(colours);
     } else {
-      skip("COLOR_0", "vertex.color0 is a vec4 (RGB colours must be widened to RGBA by the application)");
+      // Normalized RGB bytes or shorts are padded to 4 bytes per element: no 3-component format reads them.
+      skip("COLOR_0", rgb ? "vertex.color0 is a vec4; RGB colours are read as float VEC3 (alpha 1), not as normalized "
+                            "integers (their alignment padding would read as alpha)"
+                          : "vertex.color0 is a vec4 of float, or of normalized unsigned byte or short");
     }
   }
 
@@ -947,7 +958,9 @@ GltfImport importGltfRef(const std::string& refText, const GltfReadOptions& read
 
 Rig loadRig(const std::string& path, const GltfReadOptions& read) {
   if (!isGltfPath(path)) return loadRigFile(path);
-  return importGltfRef(path, read).rig;
+  GltfImport imp = importGltfRef(path, read);
+  imp.rig.importNotes = std::move(imp.notes);
+  return std::move(imp.rig);
 }
 
 std::string rigToYaml(const Rig& rig, const std::vector<std::string>& header) {
@@ -976,11 +989,14 @@ std::string rigToYaml(const Rig& rig, const std::vector<std::string>& header) {
     } else {
       for (const auto& p : a.provides)
         prov += (prov.empty() ? "{ " : ", ") + yamlQuote(p.semantic) + ": " +
-                (p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(formatComponents(a.format)))
+                (p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(componentCount(a.shaderType)))
                                    : p.swizzle);
       prov += " }";
     }
-    s += fmt::format("  {}: {{ format: {}{}, provides: {} }}\n", a.name, formatName(a.format),
+    // Declared only where it is not the format's own (a float32x3 colour read as a vec4).
+    const bool widened = !formatIsInteger(a.format) && componentCount(a.shaderType) > formatComponents(a.format);
+    s += fmt::format("  {}: {{ format: {}{}{}, provides: {} }}\n", a.name, formatName(a.format),
+                     widened ? ", shader_type: " + std::string(glslName(a.shaderType)) : "",
                      a.perMorphTarget ? ", per_target: true" : "", prov);
   }
   if (!rig.uniforms.empty()) {

@@ -81,6 +81,9 @@ struct Rig {
   // its notes; and the skin weights its data holds: "normalized" (renormalised to sum to one,
   // the default), "stored" (--no-normalize-weights), "" (not a skinned glTF primitive).
   std::vector<Diagnostic> importDiagnostics;
+  // A glTF import's notes (attributes it left out, data fed as stored): an unmet request
+  // names them, since a value the model holds but the rig does not carry reads as missing.
+  std::vector<std::string> importNotes;
   std::string skinWeights;
 
   int64_t param(const std::string& key, int64_t fallback = 0) const;

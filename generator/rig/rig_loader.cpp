@@ -110,18 +110,35 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
     if (!validIdentifier(a.name)) y.fail(it->first, fmt::format("'{}' is not a valid attribute name", a.name));
     YAML::Node body = it->second;  // a copy: it->second lives in a temporary proxy
     y.expectMap(body, "an attribute");
-    y.checkKeys(body, {"format", "provides", "fields", "per_target", "doc"});
+    y.checkKeys(body, {"format", "shader_type", "provides", "fields", "per_target", "doc"});
     if (!body["format"]) y.fail(body, fmt::format("attribute '{}' has no 'format'", a.name));
     std::string fmtName = y.scalar(body["format"], "'format'");
     if (!parseFormat(fmtName, a.format))
       y.fail(body["format"], fmt::format("unknown vertex format '{}' (expected one of: {})", fmtName, formatNames()));
-    const int n = formatComponents(a.format);
+    int n = formatComponents(a.format);
     a.shaderType = *vectorType(formatIsInteger(a.format) ? ScalarKind::UInt : ScalarKind::Float, n);
+    if (body["shader_type"]) {
+      // A vector wider than the format: the vertex input fills the components the format lacks
+      // with 0, and w with 1 (Vulkan's vertex input extraction), so RGB colours read as RGBA.
+      const std::string tn = y.scalar(body["shader_type"], "'shader_type'");
+      const std::optional<Type> t = parseType(tn);
+      if (formatIsInteger(a.format) || n == 4)
+        y.fail(body["shader_type"], fmt::format("'shader_type' widens a float or normalized format of fewer than 4 "
+                                                "components; {} is {}",
+                                                fmtName, n == 4 ? "already 4 components" : "read as integers"));
+      if (!t || scalarKind(*t) != ScalarKind::Float || isMatrix(*t) || componentCount(*t) <= n)
+        y.fail(body["shader_type"],
+               fmt::format("'shader_type: {}' must be a float vector of more components than {} ({}): the device fills "
+                           "the missing ones (0, and 1 for w)",
+                           tn, fmtName, n == 3 ? "vec4" : n == 2 ? "vec3 or vec4" : "vec2 to vec4"));
+      a.shaderType = *t;
+      n = componentCount(*t);
+    }
     if (body["per_target"]) a.perMorphTarget = y.boolean(body["per_target"], "'per_target'");
     // A part of the attribute (field -1, `what` "attribute") or of one of its fields.
     auto addPart = [&](const YAML::Node& semNode, const YAML::Node* swzNode, int field, VertexFormat format,
                        const YAML::Node& formatNode) {
-      const int comps = formatComponents(format);
+      const int comps = field < 0 ? n : formatComponents(format);  // an attribute's: its shader type's
       const std::string what = field < 0 ? "attribute" : fmt::format("field ({})", formatName(format));
       ProvidedPart p;
       p.field = field;

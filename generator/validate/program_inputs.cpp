@@ -34,7 +34,8 @@ void gatherPart(const RigAttribute& a, const ProvidedPart& p, int target, const 
   std::string swz = p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(n)) : p.swizzle;
   for (size_t v = 0; v < mesh.vertexCount; ++v)
     for (size_t k = 0; k < swz.size(); ++k)
-      comps[v * static_cast<size_t>(n) + static_cast<size_t>(swizzleIndex(swz[k]))] = src[v][static_cast<int>(k)];
+      if (swizzleIndex(swz[k]) < n)  // past a widened attribute's format: the device fills it
+        comps[v * static_cast<size_t>(n) + static_cast<size_t>(swizzleIndex(swz[k]))] = src[v][static_cast<int>(k)];
 }
 
 // Replaces, in the mesh, every value an attribute of a non-float32 format carries by the
@@ -47,14 +48,19 @@ void quantizeStreams(const Rig& rig, rt::Mesh& m) {
     for (int t = 0; t < targets; ++t)
       for (const auto& p : a.provides) {
         const VertexFormat format = partFormat(a, p);  // a bit-packed field's own
-        if (formatIsFloat32(format)) continue;
         const int n = formatComponents(format);
+        // A widened attribute (shader_type past the format): the device reads 0, and 1 for w.
+        const int declared = p.field >= 0 ? n : componentCount(a.shaderType);
+        if (formatIsFloat32(format) && declared == n) continue;
         auto it = m.streams.find(partSemantic(a, p, a.perMorphTarget ? t : -1));
         if (it == m.streams.end()) continue;
-        const std::string swz = p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(n)) : p.swizzle;
+        const std::string swz =
+            p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(declared)) : p.swizzle;
         for (auto& v : it->second)
-          for (size_t k = 0; k < swz.size(); ++k)
-            v[static_cast<int>(k)] = storedValue(format, swizzleIndex(swz[k]), v[static_cast<int>(k)]);
+          for (size_t k = 0; k < swz.size(); ++k) {
+            const int c = swizzleIndex(swz[k]);
+            v[static_cast<int>(k)] = c >= n ? (c == 3 ? 1.0f : 0.0f) : storedValue(format, c, v[static_cast<int>(k)]);
+          }
       }
   }
 }

@@ -453,6 +453,15 @@ TEST(HarnessDevice, SelectsByNameSubstring) {
   EXPECT_NE(h.deviceName().find("llvmpipe"), std::string::npos);
 }
 
+// The help's "default lavapipe" names the driver; its device calls itself "llvmpipe (LLVM ...)".
+TEST(HarnessDevice, LavapipeNamesTheMesaDriver) {
+  sg::rt::HarnessOptions opt;
+  opt.deviceName = "lavapipe";
+  opt.validation = false;
+  Harness h(opt);
+  EXPECT_NE(h.deviceName().find("llvmpipe"), std::string::npos) << h.deviceName();
+}
+
 // The messenger must actually deliver messages, or "no messages" proves nothing.
 TEST(HarnessDevice, CollectsValidationMessages) {
   Harness h;

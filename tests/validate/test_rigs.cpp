@@ -10,6 +10,7 @@
 
 #include "runtime/reference.h"
 #include "test_util.h"
+#include "validate/program_inputs.h"
 #include "validate/validate.h"
 
 namespace {
@@ -136,6 +137,7 @@ INSTANTIATE_TEST_SUITE_P(
         // Every packed vertex format, read back on the device as the reference assumes.
         RigCase{"formats_a", "formats_a.rig.yaml", "formats.frag", "limb", {"skin_matrix_blend"}, kLinearBlends},
         RigCase{"formats_b", "formats_b.rig.yaml", "formats.frag", "limb", {"skin_matrix_blend"}, kLinearBlends},
+        RigCase{"formats_rgb", "formats_rgb.rig.yaml", "formats.frag", "limb", {"skin_matrix_blend"}, kLinearBlends},
         RigCase{"rigid1", "rigid1.rig.yaml", "eye.frag", "limb",
                 {"skin_matrix_rigid", "eye_position", "eye_normal"}, {"dapple_normal_z_full"}},
         RigCase{"rigid1_world", "rigid1.rig.yaml", "world.frag", "limb",
@@ -147,6 +149,21 @@ INSTANTIATE_TEST_SUITE_P(
         RigCase{"unskinned_identity", "unskinned_identity.rig.yaml", "basic.frag", "limb",
                 {"skin_matrix_identity", "clip_from_view_projection"}, {}}),
     [](const ::testing::TestParamInfo<RigCase>& p) { return std::string(p.param.name); });
+
+// A float32x3 colour read as a vec4 (shader_type): the device supplies w = 1, so the reference
+// must too, whatever alpha the mesh holds; the stored components stay as they are.
+TEST(Quantization, WidenedColourReadsAlphaOne) {
+  sg::Rig rig = sg::loadRigFile(dataPath("formats_rgb.rig.yaml"));
+  sg::ValidationScene scene = sg::proceduralScene(rig, "limb", 1, 1);
+  auto& drawn = scene.mesh.streams.at("vertex.color0");
+  for (size_t v = 0; v < drawn.size(); ++v) drawn[v].w = 0.25f + 0.001f * static_cast<float>(v % 7);  // not 1
+  const auto& read = sg::quantizeForRig(rig, scene.mesh).streams.at("vertex.color0");
+  ASSERT_EQ(read.size(), drawn.size());
+  for (size_t v = 0; v < read.size(); ++v) {
+    EXPECT_EQ(read[v], glm::vec4(glm::vec3(drawn[v]), 1.0f)) << "vertex " << v;
+    if (HasFailure()) break;
+  }
+}
 
 // The quantization path matters: with unorm8 weights, the reference fed the raw float weights
 // is off by far more than the tolerance, so the unorm8 rig above only passes because the
