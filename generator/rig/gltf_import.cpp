@@ -94,11 +94,13 @@ bool uniformScale3(double x, double y, double z) {
   return std::abs(x - y) <= 1e-4 * m && std::abs(y - z) <= 1e-4 * m;
 }
 
-// uniform_scale (docs/rig-format.md) when no node, scale animation or inverse bind matrix of
-// the model scales per axis: then mat3(M) is a valid normal matrix.
+// uniform_scale (docs/rig-format.md) when no node, GPU instance, scale animation or inverse
+// bind matrix of the model scales per axis: then mat3(M) is a valid normal matrix.
 bool modelScalesUniformly(const GltfModelData& d) {
   for (const auto& n : d.nodes) {
     if (n.hasMatrix ? !isSimilarity(n.matrix.data(), 4) : !uniformScale3(n.scale[0], n.scale[1], n.scale[2])) return false;
+    for (const auto& m : n.instances)
+      if (!isSimilarity(m.data(), 4)) return false;
   }
   for (const auto& a : d.animations)
     for (const auto& ch : a.channels)

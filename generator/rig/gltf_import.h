@@ -123,6 +123,9 @@ struct GltfNode {
   std::array<double, 4> rotation{0, 0, 0, 1};  // quaternion x, y, z, w
   std::array<double, 3> scale{1, 1, 1};
   std::vector<double> weights;  // node-level default morph weights (overrides the mesh's)
+  // EXT_mesh_gpu_instancing: the node draws its mesh once per element, at global(node) ·
+  // instance (T·R·S of the element, column-major, in the node's local space). Empty: once.
+  std::vector<std::array<double, 16>> instances;
 };
 
 struct GltfSkin {

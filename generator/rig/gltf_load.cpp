@@ -174,7 +174,7 @@ std::pair<size_t, size_t> checkGlb(const std::string& b, const std::string& file
 // Extensions whose required use does not change the vertex data, skinning or animation
 // shadergen reads (materials and textures are not read at all).
 bool readableExtension(const std::string& name) {
-  return name == "KHR_mesh_quantization" || name == "EXT_meshopt_compression" ||
+  return name == "KHR_mesh_quantization" || name == "EXT_meshopt_compression" || name == "EXT_mesh_gpu_instancing" ||
          name.rfind("KHR_materials_", 0) == 0 || name.rfind("KHR_texture_", 0) == 0 ||
          name.rfind("EXT_texture_", 0) == 0;
 }
@@ -205,7 +205,7 @@ std::string prepareJson(const char* p, size_t n, bool glb, const std::string& fi
       if (!e.is_string() || readableExtension(e.get<std::string>())) continue;
       const std::string name = e.get<std::string>();
       std::string msg = fmt::format("the model requires the extension {} (extensionsRequired), which shadergen cannot "
-                                    "read; it reads KHR_mesh_quantization and EXT_meshopt_compression",
+                                    "read; it reads KHR_mesh_quantization, EXT_meshopt_compression and EXT_mesh_gpu_instancing",
                                     name);
       std::string_view all(p, n);
       auto [line, col] = lineColumn(p, n, "\"" + name + "\"", all.find("\"extensionsRequired\""));

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "common/diagnostics.h"
@@ -15,6 +16,92 @@ namespace {
 constexpr double kUnitQuaternionTolerance = 0.00769;
 double quaternionLength(const float* q) {
   return std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2] + double(q[3]) * q[3]);
+}
+
+// T·R·S, column-major (glTF: the quaternion x, y, z, w of unit length).
+std::array<double, 16> trsMatrix(const double* t, const double* q, const double* s) {
+  const double x = q[0], y = q[1], z = q[2], w = q[3];
+  const double r[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
+                          {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
+                          {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}};
+  std::array<double, 16> m{};
+  for (int c = 0; c < 3; ++c)
+    for (int row = 0; row < 3; ++row) m[static_cast<size_t>(c * 4 + row)] = r[row][c] * s[c];
+  for (int row = 0; row < 3; ++row) m[static_cast<size_t>(12 + row)] = t[row];
+  m[15] = 1;
+  return m;
+}
+
+// EXT_mesh_gpu_instancing on node `index`: one T·R·S per element (an absent attribute is the
+// identity part). ROTATION is float or normalized (signed) byte/short VEC4, normalised before
+// use like a node's rotation; TRANSLATION and SCALE are float VEC3, or byte/short (normalized
+// or not) under KHR_mesh_quantization, as the extension allows.
+std::vector<std::array<double, 16>> readGpuInstances(const tinygltf::Node& n, size_t index, const std::string& file,
+                                                     Reader& reader, std::vector<Diagnostic>& diagnostics) {
+  static const char* kExt = "EXT_mesh_gpu_instancing";
+  auto it = n.extensions.find(kExt);
+  if (it == n.extensions.end()) return {};
+  const std::string where = fmt::format("node {} ('{}', /nodes/{}/extensions/{}", index, n.name, index, kExt);
+  // tinygltf reads an empty object as null, so "attributes": {} reads as no attributes.
+  static const tinygltf::Value kNone;
+  const tinygltf::Value& ext = it->second;
+  const tinygltf::Value& attrs = ext.IsObject() && ext.Has("attributes") ? ext.Get("attributes") : kNone;
+  const char* names[3] = {"TRANSLATION", "ROTATION", "SCALE"};
+  std::vector<AccessorData> attr(3);
+  std::string first;  // the attribute that set the count
+  size_t count = 0;
+  for (size_t k = 0; k < 3; ++k) {
+    if (!attrs.Has(names[k])) continue;
+    const tinygltf::Value& v = attrs.Get(names[k]);
+    const std::string what = fmt::format("{}/attributes/{})", where, names[k]);
+    if (!v.IsInt()) fail(file, fmt::format("{}: {} is not an accessor index", what, names[k]));
+    AccessorData d = reader.read(v.GetNumberAsInt(), what);
+    const bool rotation = k == 1;
+    const bool small = d.componentType == TINYGLTF_COMPONENT_TYPE_BYTE || d.componentType == TINYGLTF_COMPONENT_TYPE_SHORT;
+    if (d.type != (rotation ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3) ||
+        !(d.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || (small && (d.normalized || !rotation))))
+      fail(file, fmt::format("{}: {} is {}{} {}; it must be {}", what, names[k], d.normalized ? "normalized " : "",
+                             componentTypeName(d.componentType), typeName(d.type),
+                             rotation ? "VEC4 of float, or normalized byte or short"
+                                      : "VEC3 of float, or byte or short, normalized or not (KHR_mesh_quantization)"));
+    if (first.empty()) {
+      first = names[k];
+      count = d.count;
+    } else if (d.count != count) {
+      fail(file, fmt::format("{}: {} has {} elements but {} has {}; every attribute has one per instance", what,
+                             names[k], d.count, first, count));
+    }
+    attr[k] = std::move(d);
+  }
+  if (first.empty()) fail(file, where + "): its \"attributes\" have no TRANSLATION, ROTATION or SCALE");
+  if (count == 0) fail(file, where + "): its attributes have no elements (no instance)");
+  reader.charge(count, sizeof(std::array<double, 16>), where + ") instance matrices");
+  std::vector<std::array<double, 16>> out;
+  out.reserve(count);
+  size_t nonUnit = 0;
+  for (size_t i = 0; i < count; ++i) {
+    double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+    for (size_t c = 0; c < 3; ++c) {
+      if (!attr[0].values.empty()) t[c] = attr[0].values[i * 3 + c];
+      if (!attr[2].values.empty()) s[c] = attr[2].values[i * 3 + c];
+    }
+    if (!attr[1].values.empty()) {
+      const double len = quaternionLength(&attr[1].values[i * 4]);
+      if (!(len > 0))
+        fail(file, fmt::format("{}/attributes/ROTATION): instance {} is a quaternion of length 0: it is no rotation",
+                               where, i));
+      if (!(std::abs(len - 1) <= kUnitQuaternionTolerance)) ++nonUnit;
+      for (size_t c = 0; c < 4; ++c) q[c] = attr[1].values[i * 4 + c] / len;
+    }
+    out.push_back(trsMatrix(t, q, s));
+  }
+  if (nonUnit)
+    diagnostics.push_back(Diagnostic{Severity::Warning, SourceLoc{file, 0, 0},
+                                     fmt::format("{}/attributes/ROTATION): {} of {} instance quaternions are not of unit "
+                                                 "length; they are normalised before use",
+                                                 where, nonUnit, count),
+                                     "ROTATION_NON_UNIT"});
+  return out;
 }
 }  // namespace
 
@@ -50,6 +137,7 @@ void readScene(const tinygltf::Model& model, const std::string& file, int mesh, 
     }
     if (n.scale.size() == 3) std::copy(n.scale.begin(), n.scale.end(), g.scale.begin());
     g.weights = n.weights;
+    g.instances = readGpuInstances(n, data.nodes.size(), file, reader, diagnostics);
     for (int c : g.children)
       if (c < 0 || static_cast<size_t>(c) >= model.nodes.size())
         fail(file, fmt::format("node '{}' has a child {} that does not exist", n.name, c));

@@ -223,7 +223,11 @@ rt::Pose gltfPose(const GltfImport& model, const rt::Mesh& mesh, const rt::RigSh
                                ? glm::mat4(G[static_cast<size_t>(skin.joints[j])] * glm::dmat4(fromArrayF(skin.inverseBind[j])))
                                : glm::mat4(1.0f));
   } else {
-    pose.model = node >= 0 ? glm::mat4(G[static_cast<size_t>(node)]) : glm::mat4(1.0f);
+    glm::dmat4 place = instance ? instance->instanceMatrix : glm::dmat4(1.0);
+    if (!instance && node >= 0 && !d.nodes[static_cast<size_t>(node)].instances.empty())
+      place = fromArray(d.nodes[static_cast<size_t>(node)].instances.front());  // as gltfInstances lists it first
+    // EXT_mesh_gpu_instancing: the instance's transform applies in the node's local space.
+    pose.model = node >= 0 ? glm::mat4(G[static_cast<size_t>(node)] * place) : glm::mat4(1.0f);
   }
   for (int i = 0; i < shape.morphTargets; ++i)
     pose.morphWeights.push_back(static_cast<float>(static_cast<size_t>(i) < weights.size() ? weights[static_cast<size_t>(i)] : 0.0));
@@ -261,7 +265,36 @@ std::vector<GltfInstance> gltfInstances(const GltfImport& model, std::vector<std
     return name.empty() ? fmt::format("node {}", n) : fmt::format("node {} '{}'", n, name);
   };
   std::vector<GltfInstance> out;
-  out.push_back(GltfInstance{d.meshNode, d.skin, d.meshNode >= 0 ? describe(d.meshNode) : "no node (origin)"});
+  // A node's GPU instances (EXT_mesh_gpu_instancing): one instance each for a rigid
+  // primitive, at most kMaxGpuInstancesChecked spread evenly (floor(k (N-1) / (K-1)): the
+  // first and the last, distinct, the same every run). A skinned one is placed by its joints,
+  // and the extension defines no instanced skinning: posed once, with a note.
+  static const std::vector<std::array<double, 16>> none;
+  auto add = [&](GltfInstance inst) {
+    const auto& gpu = inst.node >= 0 ? d.nodes[static_cast<size_t>(inst.node)].instances : none;
+    if (gpu.empty() || d.skin >= 0) {
+      if (!gpu.empty() && notes)
+        notes->push_back(fmt::format("{} has {} GPU instances (EXT_mesh_gpu_instancing), which are not posed for "
+                                     "the skinned mesh {}: posed once, by its joints",
+                                     inst.name, gpu.size(), d.mesh));
+      out.push_back(std::move(inst));
+      return;
+    }
+    const size_t N = gpu.size(), K = std::min(N, kMaxGpuInstancesChecked);
+    if (K < N && notes)
+      notes->push_back(fmt::format("checked {} of {} GPU instances of {} (EXT_mesh_gpu_instancing), evenly spread, "
+                                   "the first and the last included",
+                                   K, N, inst.name));
+    for (size_t k = 0; k < K; ++k) {
+      const size_t g = K == 1 ? 0 : k * (N - 1) / (K - 1);
+      GltfInstance gi = inst;
+      gi.gpuInstance = static_cast<int>(g);
+      gi.instanceMatrix = fromArray(gpu[g]);
+      gi.name = fmt::format("{} instance {}", inst.name, g);
+      out.push_back(std::move(gi));
+    }
+  };
+  add(GltfInstance{d.meshNode, d.skin, d.meshNode >= 0 ? describe(d.meshNode) : "no node (origin)"});
   // Nodes whose morph weights an animation sets: their instances differ even under one skin.
   std::vector<char> animatedWeights(d.nodes.size(), 0);
   for (const auto& a : d.animations)
@@ -298,7 +331,7 @@ std::vector<GltfInstance> gltfInstances(const GltfImport& model, std::vector<std
                          fmt::format("{} poses mesh {} with skin {} of {} joints, but its vertices use joint {}",
                                      inst.name, d.mesh, inst.skin, joints, usedJoints - 1));
     }
-    out.push_back(std::move(inst));
+    add(std::move(inst));
   }
   return out;
 }

@@ -24,22 +24,31 @@ struct GltfSceneOptions {
   std::optional<double> morphWeight;
   GltfReadOptions read;  // how the model's data is read (the overload that imports it)
   // Pose every instance of the primitive (gltfInstances), each at every time: poses are
-  // instance-major (pose i * times + k). false: the import's node alone.
+  // instance-major (pose i * times + k). false: the first alone (the import's node).
   bool allInstances = false;
 };
 
 // One node of the scene drawing the primitive's mesh, posed with its own transform, skin and
-// morph weights (docs/gltf.md, "Instances").
+// morph weights (docs/gltf.md, "Instances"); on a node with EXT_mesh_gpu_instancing, one of
+// its GPU instances.
 struct GltfInstance {
   int node = -1;  // -1: no node instantiates the mesh (posed at the origin)
   int skin = -1;  // the skin posing it (-1: rigid, at the node)
-  std::string name;  // "node 12 'Armature.003'" (for reports)
+  std::string name;  // "node 12 'Armature.003'", "node 0 'Cube' instance 17" (for reports)
+  int gpuInstance = -1;  // the element of the node's EXT_mesh_gpu_instancing (-1: none)
+  glm::dmat4 instanceMatrix{1.0};  // its T·R·S: placed at global(node) · instanceMatrix
 };
+// GPU instances checked per node: each is a posing and a device draw, and a node may carry
+// 100,000; more are sampled evenly, the first and the last included.
+constexpr size_t kMaxGpuInstancesChecked = 256;
 // The primitive's distinct instances: the import's node first, then every other node of the
 // scene drawing the mesh (depth first, pre-order). A skinned primitive's node is placed by its
 // skin: a node with the same skin and the same morph weights (node defaults, no animated
 // `weights`) as an earlier one poses it identically and is left out, as is a node without a
-// skin (noted in `notes`). Throws InputError for a skin whose joints the vertices overrun.
+// skin (noted in `notes`). A rigid primitive's node with EXT_mesh_gpu_instancing gives one
+// instance per GPU instance (at most kMaxGpuInstancesChecked, noted when fewer); a skinned
+// one's is posed once (its joints place the vertices, noted). Throws InputError for a skin
+// whose joints the vertices overrun.
 std::vector<GltfInstance> gltfInstances(const GltfImport& model, std::vector<std::string>* notes = nullptr);
 
 // What was posed, for reports.
@@ -53,7 +62,7 @@ struct GltfSceneInfo {
 
 // One pose per time (and instance). Skinned: skin.bones[j] = global(joint_j) · inverseBind_j (world space;
 // the skinned mesh node's own transform is ignored, as the glTF spec requires). Unskinned:
-// model.matrix = global(mesh node). Throws InputError for an unknown animation.
+// model.matrix = global(mesh node) · instanceMatrix. Throws InputError for an unknown animation.
 ValidationScene gltfScene(const GltfImport& model, const GltfSceneOptions& opts, GltfSceneInfo* info = nullptr);
 // From a rig path "model.glb#m/p".
 ValidationScene gltfScene(const std::string& modelRef, const GltfSceneOptions& opts, GltfSceneInfo* info = nullptr);
@@ -72,7 +81,7 @@ std::vector<glm::dmat4> gltfNodeGlobals(const GltfModelData& data, int anim, dou
 std::vector<glm::dmat4> gltfNodeGlobals(const GltfModelData& data, int anim, double t,
                                         std::vector<double>* morphWeights, int meshNode);
 // The uniforms for time t (camera framing the posed model), of `instance` (default: the
-// import's node and skin).
+// import's node and skin, at its first GPU instance if it has any).
 rt::Pose gltfPose(const GltfImport& model, const rt::Mesh& mesh, const rt::RigShape& shape, int anim, double t,
                   const GltfInstance* instance = nullptr);
 

@@ -24,6 +24,7 @@ Json instanceJson(const GltfInstance& inst, size_t index) {
   j["node"] = inst.node;
   j["node_description"] = inst.name;
   j["skin"] = inst.skin;
+  j["gpu_instance"] = inst.gpuInstance;  // EXT_mesh_gpu_instancing's element (-1: none)
   return j;
 }
 

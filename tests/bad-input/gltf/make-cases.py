@@ -397,6 +397,52 @@ case("report-on-a-yaml-rig", {},
      2, "--report", "to a YAML rig")
 
 
+# --- EXT_mesh_gpu_instancing (a node's per-instance TRANSLATION / ROTATION / SCALE) ----------
+INST_BLOB = (TRI + struct.pack("<6f", 0, 0, 0, 2, 0, 0) + struct.pack("<12f", 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 1)
+             + struct.pack("<12H", 0, 0, 0, 65535, 0, 0, 0, 65535, 0, 0, 0, 65535))
+INST_VIEWS = [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24},
+              {"buffer": 0, "byteOffset": 60, "byteLength": 48}, {"buffer": 0, "byteOffset": 108, "byteLength": 24}]
+INST_ACCESSORS = [POS, {"bufferView": 1, "componentType": 5126, "count": 2, "type": "VEC3"},  # 1: 2 translations
+                  {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC4"},  # 2: 3 rotations, the 2nd zero
+                  {"bufferView": 3, "componentType": 5123, "count": 3, "type": "VEC4", "normalized": True}]
+
+
+def instanced(ext, required=False):
+    """The triangle on node 0 with EXT_mesh_gpu_instancing `ext`."""
+    m = model(INST_ACCESSORS, views=INST_VIEWS, blob=INST_BLOB,
+              extra={"nodes": [{"mesh": 0, "extensions": {"EXT_mesh_gpu_instancing": ext}}]})
+    if required:
+        m["extensionsUsed"] = m["extensionsRequired"] = ["EXT_mesh_gpu_instancing"]
+    return m
+
+
+INST_AT = "@D/m.gltf: error: node 0 ('', /nodes/0/extensions/EXT_mesh_gpu_instancing"
+case("gpu-instancing-required", {"m.gltf": text(instanced({"attributes": {"TRANSLATION": 1}}, required=True))},
+     rig_import("@D/m.gltf"), 0)
+case("gpu-instancing-count-mismatch", {"m.gltf": text(instanced({"attributes": {"TRANSLATION": 1, "ROTATION": 2}}))},
+     VALIDATE_TRI, 1,
+     INST_AT + "/attributes/ROTATION): ROTATION has 3 elements but TRANSLATION has 2; every attribute has one per "
+     "instance")
+case("gpu-instancing-rotation-unsigned", {"m.gltf": text(instanced({"attributes": {"ROTATION": 3}}))},
+     rig_import("@D/m.gltf"), 1,
+     INST_AT + "/attributes/ROTATION): ROTATION is normalized unsigned short VEC4; it must be VEC4 of float, or "
+     "normalized byte or short")
+case("gpu-instancing-translation-vec4", {"m.gltf": text(instanced({"attributes": {"TRANSLATION": 2}}))},
+     rig_import("@D/m.gltf"), 1,
+     INST_AT + "/attributes/TRANSLATION): TRANSLATION is float VEC4; it must be VEC3 of float, or byte or short")
+case("gpu-instancing-rotation-zero", {"m.gltf": text(instanced({"attributes": {"ROTATION": 2}}))},
+     rig_import("@D/m.gltf"), 1,
+     INST_AT + "/attributes/ROTATION): instance 1 is a quaternion of length 0: it is no rotation")
+case("gpu-instancing-accessor-missing", {"m.gltf": text(instanced({"attributes": {"SCALE": 9}}))},
+     rig_import("@D/m.gltf"), 1, "/attributes/SCALE) refers to accessor 9, which does not exist")
+case("gpu-instancing-accessor-not-index", {"m.gltf": text(instanced({"attributes": {"SCALE": "one"}}))},
+     rig_import("@D/m.gltf"), 1, INST_AT + "/attributes/SCALE): SCALE is not an accessor index")
+case("gpu-instancing-no-attributes", {"m.gltf": text(instanced({"attributes": {}}))}, rig_import("@D/m.gltf"), 1,
+     INST_AT + "): its \"attributes\" have no TRANSLATION, ROTATION or SCALE")
+case("gpu-instancing-attributes-missing", {"m.gltf": text(instanced({}))}, rig_import("@D/m.gltf"), 1,
+     INST_AT + "): its \"attributes\" have no TRANSLATION, ROTATION or SCALE")
+
+
 def main():
     for name in sorted(os.listdir(HERE)):
         if os.path.isdir(os.path.join(HERE, name)) and name not in cases:
