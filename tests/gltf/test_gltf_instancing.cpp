@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "cli_run.h"
 #include "gltf_builder.h"
 #include "render/render.h"
 #include "rig/gltf_import.h"
@@ -22,7 +23,9 @@ namespace sg {
 namespace {
 
 namespace fs = std::filesystem;
+using test::CliRun;
 using test::GltfBuilder;
+using test::cli;
 
 std::string sourcePath(const std::string& rel) { return std::string(SG_SOURCE_DIR) + "/" + rel; }
 
@@ -195,22 +198,6 @@ TEST(GltfInstancing, SkinnedMeshIsPosedOnceWithANote) {
       << notes[0];
 }
 
-struct CliRun {
-  int status = -1;
-  std::string out;
-};
-CliRun cli(const std::string& args) {
-  std::string cmd = fmt::format("XDG_RUNTIME_DIR=/tmp \"{}\" {} 2>&1", SG_CLI, args);
-  CliRun r;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf{};
-  size_t n = 0;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
 
 // (b, on the device) `validate` checks every GPU instance, and the world positions the device
 // computed for each equal the hand values.

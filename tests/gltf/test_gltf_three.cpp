@@ -16,6 +16,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "cli_run.h"
 #include "gltf_test_util.h"
 #include "rig/gltf_import.h"
 #include "validate/gltf_scene.h"
@@ -28,27 +29,15 @@ namespace fs = std::filesystem;
 using test::dataPath;
 using test::modelPath;
 using test::sourcePath;
+using test::CliRun;
+using test::cli;
+using test::shell;
 
-struct ShellRun {
-  int status = -1;
-  std::string out;
-};
-ShellRun sh(const std::string& cmd) {
-  ShellRun r;
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  if (!p) return r;
-  std::array<char, 65536> buf{};
-  size_t n = 0;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
 
 std::string script() { return sourcePath("tests/js/three_pose.mjs"); }
 // Node.js and the pinned three.js (tests/js, `npm ci` in cmake/dev.sh); the tests skip without them.
 std::string missingNode() {
-  if (sh("node --version").status != 0) return "node is not installed (Debian package nodejs; cmake/dev.sh)";
+  if (shell("node --version").status != 0) return "node is not installed (Debian package nodejs; cmake/dev.sh)";
   for (const char* package : {"three", "gltf-validator"})
     if (!fs::exists(sourcePath(fmt::format("tests/js/node_modules/{}/package.json", package))))
       return fmt::format("{} is not installed in tests/js/node_modules (npm ci in tests/js; cmake/dev.sh)", package);
@@ -79,7 +68,7 @@ std::map<Key, Posed> threePose(const std::string& model, const std::string& anim
   std::string cmd = fmt::format("node \"{}\" \"{}\"", script(), model);
   if (!animation.empty()) cmd += fmt::format(" --animation \"{}\"", animation);
   for (double t : times) cmd += fmt::format(" --time {}", t);
-  ShellRun r = sh(cmd);
+  CliRun r = shell(cmd);
   EXPECT_EQ(r.status, 0) << r.out;
   std::map<Key, Posed> out;
   if (r.status != 0) return out;
@@ -250,7 +239,7 @@ TEST(ThreeJs, EverySharedModelAgreesWithThreeJs) {
                                   SG_CLI, model, dataPath(mc.fragment), sourcePath("rules/standard.yaml"), dir.string());
     if (!mc.animation.empty()) cmd += " --animation " + mc.animation;
     for (double t : mc.times) cmd += fmt::format(" --time {}", t);
-    ShellRun v = sh(cmd);
+    CliRun v = shell(cmd);
     ASSERT_EQ(v.status, 0) << v.out;
     Comparison c = compare(threePose(model, mc.animation, mc.times), savedPose(dir));
     EXPECT_TRUE(c.problems.empty()) << fmt::format("{}", fmt::join(c.problems, "\n"));
@@ -278,7 +267,7 @@ TEST(ThreeJs, EverySharedModelAgreesWithThreeJs) {
                              worst, worstNormal);
     // The saved glTF passes the Khronos glTF-Validator and opens in three.js's loader, its
     // positions the .bin arrays float for float.
-    ShellRun back = sh(fmt::format("node \"{}\" --check-saved \"{}\"", script(), dir.string()));
+    CliRun back = shell(fmt::format("node \"{}\" --check-saved \"{}\"", script(), dir.string()));
     EXPECT_EQ(back.status, 0) << back.out;
     EXPECT_NE(back.out.find("\"meshes\":"), std::string::npos) << back.out;
     fs::remove_all(dir);

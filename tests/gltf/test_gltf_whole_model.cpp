@@ -15,6 +15,7 @@
 #include <set>
 #include <sstream>
 
+#include "cli_run.h"
 #include "gltf_test_util.h"
 #include "render/render.h"
 #include "runtime/reference.h"
@@ -29,6 +30,9 @@ namespace fs = std::filesystem;
 using test::dataPath;
 using test::modelPath;
 using test::sourcePath;
+using test::CliRun;
+using test::cli;
+using test::shell;
 
 // three.js's RobotExpressive (CC0): a fetched data file, so it lives in ../shared/models, not
 // in this repository; the tests that need it skip until it is installed there.
@@ -37,23 +41,6 @@ std::string robot() { return modelPath("RobotExpressive/RobotExpressive.glb"); }
   if (!fs::exists(robot()))                                                                        \
   GTEST_SKIP() << robot() << " is not installed (three.js's RobotExpressive.glb, CC0; see docs/gltf.md)"
 
-struct CliRun {
-  int status = -1;
-  std::string out;  // standard output and error together
-};
-
-CliRun cli(const std::string& args) {
-  std::string cmd = fmt::format("XDG_RUNTIME_DIR=/tmp \"{}\" {} 2>&1", SG_CLI, args);
-  CliRun r;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf{};
-  size_t n = 0;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
 
 fs::path scratch(const std::string& name) {
   fs::path d = fs::temp_directory_path() / ("sg_whole_" + name);
