@@ -535,6 +535,7 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
     if (f) {
       RigAttribute attr = makeAttribute("color0", *f, {{"vertex.color0", ""}}, file);
       attr.shaderType = Type::Vec4;
+      attr.widened = rgb;
       rig.attributes.push_back(std::move(attr));
       carried("COLOR_0", "color0", *f);
       auto colours = reader.stream(readAttr("COLOR_0"), 0, rgb ? 3 : 4, where + " attribute COLOR_0");
@@ -991,14 +992,13 @@ std::string rigToYaml(const Rig& rig, const std::vector<std::string>& header) {
     } else {
       for (const auto& p : a.provides)
         prov += (prov.empty() ? "{ " : ", ") + yamlQuote(p.semantic) + ": " +
-                (p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(componentCount(a.shaderType)))
+                (p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(a.widened ? componentCount(a.shaderType)
+                                                                                          : formatComponents(a.format)))
                                    : p.swizzle);
       prov += " }";
     }
-    // Declared only where it is not the format's own (a float32x3 colour read as a vec4).
-    const bool widened = !formatIsInteger(a.format) && componentCount(a.shaderType) > formatComponents(a.format);
     s += fmt::format("  {}: {{ format: {}{}{}, provides: {} }}\n", a.name, formatName(a.format),
-                     widened ? ", shader_type: " + std::string(glslName(a.shaderType)) : "",
+                     a.widened ? ", shader_type: " + std::string(glslName(a.shaderType)) : "",
                      a.perMorphTarget ? ", per_target: true" : "", prov);
   }
   if (!rig.uniforms.empty()) {

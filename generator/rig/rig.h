@@ -44,7 +44,8 @@ struct PackedField {
 struct RigAttribute {
   std::string name;       // base of the GLSL input name (a_<name>, a_<name><target>)
   VertexFormat format = VertexFormat::Float32x4;
-  Type shaderType = Type::Vec4;  // type declared in the shader (derived from format)
+  Type shaderType = Type::Vec4;  // type declared in the shader (derived from format, unless widened)
+  bool widened = false;          // `shader_type`: wider than the format; the device fills the rest
   bool perMorphTarget = false;   // one stream per morph target; semantics get "[target]"
   std::vector<ProvidedPart> provides;
   std::vector<PackedField> fields;  // non-empty: bit-packed (format uint32x4, uint32x2 or uint32)

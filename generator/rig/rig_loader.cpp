@@ -132,6 +132,7 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
                            "the missing ones (0, and 1 for w)",
                            tn, fmtName, n == 3 ? "vec4" : n == 2 ? "vec3 or vec4" : "vec2 to vec4"));
       a.shaderType = *t;
+      a.widened = true;
       n = componentCount(*t);
     }
     if (body["per_target"]) a.perMorphTarget = y.boolean(body["per_target"], "'per_target'");

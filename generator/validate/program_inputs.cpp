@@ -50,7 +50,7 @@ void quantizeStreams(const Rig& rig, rt::Mesh& m) {
         const VertexFormat format = partFormat(a, p);  // a bit-packed field's own
         const int n = formatComponents(format);
         // A widened attribute (shader_type past the format): the device reads 0, and 1 for w.
-        const int declared = p.field >= 0 ? n : componentCount(a.shaderType);
+        const int declared = p.field >= 0 || !a.widened ? n : componentCount(a.shaderType);
         if (formatIsFloat32(format) && declared == n) continue;
         auto it = m.streams.find(partSemantic(a, p, a.perMorphTarget ? t : -1));
         if (it == m.streams.end()) continue;
