@@ -58,8 +58,11 @@ struct ValidateCommand {
   // "instances: 84 checked, each at every time (node 10, node 21, ...)", a note per instance
   // left out, and a line per failing instance and time.
   static std::string formatInstances(const ValidatedPart& p) {
+    // Past 6 (a GPU-instanced node has hundreds): the first 4, "...", the last; --report has all.
     std::string names;
-    for (const auto& i : p.instances) names += (names.empty() ? "" : ", ") + i.name;
+    const size_t n = p.instances.size();
+    for (size_t k = 0; k < n; ++k)
+      if (n <= 6 || k < 4 || k + 1 == n) names += (names.empty() ? "" : k + 1 == n && n > 6 ? ", ..., " : ", ") + p.instances[k].name;
     std::string s = fmt::format("instances: {} checked, each at every time ({})\n", p.instances.size(), names);
     for (const auto& n : p.instanceNotes) s += "note: " + n + "\n";
     const RunReport& run = p.report.runs.front();

@@ -428,6 +428,10 @@ TEST(WholeModel, EveryInstanceOfRecursiveSkeletonsIsValidatedAndListed) {
                              (out / "report.json").string(), (out / "saved").string()));
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("instances: 84 checked, each at every time"), std::string::npos) << r.out;
+  // The line names the first four and the last (the report lists every one, below).
+  const std::string line = r.out.substr(r.out.find("instances: 84"), r.out.find('\n', r.out.find("instances: 84")) - r.out.find("instances: 84"));
+  EXPECT_EQ(std::count(line.begin(), line.end(), ','), 6) << line;  // "checked, ": 1; the names: 5
+  EXPECT_NE(line.find(", ..., node "), std::string::npos) << line;
   EXPECT_NE(r.out.find("PASS  m0p0-skinned_mesh  (" + skeletons() + "#0/0): 40 vertices, skinned (10 joints), 84 instance(s)"),
             std::string::npos)
       << r.out;
