@@ -157,7 +157,8 @@ TEST(Quantization, WidenedColourReadsAlphaOne) {
   sg::ValidationScene scene = sg::proceduralScene(rig, "limb", 1, 1);
   auto& drawn = scene.mesh.streams.at("vertex.color0");
   for (size_t v = 0; v < drawn.size(); ++v) drawn[v].w = 0.25f + 0.001f * static_cast<float>(v % 7);  // not 1
-  const auto& read = sg::quantizeForRig(rig, scene.mesh).streams.at("vertex.color0");
+  const sg::rt::Mesh quantized = sg::quantizeForRig(rig, scene.mesh);
+  const auto& read = quantized.streams.at("vertex.color0");
   ASSERT_EQ(read.size(), drawn.size());
   for (size_t v = 0; v < read.size(); ++v) {
     EXPECT_EQ(read[v], glm::vec4(glm::vec3(drawn[v]), 1.0f)) << "vertex " << v;
