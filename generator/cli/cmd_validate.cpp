@@ -59,10 +59,12 @@ struct ValidateCommand {
   // left out, and a line per failing instance and time.
   static std::string formatInstances(const ValidatedPart& p) {
     // Past 6 (a GPU-instanced node has hundreds): the first 4, "...", the last; --report has all.
-    std::string names;
     const size_t n = p.instances.size();
-    for (size_t k = 0; k < n; ++k)
-      if (n <= 6 || k < 4 || k + 1 == n) names += (names.empty() ? "" : k + 1 == n && n > 6 ? ", ..., " : ", ") + p.instances[k].name;
+    std::string names;
+    for (size_t k = 0; k < n; ++k) {
+      if (n > 6 && k >= 4 && k + 1 < n) continue;
+      names += (k == 0 ? "" : n > 6 && k + 1 == n ? ", ..., " : ", ") + p.instances[k].name;
+    }
     std::string s = fmt::format("instances: {} checked, each at every time ({})\n", p.instances.size(), names);
     for (const auto& n : p.instanceNotes) s += "note: " + n + "\n";
     const RunReport& run = p.report.runs.front();

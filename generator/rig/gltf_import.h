@@ -223,4 +223,8 @@ Rig loadRig(const std::string& path, const GltfReadOptions& read = {});
 // comments at the top.
 std::string rigToYaml(const Rig& rig, const std::vector<std::string>& header = {});
 
+// A node's (or a GPU instance's) local transform T·R·S, column-major, from glTF's translation,
+// rotation quaternion (x, y, z, w; normalised here) and scale.
+std::array<double, 16> gltfTrs(const double* t, const double* q, const double* s);
+
 }  // namespace sg

@@ -7,7 +7,24 @@
 #include <array>
 #include <cmath>
 
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+
 #include "common/diagnostics.h"
+
+namespace sg {
+
+std::array<double, 16> gltfTrs(const double* t, const double* q, const double* s) {
+  const glm::dmat4 m = glm::translate(glm::dmat4(1.0), glm::dvec3(t[0], t[1], t[2])) *
+                       glm::mat4_cast(glm::normalize(glm::dquat(q[3], q[0], q[1], q[2]))) *  // glm: (w, x, y, z)
+                       glm::scale(glm::dmat4(1.0), glm::dvec3(s[0], s[1], s[2]));
+  std::array<double, 16> out{};
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) out[static_cast<size_t>(c * 4 + r)] = m[c][r];
+  return out;
+}
+
+}  // namespace sg
 
 namespace sg::gltf {
 namespace {
@@ -16,20 +33,6 @@ namespace {
 constexpr double kUnitQuaternionTolerance = 0.00769;
 double quaternionLength(const float* q) {
   return std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2] + double(q[3]) * q[3]);
-}
-
-// T·R·S, column-major (glTF: the quaternion x, y, z, w of unit length).
-std::array<double, 16> trsMatrix(const double* t, const double* q, const double* s) {
-  const double x = q[0], y = q[1], z = q[2], w = q[3];
-  const double r[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
-                          {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
-                          {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}};
-  std::array<double, 16> m{};
-  for (int c = 0; c < 3; ++c)
-    for (int row = 0; row < 3; ++row) m[static_cast<size_t>(c * 4 + row)] = r[row][c] * s[c];
-  for (int row = 0; row < 3; ++row) m[static_cast<size_t>(12 + row)] = t[row];
-  m[15] = 1;
-  return m;
 }
 
 // EXT_mesh_gpu_instancing on node `index`: one T·R·S per element (an absent attribute is the
@@ -91,9 +94,9 @@ std::vector<std::array<double, 16>> readGpuInstances(const tinygltf::Node& n, si
         fail(file, fmt::format("{}/attributes/ROTATION): instance {} is a quaternion of length 0: it is no rotation",
                                where, i));
       if (!(std::abs(len - 1) <= kUnitQuaternionTolerance)) ++nonUnit;
-      for (size_t c = 0; c < 4; ++c) q[c] = attr[1].values[i * 4 + c] / len;
+      std::copy_n(&attr[1].values[i * 4], 4, q);
     }
-    out.push_back(trsMatrix(t, q, s));
+    out.push_back(gltfTrs(t, q, s));
   }
   if (nonUnit)
     diagnostics.push_back(Diagnostic{Severity::Warning, SourceLoc{file, 0, 0},

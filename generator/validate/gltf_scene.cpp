@@ -173,10 +173,7 @@ std::vector<glm::dmat4> gltfNodeGlobals(const GltfModelData& data, int anim, dou
     if (n.hasMatrix && !animated[i]) {
       local[i] = fromArray(n.matrix);
     } else {
-      glm::dmat4 T = glm::translate(glm::dmat4(1.0), glm::dvec3(tr[i][0], tr[i][1], tr[i][2]));
-      glm::dmat4 R = glm::mat4_cast(glm::normalize(quatXYZW(rot[i].data())));
-      glm::dmat4 S = glm::scale(glm::dmat4(1.0), glm::dvec3(sc[i][0], sc[i][1], sc[i][2]));
-      local[i] = T * R * S;
+      local[i] = fromArray(gltfTrs(tr[i].data(), rot[i].data(), sc[i].data()));
     }
   }
   std::vector<int> parent(N, -1);
