@@ -129,12 +129,25 @@ void makeHostile(rt::Mesh& m, const Rig& rig) {
     zeroDeltas(v, "morph.normal");
     if (v < 3) zeroDeltas(v, "morph.tangent");
   }
-  const glm::vec3 n3 = normal(3);
-  setAt(m, "vertex.tangent", 0, glm::vec4(0));                    // zero
-  setAt(m, "vertex.tangent", 1, glm::vec4(2.0f * normal(1), 0));  // parallel
-  setAt(m, "vertex.tangent", 2, glm::vec4(-normal(2), 0));        // antiparallel
-  if (m.has("vertex.tangent") && targets > 0)                     // parallel when target 0 alone is on
-    setAt(m, "morph.tangent[0]", 3, glm::vec4(1.5f * n3 - glm::vec3(m.at("vertex.tangent")[3]), 0));
+  // The parallel frames are axis-aligned: every normal and tangent format (float16, snorm8,
+  // octahedral) stores them exactly, so they stay exactly degenerate on the data as the
+  // device reads it. -N rounded to float16 beside an snorm8 N is merely ill-conditioned,
+  // and float32 Gram-Schmidt there differs from the exact definition by 3e-5.
+  auto setNormal = [&](size_t v, glm::vec3 n) {
+    if (m.has("vertex.normal")) setAt(m, "vertex.normal", v, glm::vec4(n, m.at("vertex.normal")[v].w));
+  };
+  auto setTangent = [&](size_t v, glm::vec3 t) {
+    if (m.has("vertex.tangent")) setAt(m, "vertex.tangent", v, glm::vec4(t, m.at("vertex.tangent")[v].w));
+  };
+  setAt(m, "vertex.tangent", 0, glm::vec4(0));  // zero
+  setNormal(1, {0, 1, 0});
+  setTangent(1, {0, 2, 0});  // parallel
+  setNormal(2, {0, 0, 1});
+  setTangent(2, {0, 0, -1});  // antiparallel
+  setNormal(3, {1, 0, 0});
+  setTangent(3, {0, 1, 0});
+  if (m.has("vertex.tangent") && targets > 0)  // parallel (1.5 N) when target 0 alone is on
+    setAt(m, "morph.tangent[0]", 3, glm::vec4(1.5f, -1.0f, 0.0f, 0.0f));
   setAt(m, "vertex.normal", 4, glm::vec4(0, 0, 0, m.at("vertex.normal")[4].w));          // zero
   setAt(m, "vertex.normal", 5, glm::vec4(1e-15f * normal(5), m.at("vertex.normal")[5].w));  // tiny
   setAt(m, "vertex.normal", 6, glm::vec4(1e15f * normal(6), m.at("vertex.normal")[6].w));   // huge
