@@ -44,9 +44,10 @@ struct PackCommand {
     writeFilesAtomically(files);
     for (const auto& n : r.in.notes) std::cerr << formatDiagnostic(n) << "\n";
     if (!quiet)
-      std::cout << fmt::format("packed {} vertices of '{}' into {} streams, {} bytes: {}.bin, {}.json\n",
-                               packed.vertexCount, scene.mesh.name, r.glsl.inputs.size(), packed.bytes.size(), output,
-                               output);
+      std::cout << fmt::format("packed {} vertices of '{}' into {} streams{}, {} bytes: {}.bin, {}.json\n",
+                               packed.vertexCount, scene.mesh.name, r.glsl.inputs.size(),
+                               packed.storageBuffers ? fmt::format(" and {} storage buffers", packed.storageBuffers) : "",
+                               packed.bytes.size(), output, output);
     return 0;
   }
 };
@@ -65,7 +66,7 @@ void registerPack(CLI::App& app, CliState& state) {
       ->check(CLI::IsMember({"head", "limb", "dawn"}));
   sub->add_option("-o,--output", c->output, "Output stem: writes STEM.bin (the streams) and STEM.json (their layout)")
       ->required();
-  sub->add_flag("-q,--quiet", c->quiet, "Print nothing on success");
+  sub->add_flag("-q,--quiet", c->quiet, "Do not print the summary (notes still go to stderr, as with generate -q)");
   sub->callback([c, &state] { state.run = [c] { return c->run(); }; });
 }
 

@@ -2,6 +2,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+
 #include "rig/packed_fields.h"
 #include "rig/vertex_encoding.h"
 #include "validate/program_inputs.h"
@@ -54,10 +56,33 @@ PackedVertices packVertices(const GenerateResult& r, const rt::Mesh& mesh) {
                        {"provides", std::move(provides)}});
     if (!a.fields.empty()) streams.back()["fields"] = nlohmann::json::parse(packedFieldsJson(a));
   }
+  // The per-vertex storage buffers after the streams, each described as the reflection
+  // describes it (docs/buffers.md) plus its offset and size: vertex_count * count elements
+  // (the device's copy may be longer). The palettes are the pose's, written each frame like
+  // the uniform block: listed, not packed.
+  nlohmann::json buffers = nlohmann::json::array(), palettes = nlohmann::json::array();
+  const std::vector<rt::StorageBufferData> data = perVertexBuffers(r, quantized);
+  for (nlohmann::json b : nlohmann::json::parse(reflectionOf(r)).value("storage_buffers", nlohmann::json::array())) {
+    if (b["indexing"] != "per_vertex") {
+      palettes.push_back(std::move(b));
+      continue;
+    }
+    const auto it = std::find_if(data.begin(), data.end(), [&](const auto& d) { return d.binding == b["binding"]; });
+    const size_t size = out.vertexCount * b["count"].get<size_t>() * b["stride"].get<size_t>();
+    const size_t offset = (out.bytes.size() + 15) / 16 * 16;
+    out.bytes.resize(offset);
+    out.bytes.insert(out.bytes.end(), it->data.begin(), it->data.begin() + static_cast<std::ptrdiff_t>(size));
+    b["offset"] = offset;
+    b["size"] = size;
+    buffers.push_back(std::move(b));
+  }
+  out.storageBuffers = buffers.size();
   const nlohmann::json layout = {{"rig", rig.name},
                                  {"vertex_count", out.vertexCount},
                                  {"bytes", out.bytes.size()},
                                  {"streams", std::move(streams)},
+                                 {"storage_buffers", std::move(buffers)},
+                                 {"palettes", std::move(palettes)},
                                  // the values the mesh gives its uniforms (the bounds), by semantic
                                  {"uniforms", quantized.uniforms}};
   out.layoutJson = layout.dump(2) + "\n";

@@ -14,10 +14,13 @@ namespace sg {
 
 struct PackedVertices {
   size_t vertexCount = 0;
-  std::vector<uint8_t> bytes;  // every stream, each tightly packed, at 16-byte aligned offsets
+  std::vector<uint8_t> bytes;  // every stream, then every per-vertex storage buffer, each at a 16-byte aligned offset
+  size_t storageBuffers = 0;   // per-vertex storage buffers among them
   // {"vertex_count", "bytes", "streams": [{"input", "location", "attribute", "target",
   //  "format", "offset", "stride", "size", "provides": [{semantic, components[, encodes,
-  //  encoding, max_error_deg]}]}]}, in location order; written with nlohmann::json.
+  //  encoding, max_error_deg]}]}] in location order, "storage_buffers": [the reflection's
+  //  entry plus "offset", "size"], "palettes" (the reflection's entries: written each
+  //  frame), "uniforms"}; written with nlohmann::json.
   std::string layoutJson;
 };
 

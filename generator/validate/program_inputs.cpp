@@ -549,11 +549,15 @@ UniformValues feedPose(const GenerateResult& r, const rt::Mesh& mesh, const rt::
   return values;
 }
 
+std::vector<rt::StorageBufferData> perVertexBuffers(const GenerateResult& r, const rt::Mesh& mesh) {
+  return buildStorageBuffers(r.in.problem, r.glsl, mesh, rt::Pose{}, true);
+}
+
 rt::ProgramInputs programInputs(const GenerateResult& r, const rt::Mesh& mesh, const rt::Pose& pose) {
   rt::ProgramInputs in;
   in.vertexCount = static_cast<uint32_t>(mesh.vertexCount);
   for (const auto& i : r.glsl.inputs) in.streams.push_back(vertexStream(r.in.rig, i, mesh));
-  in.storageBuffers = buildStorageBuffers(r.in.problem, r.glsl, mesh, rt::Pose{}, true);
+  in.storageBuffers = perVertexBuffers(r, mesh);
   in.declared = declaredDescriptors(r.spirv.descriptors);
   feedPose(r, mesh, pose, in);
   return in;

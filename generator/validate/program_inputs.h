@@ -18,6 +18,10 @@ namespace sg {
 // streams, storage buffers, uniform block and declared descriptors. Throws InputError when
 // the mesh or pose lacks what the program reads.
 rt::ProgramInputs programInputs(const GenerateResult& r, const rt::Mesh& mesh, const rt::Pose& pose);
+// The per-vertex storage buffers program `r` reads over `mesh` (quantizeForRig'd): morph
+// deltas, joints and weights, each element (v, i) at v * count + i (docs/buffers.md). The
+// palettes follow the pose (feedPose) and are not among them.
+std::vector<rt::StorageBufferData> perVertexBuffers(const GenerateResult& r, const rt::Mesh& mesh);
 // Feeds `inputs` (built by programInputs for this mesh) for another pose: the uniform
 // block and the palettes. Returns the uniform values it fed (the reference uses the same).
 UniformValues feedPose(const GenerateResult& r, const rt::Mesh& mesh, const rt::Pose& pose, rt::ProgramInputs& inputs);

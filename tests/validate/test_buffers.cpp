@@ -6,12 +6,16 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <nlohmann/json.hpp>
+#include <set>
 
 #include "test_util.h"
 #include "rig/rig_lod.h"
 #include "validate/gltf_scene.h"
+#include "validate/pack.h"
 #include "validate/validate.h"
 
 namespace {
@@ -259,6 +263,62 @@ TEST(Buffers, NamedDeviceLimitsComeFromTheDevice) {
   EXPECT_EQ(sg::applyDeviceLimits(portable, {}, v.harness()), "");
   EXPECT_EQ(portable.maxAttributes, 16);
   EXPECT_EQ(portable.maxUniformBlockBytes, 16384u);
+}
+
+
+// `pack` writes what the application uploads, the storage buffers too: face52's plan reads its
+// 52 targets' deltas from two per-vertex buffers, and each element (v, i), read back at the
+// layout's offset + (v * count + i) * stride alone (docs/buffers.md), is the mesh's own
+// morph.position[i] / morph.normal[i] of vertex v (float32: stored exactly). Until session 35
+// the layout listed only the 4 attribute streams and the deltas were missing without a word.
+// A palette read from a buffer is the pose's: listed, not packed.
+TEST(Buffers, PackWritesThePerVertexBuffersTheLayoutDescribes) {
+  sg::GenerateOptions o;
+  o.rigPath = dataPath("face52.rig.yaml");
+  o.fragmentPath = dataPath("world.frag");
+  o.rulesPaths = {sourcePath("rules/standard.yaml")};
+  const sg::GenerateResult r = sg::generate(o);
+  const sg::ValidationScene scene = sg::proceduralScene(r.in.rig, "head", 1, 1);
+  const sg::PackedVertices packed = sg::packVertices(r, scene.mesh);
+  const nlohmann::json layout = nlohmann::json::parse(packed.layoutJson);
+  ASSERT_EQ(layout["bytes"], packed.bytes.size());
+  ASSERT_EQ(layout["storage_buffers"].size(), 2u);
+  EXPECT_EQ(packed.storageBuffers, 2u);
+  std::set<std::string> families;
+  for (const auto& b : layout["storage_buffers"]) {
+    ASSERT_EQ(b["count"], 52);
+    ASSERT_EQ(b["holds"].size(), 1u);
+    const std::string family = b["holds"][0]["semantic"].get<std::string>();  // "morph.position[i]"
+    families.insert(family);
+    const std::string components = b["holds"][0]["components"];
+    const size_t offset = b["offset"], stride = b["stride"], count = b["count"];
+    ASSERT_EQ(offset % 16, 0u);
+    ASSERT_EQ(b["size"].get<size_t>(), scene.mesh.vertexCount * count * stride);
+    ASSERT_LE(offset + b["size"].get<size_t>(), packed.bytes.size());
+    size_t wrong = 0;
+    for (size_t i = 0; i < count; ++i) {
+      const auto& src = scene.mesh.at(family.substr(0, family.size() - 3) + "[" + std::to_string(i) + "]");
+      for (size_t v = 0; v < scene.mesh.vertexCount; ++v)
+        for (size_t c = 0; c < components.size(); ++c) {
+          float x;
+          std::memcpy(&x, packed.bytes.data() + offset + (v * count + i) * stride + 4 * c, 4);
+          wrong += x != src[v][static_cast<int>(c)];
+        }
+    }
+    EXPECT_EQ(wrong, 0u) << family;
+  }
+  EXPECT_EQ(families, (std::set<std::string>{"morph.position[i]", "morph.normal[i]"}));
+  EXPECT_TRUE(layout["palettes"].empty());
+
+  sg::GenerateOptions limb = o;
+  limb.rigPath = dataPath("limb8_palette300.rig.yaml");
+  limb.fragmentPath = dataPath("world.frag");
+  const sg::GenerateResult lr = sg::generate(limb);
+  const nlohmann::json ll = nlohmann::json::parse(sg::packVertices(lr, sg::proceduralScene(lr.in.rig, "limb", 1, 1).mesh).layoutJson);
+  ASSERT_EQ(ll["palettes"].size(), 1u);
+  EXPECT_EQ(ll["palettes"][0]["semantic"], "skin.bones_buffer");
+  EXPECT_EQ(ll["palettes"][0]["count"], 300);
+  EXPECT_FALSE(ll["palettes"][0].contains("offset"));
 }
 
 }  // namespace
