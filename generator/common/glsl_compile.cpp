@@ -136,6 +136,9 @@ GlslShader::GlslShader(const GlslUnit& unit, TargetEnv env) : impl_(std::make_un
   // Unnamed: glslang then reports string numbers, which `#line L S` directives set and
   // parseGlslangLog maps to files (a name would stick across #line).
   const char* src = m.unit.text.c_str();
+  // A UTF-8 byte-order mark (some Windows editors write one) is no GLSL token: glslang
+  // would stop at it. Editors do not show it, so line 1's columns count without it.
+  if (m.unit.text.rfind("\xEF\xBB\xBF", 0) == 0) src += 3;
   m.shader->setStrings(&src, 1);
   EnvVersions v = versionsOf(env);
   const bool hlsl = unit.language == SourceLanguage::Hlsl;
@@ -204,6 +207,7 @@ std::vector<StageVariable> stageVariables(glslang::TProgram& prog, bool outputs)
       v.typeText = t->getCompleteString();
       const auto& q = t->getQualifier();
       if (q.hasLocation()) v.location = static_cast<int>(q.layoutLocation);
+      if (q.hasComponent()) v.component = static_cast<int>(q.layoutComponent);
       v.flat = q.flat;
       v.block = t->getBasicType() == glslang::EbtBlock;
       if (v.block) v.blockName = t->getTypeName().c_str();

@@ -48,6 +48,7 @@ struct StageVariable {
   int arraySize = 0;         // elements of a 1-D array, 0 = not an array
   std::string typeText;      // glslang's spelling of the type (for messages)
   int location = -1;         // -1: no layout(location)
+  int component = -1;        // -1: no layout(component)
   bool flat = false;
   bool block = false;        // an interface block, or a member of one
   std::string blockName;     // the block's type name (`in Block { ... } instance;`)

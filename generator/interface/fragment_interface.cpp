@@ -163,6 +163,13 @@ FragmentInterface reflectFragmentSource(const std::string& source, const std::st
     in.arraySize = r.arraySize;
     if (r.location < 0)
       throw InputError(in.loc, fmt::format("fragment input '{}' has no layout(location = N)", r.name));
+    // One input per location: the emitter writes whole locations, and a list of semantics
+    // packs several values into one input instead (docs/rules-format.md, "Varyings").
+    if (r.component >= 0)
+      throw InputError(in.loc, fmt::format("fragment input '{}' uses layout(component = {}): inputs sharing a location "
+                                           "are not supported; give it a location of its own, or declare one vector "
+                                           "and map it to a list of semantics (--map NAME=sem,sem)",
+                                           r.name, r.component));
     in.location = r.location;
     in.flat = r.flat;
     fi.inputs.push_back(std::move(in));

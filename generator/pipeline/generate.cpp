@@ -147,11 +147,17 @@ Plan searchStage(const LoadedInputs& in, const SearchOptions& opts, SearchStats*
                               list);
       }
     }
+    // Buffers the draw's size ruled out: why the buffer forms did not help.
+    std::string oversized;
+    for (const auto& b : p.buffers)
+      if (!b.oversize.empty())
+        oversized += fmt::format("{} {} ({})", oversized.empty() ? "; storage buffers were ruled out by the draw's size:" : ",",
+                                 p.facts[b.fact].name, b.oversize);
     throw InputError(at,
                      fmt::format("no plan for rig '{}' fits the device limits: the cheapest plan reads {}; no "
                                  "alternative rule (rules/buffers.yaml reads morph targets, influences and bones "
-                                 "from storage buffers) stays within them",
-                                 in.rig.name, broken.empty() ? "more than the limits allow" : broken));
+                                 "from storage buffers) stays within them{}",
+                                 in.rig.name, broken.empty() ? "more than the limits allow" : broken, oversized));
   }
   // A glTF import's notes say which of the model's attributes the rig does not carry.
   std::vector<Diagnostic> notes = in.notes;

@@ -405,11 +405,13 @@ void setDeviceLimits(Problem& p, int64_t maxAttributes, int64_t maxUniformBytes,
 
 void dropOversizedBuffers(Problem& p, int64_t maxVertices, int64_t maxBytes) {
   if (maxVertices <= 0) return;
-  for (const auto& b : p.buffers) {
+  for (auto& b : p.buffers) {
     if (b.kind != BufferSource::Kind::PerVertex) continue;
     // Checked in long double: vertices x count x stride can pass 2^63 for hostile options.
     long double bytes = static_cast<long double>(maxVertices) * b.count * b.strideBytes;
     if (bytes <= static_cast<long double>(maxBytes)) continue;
+    b.oversize = fmt::format("{:.0f} bytes for {} vertices, over the {} bytes of maxStorageBufferRange",
+                             static_cast<double>(bytes), maxVertices, maxBytes);
     p.facts[b.fact].source = Fact::Source::Computed;
     p.init.erase(std::remove(p.init.begin(), p.init.end(), b.fact), p.init.end());
   }

@@ -118,6 +118,9 @@ struct BufferSource {
   };
   std::vector<Part> parts;  // PerVertex
   int uniform = -1;         // Array: the rig uniform whose values it holds
+  // Set by dropOversizedBuffers when it drops this buffer: "N bytes for V vertices, over the
+  // M bytes of maxStorageBufferRange". The error for a rig no plan fits quotes it.
+  std::string oversize;
 };
 
 // One line of instantiated snippet. Fact references are encoded as

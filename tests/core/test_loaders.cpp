@@ -1188,6 +1188,26 @@ TEST(Fragment, SyntaxErrorIsLocated) {
   EXPECT_MSG(d2, "undeclared");
 }
 
+// Some Windows editors start a UTF-8 file with a byte-order mark; glslang stopped at it
+// ("'\xEF' : unexpected token" at line 1). The shader reads as it would without it, with
+// line 2's columns unchanged.
+TEST(Fragment, AUtf8ByteOrderMarkIsNotGlsl) {
+  const std::string src =
+      "\xEF\xBB\xBF#version 450\r\n"
+      "layout(location = 0) in vec3 N;\r\n"
+      "layout(location = 0) out vec4 color;\r\n"
+      "void main() { color = vec4(N, 1.0); }\r\n";
+  sg::FragmentInterface fi = sg::reflectFragmentSource(src, "bom.frag");
+  ASSERT_EQ(fi.inputs.size(), 1u);
+  EXPECT_EQ(fi.inputs[0].name, "N");
+  EXPECT_EQ(fi.inputs[0].loc.line, 2);
+  EXPECT_EQ(fi.inputs[0].loc.col, 30);
+  // An error after it is still located in the file's own lines.
+  auto d = errorOf([&] { sg::reflectFragmentSource("\xEF\xBB\xBF#version 450\nvoid main() { undeclared; }\n", "bom.frag"); });
+  EXPECT_EQ(d.loc.line, 2) << sg::formatDiagnostic(d);
+  EXPECT_MSG(d, "undeclared");
+}
+
 TEST(Fragment, InputWithoutLocation) {
   const std::string src =
       "#version 450\n"
