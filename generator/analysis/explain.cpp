@@ -296,9 +296,14 @@ std::string formatUnreachable(const Problem& p, const std::vector<UnreachableGoa
     if (g.missingInputs.empty()) {
       out += ": no rule derives it from anything a rig could provide\n";
     } else {
-      for (size_t i = 0; i < g.missingInputs.size(); ++i)
+      for (size_t i = 0; i < g.missingInputs.size(); ++i) {
         out += fmt::format("{}{{{}}}", i == 0 ? ": possible if the rig also provided " : " or ",
                            compactFactList(g.missingInputs[i]));
+        // The rig stores it, but this generation withholds it: say so, not "provide it".
+        for (const std::string& s : g.missingInputs[i])
+          if (auto w = p.withheld.find(s); w != p.withheld.end())
+            out += fmt::format(" (the rig stores {}, withheld: {})", s, w->second);
+      }
       out += "\n";
     }
     for (const auto& r : g.inapplicableRules) out += "  " + r + "\n";

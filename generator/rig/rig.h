@@ -85,6 +85,9 @@ struct Rig {
   // A glTF import's notes (attributes it left out, data fed as stored): an unmet request
   // names them, since a value the model holds but the rig does not carry reads as missing.
   std::vector<std::string> importNotes;
+  // Semantics the rig stores that this generation withholds from the search, and why
+  // ("--max-error"): an unmet request must not suggest providing them.
+  std::map<std::string, std::string> withheld;
   std::string skinWeights;
 
   int64_t param(const std::string& key, int64_t fallback = 0) const;

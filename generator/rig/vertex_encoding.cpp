@@ -275,7 +275,9 @@ Rig withinErrorBudgets(const Rig& rig, const std::map<std::string, double>& budg
         break;
       }
     }
-  return withoutProvided(rig, over);
+  Rig out = withoutProvided(rig, over);
+  for (const std::string& s : over) out.withheld[s] = "over the --max-error budget";
+  return out;
 }
 
 const RigAttribute* attributeProviding(const Rig& rig, const std::string& semantic) {

@@ -391,7 +391,9 @@ class Builder {
 }  // namespace
 
 Problem buildProblem(const Rig& rig, const RuleSet& rules, const std::vector<Varying>& varyings) {
-  return Builder(rig, rules).build(varyings);
+  Problem p = Builder(rig, rules).build(varyings);
+  p.withheld = rig.withheld;
+  return p;
 }
 
 void setDeviceLimits(Problem& p, int64_t maxAttributes, int64_t maxUniformBytes, int64_t maxStorageBuffers) {

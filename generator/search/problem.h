@@ -4,6 +4,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -155,6 +156,7 @@ struct Problem {
   std::vector<int> goals;  // requested facts (sorted, unique)
   // Rules skipped at instantiation and why (for explain/check): "when is false", ...
   std::vector<std::pair<int, std::string>> skippedRules;
+  std::map<std::string, std::string> withheld;  // the rig's (Rig::withheld)
   std::vector<ResourceLimit> limits;  // empty: unconstrained (random libraries, tests)
   std::vector<ResourceItem> resources;
   std::vector<BufferSource> buffers;

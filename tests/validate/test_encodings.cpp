@@ -162,6 +162,11 @@ TEST(Octahedral, ABudgetTighterThanTheEncodingRemovesIt) {
     std::string all = sg::formatDiagnostic(e.diagnostic());
     for (const auto& d : e.related) all += "\n" + sg::formatDiagnostic(d);
     EXPECT_NE(all.find("cannot produce 'world.normal'"), std::string::npos) << all;
+    // Its suggestion to provide the code the rig stores says the budget withheld it.
+    EXPECT_NE(all.find("{vertex.normal_octahedral} (the rig stores vertex.normal_octahedral, withheld: over the "
+                       "--max-error budget)"),
+              std::string::npos)
+        << all;
     EXPECT_NE(all.find("octahedral.rig.yaml:12:3: note: vertex.normal_octahedral (attribute 'frame', snorm16x4) is not "
                        "offered to the search: it errs up to 0.00372 deg, over the budget of 0.001 deg"),
               std::string::npos)
