@@ -415,6 +415,7 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
         if (!floatMesh) {
           floatMesh = rt::everyNthVertex(mesh, floatStride);
           for (auto& [sem, stream] : rt::everyNthVertex(scene.mesh, floatStride).streams) floatMesh->streams[sem] = std::move(stream);
+          fillWidenedComponents(rig, *floatMesh);
         }
         FloatReference f = floatReference(rules, shape, *floatMesh, pr.uniforms, bounds, floatMissing);
         for (size_t k = 0; k < floatMissing.size(); ++k) {
