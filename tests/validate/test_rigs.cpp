@@ -195,6 +195,52 @@ TEST(Quantization, WidenedColourFillIsTheFloatDataToo) {
   EXPECT_EQ(fillBound, 0.0);
 }
 
+// 16 vec4 varyings, 64 components (the least maxVertexOutputComponents Vulkan guarantees),
+// each mapped to eye.position: with gl_Position the capture record is 68 components, past
+// glslang's OpenGL default of 64 interleaved components but within the device's
+// transform-feedback limits, which are the ones that apply.
+sg::ValidateOptions outputs64(const std::string& rig) {
+  sg::ValidateOptions vo;
+  vo.gen.rigPath = rig;
+  vo.gen.fragmentPath = dataPath("outputs64.frag");
+  vo.gen.rulesPaths = {sourcePath("rules/standard.yaml")};
+  for (int i = 0; i < 16; ++i) vo.gen.overrides.push_back({"e" + std::to_string(i), {"eye.position"}});
+  return vo;
+}
+
+TEST(Capture, SixtyFourOutputComponentsValidate) {
+  const sg::ValidateOptions vo = outputs64(dataPath("unskinned_model.rig.yaml"));
+  sg::Validator v(vo);
+  const sg::ValidateReport rep = v.run(sg::proceduralScene(sg::loadRigFile(vo.gen.rigPath), "limb", 1, 2));
+  std::cout << sg::formatReport(rep);
+  expectAllPass(rep);
+  const sg::RunReport& run = rep.runs.at(0);
+  ASSERT_EQ(run.outputs.size(), 17u);  // gl_Position and e0..e15
+  for (const auto& o : run.outputs) EXPECT_FALSE(o.unchecked) << o.name << ": " << o.uncheckedReason;
+}
+
+// A device capturing fewer bytes a vertex than the record: a located error at the fragment
+// input whose output crosses the limit, naming the Vulkan limits, before anything compiles.
+TEST(Capture, ARecordPastTheDevicesLimitIsALocatedError) {
+  sg::GenerateOptions gen = outputs64(dataPath("unskinned_model.rig.yaml")).gen;
+  gen.capture = true;
+  gen.maxCaptureBytes = 256;  // gl_Position and e0..e14; e15 is past it
+  const std::string frag = readText(gen.fragmentPath);
+  const int e15Line = 1 + static_cast<int>(std::count(frag.begin(), frag.begin() + static_cast<long>(frag.find("vec4 e15;")), '\n'));
+  try {
+    sg::generate(gen);
+    FAIL() << "generated a capture record past the device's limit";
+  } catch (const sg::InputError& e) {
+    const sg::Diagnostic& d = e.diagnostic();
+    EXPECT_EQ(d.loc.file, gen.fragmentPath);
+    EXPECT_EQ(d.loc.line, e15Line);
+    EXPECT_NE(d.message.find("maxTransformFeedbackBufferDataStride"), std::string::npos) << d.message;
+    EXPECT_NE(d.message.find("'e15'"), std::string::npos) << d.message;
+  }
+  gen.maxCaptureBytes = 272;  // exactly the record
+  EXPECT_NO_THROW(sg::generate(gen));
+}
+
 // The quantization path matters: with unorm8 weights, the reference fed the raw float weights
 // is off by far more than the tolerance, so the unorm8 rig above only passes because the
 // validator gives the reference the values the GPU reads.
