@@ -490,6 +490,7 @@ UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape
                             const rt::Pose& pose) {
   UniformValues uniforms = poseUniforms(rig, pose);
   for (const auto& u : mesh.uniforms) uniforms.insert(u);
+  for (auto& u : definitionInputs(rig, rules, pose)) uniforms.insert(std::move(u));
   for (const auto& u : rig.uniforms) {
     const SemanticDecl* d = rules.findSemantic(u.semantic);
     if (uniforms.count(u.semantic) || !d || !d->definition) continue;
