@@ -319,6 +319,10 @@ std::string Harness::deviceName() const { return impl_->dev.props.deviceName; }
 std::string Harness::driver() const { return impl_->dev.driver; }
 bool Harness::validationEnabled() const { return impl_->validation; }
 const VkPhysicalDeviceLimits& Harness::limits() const { return impl_->dev.props.limits; }
+uint32_t Harness::maxCaptureBytes() const {
+  const auto& x = impl_->dev.xfbProps;
+  return std::min({x.maxTransformFeedbackBufferDataStride, x.maxTransformFeedbackBufferDataSize, x.maxTransformFeedbackStreamDataSize});
+}
 Harness::Handles Harness::handles() const {
   return {impl_->dev.pd, impl_->device, impl_->queueFamily, impl_->queue, impl_->memoryBudget, impl_->executableStatistics};
 }
@@ -328,9 +332,10 @@ RunResult Harness::run(const RunRequest& req) {
   const uint32_t stride = req.capture.strideBytes;
   const VkDeviceSize captureSize = VkDeviceSize(req.vertexCount) * stride;
   const VkDeviceSize xfbSize = VkDeviceSize(req.vertexCount + (req.vertexCount & 1u)) * stride;
-  if (stride == 0 || stride % 4 != 0 || stride > h.dev.xfbProps.maxTransformFeedbackBufferDataStride)
-    throw std::runtime_error(fmt::format("vk harness: capture stride {} must be a non-zero multiple of 4 and at most {}",
-                                         stride, h.dev.xfbProps.maxTransformFeedbackBufferDataStride));
+  if (stride == 0 || stride % 4 != 0 || stride > maxCaptureBytes())
+    throw std::runtime_error(fmt::format("vk harness: capture stride {} must be a non-zero multiple of 4 and at most {} "
+                                         "(the device's transform-feedback limits)",
+                                         stride, maxCaptureBytes()));
   if (xfbSize > h.dev.xfbProps.maxTransformFeedbackBufferSize)
     throw std::runtime_error(fmt::format("vk harness: capture of {} bytes exceeds the device's transform feedback buffer size {}",
                                          xfbSize, h.dev.xfbProps.maxTransformFeedbackBufferSize));

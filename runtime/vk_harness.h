@@ -60,6 +60,10 @@ class Harness {
   bool validationEnabled() const;  // whether the layer was found and enabled
   // The physical device's limits (maxVertexInputAttributes, maxUniformBufferRange, ...).
   const VkPhysicalDeviceLimits& limits() const;
+  // The bytes a vertex's capture record may take in the one transform-feedback buffer run()
+  // binds: the least of maxTransformFeedbackBufferDataStride, maxTransformFeedbackBufferDataSize
+  // and maxTransformFeedbackStreamDataSize (VK_EXT_transform_feedback).
+  uint32_t maxCaptureBytes() const;
 
   // The device the harness set up, for code that draws with it (runtime/vk_render.h).
   struct Handles {

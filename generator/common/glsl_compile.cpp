@@ -109,6 +109,7 @@ struct GlslShader::Impl {
   GlslUnit unit;
   TargetEnv env = TargetEnv::Vulkan1_0;
   EShLanguage lang = EShLangVertex;
+  TBuiltInResource resources{};  // what the parse was given (the link reads it too)
   std::unique_ptr<glslang::TShader> shader;
   std::unique_ptr<glslang::TProgram> program;  // this stage linked alone
   std::vector<Diagnostic> diagnostics;
@@ -154,7 +155,10 @@ GlslShader::GlslShader(const GlslUnit& unit, TargetEnv env) : impl_(std::make_un
     m.shader->setAutoMapLocations(true);  // bindSemantics sets the real ones
     m.shader->setEnvTargetHlslFunctionality1();
   }
-  bool parsed = m.shader->parse(GetDefaultResources(), hlsl ? 500 : 450, ECoreProfile, false, false, messages);
+  m.resources = *GetDefaultResources();
+  if (unit.maxCaptureStrideBytes > 0)
+    m.resources.maxTransformFeedbackInterleavedComponents = static_cast<int>(unit.maxCaptureStrideBytes / 4);
+  bool parsed = m.shader->parse(&m.resources, hlsl ? 500 : 450, ECoreProfile, false, false, messages);
   m.diagnostics = parseGlslangLog(m.shader->getInfoLog(), m.unit);
   if (!parsed) return;
   m.program = std::make_unique<glslang::TProgram>();

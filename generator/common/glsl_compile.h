@@ -39,6 +39,10 @@ struct GlslUnit {
   // uniform block); set = space. The SPIR-V keeps each input's and output's semantic
   // (SPV_GOOGLE_hlsl_functionality1) for bindSemantics.
   uint32_t hlslTextureBindingShift = 0;
+  // A transform-feedback capture build: the largest xfb_stride accepted, in bytes (the capture
+  // device's limit). glslang's default, gl_MaxTransformFeedbackInterleavedComponents = 64, is
+  // OpenGL's minimum, not a Vulkan limit. 0: that default.
+  uint32_t maxCaptureStrideBytes = 0;
 };
 
 // A user input or output of one stage, as reflected from the parse.

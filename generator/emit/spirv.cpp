@@ -6,8 +6,11 @@
 
 namespace sg {
 
-CompiledVertexShader compileVertex(const EmittedGlsl& glsl, const std::string& glslFileName, TargetEnv env) {
-  GlslShader parsed(GlslUnit{Stage::Vertex, glsl.text, glslFileName, glsl.sourceFiles}, env);
+CompiledVertexShader compileVertex(const EmittedGlsl& glsl, const std::string& glslFileName, TargetEnv env,
+                                   uint32_t maxCaptureBytes) {
+  GlslUnit unit{Stage::Vertex, glsl.text, glslFileName, glsl.sourceFiles};
+  unit.maxCaptureStrideBytes = maxCaptureBytes > 0 ? maxCaptureBytes : glsl.captureStride;
+  GlslShader parsed(unit, env);
   if (!parsed.ok())
     throwDiagnostics(parsed.diagnostics(), glslFileName, "the generated vertex shader does not compile");
   SpirvModule m;

@@ -32,8 +32,11 @@ struct CompiledVertexShader {
   GlslShader parsed;
 };
 
-// Compiles `glsl`; errors become InputErrors located through its #line map.
-CompiledVertexShader compileVertex(const EmittedGlsl& glsl, const std::string& glslFileName, TargetEnv env);
+// Compiles `glsl`; errors become InputErrors located through its #line map. A capture build's
+// record may take up to `maxCaptureBytes` a vertex (its device's; 0: none known, so its own
+// stride: the harness checks it against the device that runs it).
+CompiledVertexShader compileVertex(const EmittedGlsl& glsl, const std::string& glslFileName, TargetEnv env,
+                                   uint32_t maxCaptureBytes = 0);
 SpirvModule compileVertexShader(const EmittedGlsl& glsl, const std::string& glslFileName, TargetEnv env);
 
 // Links the vertex shader with the fragment shader in glslang (cross-stage checks) and

@@ -51,8 +51,10 @@ std::vector<double> ranks(const std::vector<double>& v) {
   return r;
 }
 
-GlslShader parseVertex(const std::string& text, const std::string& path, TargetEnv env) {
-  GlslShader s(GlslUnit{Stage::Vertex, text, path, {}}, env);
+GlslShader parseVertex(const std::string& text, const std::string& path, TargetEnv env, uint32_t maxCaptureBytes) {
+  GlslUnit unit{Stage::Vertex, text, path, {}};
+  unit.maxCaptureStrideBytes = maxCaptureBytes;
+  GlslShader s(unit, env);
   if (!s.ok()) throwDiagnostics(s.diagnostics(), path, "the vertex shader does not compile");
   return s;
 }
@@ -160,7 +162,9 @@ std::string addCaptureQualifiers(const std::string& glsl, const std::string& pat
 
 GenerateResult handWrittenProgram(const std::string& text, const std::string& path, const GenerateResult& like,
                                   TargetEnv env) {
-  GlslShader s = parseVertex(text, path, env);
+  // A capture build declares the record of the program it stands in for, which generating
+  // that program checked against the device (GenerateOptions::maxCaptureBytes).
+  GlslShader s = parseVertex(text, path, env, like.glsl.captureStride);
   const Rig& rig = like.in.rig;
   GenerateResult r = like;
   r.glsl.text = text;
@@ -349,6 +353,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     GenerateOptions capture = render;
     render.capture = false;
     capture.capture = true;
+    capture.maxCaptureBytes = validator.harness().maxCaptureBytes();
     Program p;
     p.render = generateFrom(in, render);
     p.row.label = label;

@@ -66,6 +66,28 @@ std::vector<Diagnostic> unreachableInputs(const LoadedInputs& in) {
   throw e;
 }
 
+// Validation captures a vertex's outputs, gl_Position first, into one transform-feedback
+// buffer (glsl.captureStride bytes a vertex): the record must fit the device that runs it.
+// Located at the fragment input whose output first crosses the limit.
+void checkCaptureFits(const LoadedInputs& in, const EmittedGlsl& glsl, uint32_t maxBytes) {
+  if (glsl.captureStride <= maxBytes) return;
+  SourceLoc at{in.fragment.file, 0, 0};
+  std::string crossing;
+  for (const auto& o : glsl.outputs) {
+    const uint32_t end = o.captureOffset + 4u * static_cast<uint32_t>(componentCount(o.type) * std::max(1, o.arraySize));
+    if (end <= maxBytes || !crossing.empty()) continue;
+    crossing = o.name;
+    for (const auto& v : in.varyings)
+      if (v.name == o.name && v.loc.line) at = v.loc;
+  }
+  throw InputError(at, fmt::format("validation captures gl_Position and every output of the program, {} bytes a vertex "
+                                   "({} components), in one transform-feedback buffer; the device captures at most {} "
+                                   "bytes a vertex (the least of its maxTransformFeedbackBufferDataStride, "
+                                   "maxTransformFeedbackBufferDataSize and maxTransformFeedbackStreamDataSize); '{}' "
+                                   "is past it",
+                                   glsl.captureStride, glsl.captureStride / 4, maxBytes, crossing));
+}
+
 }  // namespace
 
 LoadedInputs instantiateStage(Rig rig, RuleSet rules, FragmentInterface fragment,
@@ -184,9 +206,9 @@ EmittedGlsl emitStage(const LoadedInputs& in, const Plan& plan, const TemplateSe
 }
 
 CompiledVertexShader compileStage(const LoadedInputs& in, const Plan& plan, const EmittedGlsl& glsl,
-                                  const std::string& glslName, TargetEnv env) {
+                                  const std::string& glslName, TargetEnv env, uint32_t maxCaptureBytes) {
   try {
-    return compileVertex(glsl, glslName, env);
+    return compileVertex(glsl, glslName, env, maxCaptureBytes);
   } catch (const InputError& e) {
     // glslang reports lines only: point the columns at the snippet text in the rules file.
     std::vector<SourceLoc> snippetLines;
@@ -406,7 +428,9 @@ GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const
   eo.search = searchMethod(res.stats);
   eo.version = shadergenVersion();
   res.glsl = emitStage(in, res.plan, templates, eo);
-  CompiledVertexShader compiled = compileStage(in, res.plan, res.glsl, opts.outputName, opts.targetEnv);
+  if (opts.maxCaptureBytes > 0) checkCaptureFits(in, res.glsl, opts.maxCaptureBytes);
+  CompiledVertexShader compiled =
+      compileStage(in, res.plan, res.glsl, opts.outputName, opts.targetEnv, opts.capture ? opts.maxCaptureBytes : 0);
   res.spirv = compiled.module;
   res.spirv.words =
       checkStage(in, res.glsl, compiled, ShaderCheckOptions{opts.outputName, opts.targetEnv, opts.optimize, opts.maxUniformBlockBytes});

@@ -45,6 +45,10 @@ struct GenerateOptions {
   TargetEnv targetEnv = TargetEnv::Vulkan1_0;
   bool optimize = false;
   bool capture = false;  // transform-feedback build for validation
+  // The bytes a vertex's capture record (gl_Position and every output) may take on the device
+  // that validates the program (rt::Harness::maxCaptureBytes); a record past it is a located
+  // error. 0: no device known, not checked here (the harness checks what it runs).
+  uint32_t maxCaptureBytes = 0;
   std::string outputName = "shader.vert";  // how the GLSL is named in diagnostics
   // The uniform block must fit the device's maxUniformBufferRange; 16384 bytes is what
   // every Vulkan device guarantees (docs/limits.md). A known device may raise it.

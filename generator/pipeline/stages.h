@@ -64,9 +64,10 @@ EmittedGlsl emitStage(const LoadedInputs& in, const Plan& plan, const TemplateSe
 
 // ---- compile ----------------------------------------------------------------------------
 // Parses the GLSL once (SPIR-V + uniform layout + the parse for the link check). Compile
-// errors are located at the rules' snippet lines, columns refined.
+// errors are located at the rules' snippet lines, columns refined. `maxCaptureBytes`: as
+// compileVertex's.
 CompiledVertexShader compileStage(const LoadedInputs& in, const Plan& plan, const EmittedGlsl& glsl,
-                                  const std::string& glslName, TargetEnv env);
+                                  const std::string& glslName, TargetEnv env, uint32_t maxCaptureBytes = 0);
 
 // ---- check ------------------------------------------------------------------------------
 struct ShaderCheckOptions {

@@ -19,22 +19,6 @@ struct Axis {
   std::vector<std::vector<float>> linear;  // [semantic][value]
 };
 
-// The semantics `semantic`'s definition may read, directly or through other definitions, on
-// any branch (families by their name); nullopt if it is not declared.
-std::optional<std::set<std::string>> readsOf(const RuleSet& rules, const std::string& semantic) {
-  const SemanticDecl* d = rules.findSemantic(semantic);
-  if (!d) return std::nullopt;
-  std::set<std::string> seen;
-  std::vector<const SemanticDecl*> todo{d};
-  while (!todo.empty()) {
-    const SemanticDecl* x = todo.back();
-    todo.pop_back();
-    if (!seen.insert(x->name).second || !x->definition) continue;
-    for (int r : definitionReads(*x->definition)) todo.push_back(&rules.semantics[static_cast<size_t>(r)]);
-  }
-  return seen;
-}
-
 }  // namespace
 
 FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::Mesh& floatMesh,
@@ -53,7 +37,7 @@ FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::M
     return evaluators.emplace(which, reference.evaluator(names)).first->second;
   };
   std::vector<std::optional<std::set<std::string>>> reads;
-  for (const auto& s : semantics) reads.push_back(readsOf(rules, s));
+  for (const auto& s : semantics) reads.push_back(definitionReadsOf(rules, s));
   auto readers = [&](const std::string& stream) {
     const std::string family = stream.substr(0, stream.find('['));
     std::vector<size_t> which;

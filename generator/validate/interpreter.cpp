@@ -306,4 +306,18 @@ std::vector<std::string> Interpreter::inputsAt(const std::string& semantic, size
   return out;
 }
 
+std::optional<std::set<std::string>> definitionReadsOf(const RuleSet& rules, const std::string& semantic) {
+  const SemanticDecl* d = rules.findSemantic(semantic);
+  if (!d) return std::nullopt;
+  std::set<std::string> seen;
+  std::vector<const SemanticDecl*> todo{d};
+  while (!todo.empty()) {
+    const SemanticDecl* x = todo.back();
+    todo.pop_back();
+    if (!seen.insert(x->name).second || !x->definition) continue;
+    for (int r : definitionReads(*x->definition)) todo.push_back(&rules.semantics[static_cast<size_t>(r)]);
+  }
+  return seen;
+}
+
 }  // namespace sg

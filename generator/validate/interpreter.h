@@ -9,6 +9,8 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -27,6 +29,10 @@ using UniformValues = std::map<std::string, std::vector<double>>;
 struct UndefinedSemantic : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+// The semantics `semantic`'s definition may read, directly or through other definitions, on
+// any branch (families by their name), `semantic` included; nullopt if it is not declared.
+std::optional<std::set<std::string>> definitionReadsOf(const RuleSet& rules, const std::string& semantic);
 
 class Interpreter {
  public:

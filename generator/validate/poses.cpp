@@ -4,8 +4,10 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <random>
 #include <set>
 
@@ -108,6 +110,33 @@ void pushMat(std::vector<double>& out, const glm::mat4& m) {
     for (int r = 0; r < 4; ++r) out.push_back(m[c][r]);
 }
 
+// The value of a uniform rt::Pose holds in a named field, `arraySize` elements at least for
+// an array; nullopt for any other semantic.
+std::optional<std::vector<double>> poseField(const std::string& s, const rt::Pose& pose, int arraySize) {
+  std::vector<double> v;
+  if (s == "skin.bones") {
+    for (const auto& b : pose.bones) pushMat(v, b);
+  } else if (s == "morph.weights") {
+    for (int i = 0; i < std::max(arraySize, static_cast<int>(pose.morphWeights.size())); ++i)
+      v.push_back(i < static_cast<int>(pose.morphWeights.size()) ? pose.morphWeights[static_cast<size_t>(i)] : 0.0);
+  } else if (s == "camera.position") {
+    v = {pose.cameraPosition.x, pose.cameraPosition.y, pose.cameraPosition.z};
+  } else if (s == "camera.view") {
+    pushMat(v, pose.view);
+  } else if (s == "camera.projection") {
+    pushMat(v, pose.projection);
+  } else if (s == "camera.view_projection") {
+    pushMat(v, pose.viewProjection());
+  } else if (s == "model.matrix") {
+    pushMat(v, pose.model);
+  } else if (s == "dapple.matrix") {
+    pushMat(v, pose.dapple);
+  } else {
+    return std::nullopt;
+  }
+  return v;
+}
+
 }  // namespace
 
 bool isStandardUniform(const std::string& semantic) { return standardUniforms().count(semantic) != 0; }
@@ -134,32 +163,24 @@ void drawDeclaredUniforms(std::vector<rt::Pose>& poses, const Rig& rig, const Ru
 
 UniformValues poseUniforms(const Rig& rig, const rt::Pose& pose) {
   UniformValues u = pose.uniforms;
-  for (const auto& ru : rig.uniforms) {
-    const std::string& s = ru.semantic;
-    std::vector<double> v;
-    if (s == "skin.bones") {
-      for (const auto& b : pose.bones) pushMat(v, b);
-    } else if (s == "morph.weights") {
-      for (int i = 0; i < std::max(ru.arraySize, static_cast<int>(pose.morphWeights.size())); ++i)
-        v.push_back(i < static_cast<int>(pose.morphWeights.size()) ? pose.morphWeights[static_cast<size_t>(i)] : 0.0);
-    } else if (s == "camera.position") {
-      v = {pose.cameraPosition.x, pose.cameraPosition.y, pose.cameraPosition.z};
-    } else if (s == "camera.view") {
-      pushMat(v, pose.view);
-    } else if (s == "camera.projection") {
-      pushMat(v, pose.projection);
-    } else if (s == "camera.view_projection") {
-      pushMat(v, pose.viewProjection());
-    } else if (s == "model.matrix") {
-      pushMat(v, pose.model);
-    } else if (s == "dapple.matrix") {
-      pushMat(v, pose.dapple);
-    } else {
-      continue;
-    }
-    u[s] = std::move(v);
-  }
+  for (const auto& ru : rig.uniforms)
+    if (auto v = poseField(ru.semantic, pose, ru.arraySize)) u[ru.semantic] = std::move(*v);
   return u;
+}
+
+UniformValues definitionInputs(const Rig& rig, const RuleSet& rules, const rt::Pose& pose) {
+  UniformValues out;
+  for (const auto& ru : rig.uniforms) {
+    const SemanticDecl* d = rules.findSemantic(ru.semantic);
+    if (!d || !d->definition) continue;
+    const std::set<std::string> reads = *definitionReadsOf(rules, ru.semantic);
+    for (const std::string& s : reads) {
+      const bool declared = std::any_of(rig.uniforms.begin(), rig.uniforms.end(), [&](const RigUniform& u) { return u.semantic == s; });
+      if (declared || rules.findSemantic(s)->definition) continue;
+      if (auto v = poseField(s, pose, 0)) out[s] = std::move(*v);
+    }
+  }
+  return out;
 }
 
 std::string formatPoseFile(const std::vector<rt::Pose>& poses) {

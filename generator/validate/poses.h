@@ -24,6 +24,13 @@ void drawDeclaredUniforms(std::vector<rt::Pose>& poses, const Rig& rig, const Ru
 
 // The values of the rig's uniforms in `pose`, by semantic, before definitions are applied.
 UniformValues poseUniforms(const Rig& rig, const rt::Pose& pose);
+// The pose's values of the uniforms that the definitions of the rig's uniforms read (through
+// other definitions too) and the rig does not declare: those it holds in named fields, the
+// values a rig declaring them would get. For the reference only (the GPU reads the rig's
+// uniforms): a rig giving camera.view_projection (= camera.projection * camera.view) and no
+// projection then has, in the reference, the projection and view its view_projection is the
+// product of, so that clip.position, defined from them, is checked.
+UniformValues definitionInputs(const Rig& rig, const RuleSet& rules, const rt::Pose& pose);
 
 // Pose files (YAML). Floats are written with 9 significant digits and doubles with 17, so
 // reading a file back and writing it again gives the same bytes.

@@ -41,26 +41,42 @@ void gatherPart(const RigAttribute& a, const ProvidedPart& p, int target, const 
 // Replaces, in the mesh, every value an attribute of a non-float32 format carries by the
 // value the device reads back from its stored form, so the reference sees exactly what the
 // GPU reads. A part's stream component k is the attribute's component of its swizzle's
-// k-th letter (10-10-10-2 stores w in 2 bits, x, y and z in 10).
+// k-th letter (10-10-10-2 stores w in 2 bits, x, y and z in 10). Components past a widened
+// attribute's format are fillWidened's.
 void quantizeStreams(const Rig& rig, rt::Mesh& m) {
   for (const auto& a : rig.attributes) {
     int targets = a.perMorphTarget ? rig.morphTargets() : 1;
     for (int t = 0; t < targets; ++t)
       for (const auto& p : a.provides) {
         const VertexFormat format = partFormat(a, p);  // a bit-packed field's own
+        if (formatIsFloat32(format)) continue;
         const int n = formatComponents(format);
-        // A widened attribute (shader_type past the format): the device reads 0, and 1 for w.
-        const int declared = p.field >= 0 || !a.widened ? n : componentCount(a.shaderType);
-        if (formatIsFloat32(format) && declared == n) continue;
+        auto it = m.streams.find(partSemantic(a, p, a.perMorphTarget ? t : -1));
+        if (it == m.streams.end()) continue;
+        const std::string swz = p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(n)) : p.swizzle;
+        for (auto& v : it->second)
+          for (size_t k = 0; k < swz.size(); ++k)
+            if (const int c = swizzleIndex(swz[k]); c < n) v[static_cast<int>(k)] = storedValue(format, c, v[static_cast<int>(k)]);
+      }
+  }
+}
+
+// A widened attribute (shader_type past the format): the device reads 0 in the components
+// the format lacks, and 1 for w, whatever the mesh holds there.
+void fillWidened(const Rig& rig, rt::Mesh& m) {
+  for (const auto& a : rig.attributes) {
+    if (!a.widened) continue;
+    const int n = formatComponents(a.format);
+    for (int t = 0; t < (a.perMorphTarget ? rig.morphTargets() : 1); ++t)
+      for (const auto& p : a.provides) {
+        if (p.field >= 0) continue;  // a bit-packed field reads its own format's components
         auto it = m.streams.find(partSemantic(a, p, a.perMorphTarget ? t : -1));
         if (it == m.streams.end()) continue;
         const std::string swz =
-            p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(declared)) : p.swizzle;
+            p.swizzle.empty() ? std::string("xyzw").substr(0, static_cast<size_t>(componentCount(a.shaderType))) : p.swizzle;
         for (auto& v : it->second)
-          for (size_t k = 0; k < swz.size(); ++k) {
-            const int c = swizzleIndex(swz[k]);
-            v[static_cast<int>(k)] = c >= n ? (c == 3 ? 1.0f : 0.0f) : storedValue(format, c, v[static_cast<int>(k)]);
-          }
+          for (size_t k = 0; k < swz.size(); ++k)
+            if (const int c = swizzleIndex(swz[k]); c >= n) v[static_cast<int>(k)] = c == 3 ? 1.0f : 0.0f;
       }
   }
 }
@@ -264,10 +280,12 @@ rt::Mesh quantizedMesh(const Rig& rig, const rt::Mesh& mesh) {
   }
   renormaliseWeights(rig, m);
   quantizeStreams(rig, m);
+  fillWidened(rig, m);
   if (encodings.empty()) return m;
   for (const StoredEncoding& se : encodings)
     if (m.has(se.name(se.e->encoded))) decodeInto(se, decodeUniformsFor(se, m), m.at(se.name(se.e->encoded)), m);
   quantizeStreams(rig, m);  // a source the rig stores too, in a rounded format
+  fillWidened(rig, m);
   return m;
 }
 
@@ -300,6 +318,8 @@ std::vector<InputErrorBound> errorBounds(const Rig& rig, const rt::Mesh& mesh) {
           const double sum = renormalised ? partitionSum(weightStreams, v) : NAN;
           for (size_t k = 0; k < swz.size(); ++k) {
             const double xv = x[v][static_cast<int>(k)];
+            // Past a widened attribute's format: the device's fill, exact (fillWidened).
+            if (swizzleIndex(swz[k]) >= n) continue;
             b.bound[v][static_cast<int>(k)] =
                 std::isnan(sum) ? storedValueMaxError(format, swizzleIndex(swz[k]), xv)
                                 : step + std::ldexp(1.0, -24) + std::abs(xv) * std::abs(1 - 1 / sum);
@@ -470,6 +490,7 @@ UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape
                             const rt::Pose& pose) {
   UniformValues uniforms = poseUniforms(rig, pose);
   for (const auto& u : mesh.uniforms) uniforms.insert(u);
+  for (auto& u : definitionInputs(rig, rules, pose)) uniforms.insert(std::move(u));
   for (const auto& u : rig.uniforms) {
     const SemanticDecl* d = rules.findSemantic(u.semantic);
     if (uniforms.count(u.semantic) || !d || !d->definition) continue;
@@ -487,6 +508,8 @@ UniformValues uniformValues(const Rig& rig, const RuleSet& rules, const RigShape
 }
 
 rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh) { return quantizedMesh(rig, mesh); }
+
+void fillWidenedComponents(const Rig& rig, rt::Mesh& mesh) { fillWidened(rig, mesh); }
 
 std::vector<InputErrorBound> quantizationErrorBounds(const Rig& rig, const rt::Mesh& mesh) { return errorBounds(rig, mesh); }
 

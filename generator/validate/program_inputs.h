@@ -39,6 +39,11 @@ std::vector<rt::DescriptorBinding> declaredDescriptors(const std::vector<ShaderD
 // streams derived from their sources (and the sources replaced by their decodes), the
 // mesh's bounds as uniforms, unorm skin weights rounded to sum to exactly one.
 rt::Mesh quantizeForRig(const Rig& rig, const rt::Mesh& mesh);
+// The components a widened attribute's format lacks (docs/rig-format.md, "Widened
+// attributes") set in `mesh` as the device reads them, 0 and 1 for w, whatever the mesh held
+// there. quantizeForRig does it; the float data of the second check needs it too: no stored
+// value carries those components, so they have no error to bound.
+void fillWidenedComponents(const Rig& rig, rt::Mesh& mesh);
 // How far quantizeForRig(rig, mesh) may move one stream the reference reads, from the
 // worst errors the formats (storedValueMaxError) and encodings (encodingMaxError) state:
 // per vertex, component k by at most bound[v][k] (a box), or, for a unit vector

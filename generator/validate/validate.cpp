@@ -415,6 +415,7 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
         if (!floatMesh) {
           floatMesh = rt::everyNthVertex(mesh, floatStride);
           for (auto& [sem, stream] : rt::everyNthVertex(scene.mesh, floatStride).streams) floatMesh->streams[sem] = std::move(stream);
+          fillWidenedComponents(rig, *floatMesh);
         }
         FloatReference f = floatReference(rules, shape, *floatMesh, pr.uniforms, bounds, floatMissing);
         for (size_t k = 0; k < floatMissing.size(); ++k) {
@@ -560,6 +561,7 @@ ValidateReport Validator::run(const ValidationScene& scene, const GenerateOption
   // Through HLSL: the shipped build is translated (its text is what `generate --emit hlsl`
   // writes) and the capture is added to the module compiled back from it.
   gen.capture = opts_.via == ValidateVia::Spirv;
+  gen.maxCaptureBytes = harness_->maxCaptureBytes();  // either way, the record is captured on this device
   if (opts_.via == ValidateVia::Hlsl && !gen.hlsl) gen.hlsl = HlslOptions{};
   if (opts_.via == ValidateVia::Hlsl)
     report.via = fmt::format("HLSL {} (compiled back by glslang)", shaderModelName(gen.hlsl->shaderModel));

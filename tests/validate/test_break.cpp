@@ -141,6 +141,42 @@ TEST(BreakRules, ClipWrongMatrix) {
   expectBroken(validateDawn(rules), "clip_from_eye", {"gl_Position"});
 }
 
+// A rig giving only camera.view_projection (no view, no projection): gl_Position is compared
+// all the same, with clip.position from the projection and view of the pose whose product
+// the rig's view_projection is. The copy passes; the clip rule with the transposed matrix
+// fails on gl_Position alone.
+sg::ValidateReport validateViewProjectionOnly(const RulesCopy& rules) {
+  sg::ValidateOptions vo;
+  vo.gen.rigPath = dataPath("view_projection_only.rig.yaml");
+  vo.gen.fragmentPath = dataPath("basic.frag");
+  vo.gen.rulesPaths = {rules.rulesFile("standard.yaml").string()};
+  sg::Validator v(vo);
+  sg::ValidateReport rep = v.run(sg::proceduralScene(sg::loadRigFile(vo.gen.rigPath), "limb", 1, 2));
+  std::cout << sg::formatReport(rep);
+  return rep;
+}
+
+TEST(BreakRules, ClipFromViewProjectionIsCheckedWithoutAProjection) {
+  RulesCopy rules("view_projection");
+  const sg::ValidateReport good = validateViewProjectionOnly(rules);
+  ASSERT_EQ(good.runs.size(), 1u);
+  EXPECT_TRUE(good.pass);
+  EXPECT_TRUE(planHas(good.runs[0], "clip_from_view_projection"));
+  const sg::OutputReport* clip = output(good.runs[0], "gl_Position");
+  ASSERT_NE(clip, nullptr);
+  EXPECT_FALSE(clip->unchecked) << clip->uncheckedReason;
+  EXPECT_EQ(sg::formatReport(good).find("unchecked"), std::string::npos);
+
+  ASSERT_TRUE(rules.edit("projection.yaml", "${out} = ${camera.view_projection} * vec4(${world.position}, 1.0);",
+                         "${out} = transpose(${camera.view_projection}) * vec4(${world.position}, 1.0);"));
+  const sg::ValidateReport broken = validateViewProjectionOnly(rules);
+  ASSERT_EQ(broken.runs.size(), 1u);
+  EXPECT_TRUE(planHas(broken.runs[0], "clip_from_view_projection"));
+  EXPECT_FALSE(broken.pass);
+  EXPECT_EQ(failingOutputs(broken.runs[0]), Set{"gl_Position"});
+  EXPECT_TRUE(broken.runs[0].validationMessages.empty());
+}
+
 // The dapple term with the matrix's third column instead of its third row (the transpose,
 // i.e. the inverse rotation): only SkinSilhouetteVec.w is wrong.
 TEST(BreakRules, DappleColumnInsteadOfRow) {

@@ -138,6 +138,7 @@ INSTANTIATE_TEST_SUITE_P(
         RigCase{"formats_a", "formats_a.rig.yaml", "formats.frag", "limb", {"skin_matrix_blend"}, kLinearBlends},
         RigCase{"formats_b", "formats_b.rig.yaml", "formats.frag", "limb", {"skin_matrix_blend"}, kLinearBlends},
         RigCase{"formats_rgb", "formats_rgb.rig.yaml", "formats.frag", "limb", {"skin_matrix_blend"}, kLinearBlends},
+        RigCase{"formats_rg", "formats_rg.rig.yaml", "formats.frag", "limb", {"skin_matrix_blend"}, kLinearBlends},
         RigCase{"rigid1", "rigid1.rig.yaml", "eye.frag", "limb",
                 {"skin_matrix_rigid", "eye_position", "eye_normal"}, {"dapple_normal_z_full"}},
         RigCase{"rigid1_world", "rigid1.rig.yaml", "world.frag", "limb",
@@ -164,6 +165,80 @@ TEST(Quantization, WidenedColourReadsAlphaOne) {
     EXPECT_EQ(read[v], glm::vec4(glm::vec3(drawn[v]), 1.0f)) << "vertex " << v;
     if (HasFailure()) break;
   }
+}
+
+// A unorm8 RG colour read as a vec4: blue and alpha are the device's fill (0, 1) in the
+// float data too, not the mesh's (its blue is (u + v) / 2): both checks pass, the second
+// comparing every component, for the fill is exact and the stored red and green within
+// their format's error.
+TEST(Quantization, WidenedColourFillIsTheFloatDataToo) {
+  const std::string rigPath = dataPath("formats_rg.rig.yaml");
+  sg::ValidateReport rep = validate({rigPath, dataPath("formats.frag"), sourcePath("rules/standard.yaml"), "limb"}, false);
+  expectAllPass(rep);
+  bool colour = false;
+  for (const auto& o : rep.runs.at(0).outputs) {
+    EXPECT_TRUE(o.floatCheck.ran) << o.name;
+    EXPECT_EQ(o.floatCheck.notCompared, 0u) << o.name;
+    colour = colour || o.name == "vertex_color0";
+  }
+  EXPECT_TRUE(colour);
+  // The mesh's blue is not what the device reads, so the fill is what the second check saw.
+  const sg::Rig rig = sg::loadRigFile(rigPath);
+  const sg::ValidationScene scene = sg::proceduralScene(rig, "limb", 1, 1);
+  size_t blue = 0;
+  for (const auto& c : scene.mesh.at("vertex.color0")) blue += c.z != 0.0f;
+  EXPECT_GT(blue, scene.mesh.vertexCount / 2);
+  double fillBound = 0;  // the fill is exact: no storage error to tolerate there
+  for (const auto& b : sg::quantizationErrorBounds(rig, scene.mesh))
+    if (b.semantic == "vertex.color0")
+      for (const auto& v : b.bound) fillBound = std::max({fillBound, v.z, v.w});
+  EXPECT_EQ(fillBound, 0.0);
+}
+
+// 16 vec4 varyings, 64 components (the least maxVertexOutputComponents Vulkan guarantees),
+// each mapped to eye.position: with gl_Position the capture record is 68 components, past
+// glslang's OpenGL default of 64 interleaved components but within the device's
+// transform-feedback limits, which are the ones that apply.
+sg::ValidateOptions outputs64(const std::string& rig) {
+  sg::ValidateOptions vo;
+  vo.gen.rigPath = rig;
+  vo.gen.fragmentPath = dataPath("outputs64.frag");
+  vo.gen.rulesPaths = {sourcePath("rules/standard.yaml")};
+  for (int i = 0; i < 16; ++i) vo.gen.overrides.push_back({"e" + std::to_string(i), {"eye.position"}});
+  return vo;
+}
+
+TEST(Capture, SixtyFourOutputComponentsValidate) {
+  const sg::ValidateOptions vo = outputs64(dataPath("unskinned_model.rig.yaml"));
+  sg::Validator v(vo);
+  const sg::ValidateReport rep = v.run(sg::proceduralScene(sg::loadRigFile(vo.gen.rigPath), "limb", 1, 2));
+  std::cout << sg::formatReport(rep);
+  expectAllPass(rep);
+  const sg::RunReport& run = rep.runs.at(0);
+  ASSERT_EQ(run.outputs.size(), 17u);  // gl_Position and e0..e15
+  for (const auto& o : run.outputs) EXPECT_FALSE(o.unchecked) << o.name << ": " << o.uncheckedReason;
+}
+
+// A device capturing fewer bytes a vertex than the record: a located error at the fragment
+// input whose output crosses the limit, naming the Vulkan limits, before anything compiles.
+TEST(Capture, ARecordPastTheDevicesLimitIsALocatedError) {
+  sg::GenerateOptions gen = outputs64(dataPath("unskinned_model.rig.yaml")).gen;
+  gen.capture = true;
+  gen.maxCaptureBytes = 256;  // gl_Position and e0..e14; e15 is past it
+  const std::string frag = readText(gen.fragmentPath);
+  const int e15Line = 1 + static_cast<int>(std::count(frag.begin(), frag.begin() + static_cast<long>(frag.find("vec4 e15;")), '\n'));
+  try {
+    sg::generate(gen);
+    FAIL() << "generated a capture record past the device's limit";
+  } catch (const sg::InputError& e) {
+    const sg::Diagnostic& d = e.diagnostic();
+    EXPECT_EQ(d.loc.file, gen.fragmentPath);
+    EXPECT_EQ(d.loc.line, e15Line);
+    EXPECT_NE(d.message.find("maxTransformFeedbackBufferDataStride"), std::string::npos) << d.message;
+    EXPECT_NE(d.message.find("'e15'"), std::string::npos) << d.message;
+  }
+  gen.maxCaptureBytes = 272;  // exactly the record
+  EXPECT_NO_THROW(sg::generate(gen));
 }
 
 // The quantization path matters: with unorm8 weights, the reference fed the raw float weights
