@@ -48,7 +48,8 @@ std::vector<Diagnostic> unreachableInputs(const LoadedInputs& in) {
     if (mine.empty()) continue;
     std::string why = formatUnreachable(p, mine);
     if (!why.empty() && why.back() == '\n') why.pop_back();
-    SourceLoc at = v.loc.line ? v.loc : SourceLoc{in.fragment.file, 0, 0};
+    // gl_Position is requested by no declaration: what it lacks (a camera) is the rig's.
+    SourceLoc at = v.loc.line ? v.loc : in.rig.nameLoc.line ? in.rig.nameLoc : SourceLoc{in.fragment.file, 0, 0};
     out.push_back(Diagnostic{Severity::Error, at, fmt::format("the request cannot be met for rig '{}': {}", in.rig.name, why)});
   }
   return out;

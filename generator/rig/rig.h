@@ -69,6 +69,7 @@ struct RigUniform {
 struct Rig {
   std::string name;
   std::string file;                            // where it came from (for diagnostics)
+  SourceLoc nameLoc;                           // its `rig:` name (line 0 for a glTF rig)
   // Every file read to make it (a glTF model and its buffer files): depfiles, cache keys,
   // and the outputs that must never overwrite an input.
   std::vector<std::string> sourceFiles;

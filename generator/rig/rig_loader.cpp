@@ -30,6 +30,9 @@ bool validRigSemanticName(const std::string& s) {
   return std::isalpha(static_cast<unsigned char>(s[0]));
 }
 
+// What validIdentifier accepts, for its errors.
+constexpr const char* kIdentifierRule = "an ASCII letter or '_', then letters, digits and '_', not starting with 'gl_'";
+
 bool validIdentifier(const std::string& s) {
   if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
   for (char c : s)
@@ -58,9 +61,10 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
   rig.sourceFiles = {fileName};
   if (!root["rig"]) y.fail(root, "missing 'rig' (the rig's name)");
   rig.name = y.scalar(root["rig"], "'rig'");
+  rig.nameLoc = locOf(root["rig"], fileName);
   // The name is quoted in generated comments and messages: printable text, one line.
   if (rig.name.empty() || rig.name.size() > kMaxRigNameBytes)
-    y.fail(root["rig"], fmt::format("the rig's name must be 1..{} characters", kMaxRigNameBytes));
+    y.fail(root["rig"], fmt::format("the rig's name must be 1..{} bytes of UTF-8", kMaxRigNameBytes));
   for (char c : rig.name)
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
       y.fail(root["rig"], fmt::format("the rig's name contains control character 0x{:02x}", static_cast<unsigned char>(c)));
@@ -81,7 +85,7 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
         }
         continue;
       }
-      if (!validIdentifier(key)) y.fail(it->first, fmt::format("'{}' is not a valid parameter name", key));
+      if (!validIdentifier(key)) y.fail(it->first, fmt::format("'{}' is not a valid parameter name ({})", key, kIdentifierRule));
       long long v = y.integer(it->second, fmt::format("deformer '{}'", key).c_str());
       if (v < 0 || v > 65535) y.fail(it->second, fmt::format("deformer '{}' = {} is out of range 0..65535", key, v));
       rig.params[key] = v;
@@ -107,7 +111,7 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
     RigAttribute a;
     a.name = y.scalar(it->first, "an attribute name");
     a.loc = locOf(it->first, fileName);
-    if (!validIdentifier(a.name)) y.fail(it->first, fmt::format("'{}' is not a valid attribute name", a.name));
+    if (!validIdentifier(a.name)) y.fail(it->first, fmt::format("'{}' is not a valid attribute name ({})", a.name, kIdentifierRule));
     YAML::Node body = it->second;  // a copy: it->second lives in a temporary proxy
     y.expectMap(body, "an attribute");
     y.checkKeys(body, {"format", "shader_type", "provides", "fields", "per_target", "doc"});
@@ -228,7 +232,7 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
       RigUniform un;
       un.name = y.scalar(it->first, "a uniform name");
       un.loc = locOf(it->first, fileName);
-      if (!validIdentifier(un.name)) y.fail(it->first, fmt::format("'{}' is not a valid uniform name", un.name));
+      if (!validIdentifier(un.name)) y.fail(it->first, fmt::format("'{}' is not a valid uniform name ({})", un.name, kIdentifierRule));
       YAML::Node body = it->second;  // a copy: it->second lives in a temporary proxy
       y.expectMap(body, "a uniform");
       y.checkKeys(body, {"type", "semantic", "array", "doc"});

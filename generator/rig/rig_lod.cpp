@@ -9,7 +9,8 @@ namespace sg {
 Rig rigWithParameters(const Rig& rig, const std::map<std::string, int64_t>& params, const SourceLoc& at) {
   Rig out = rig;
   for (const auto& [key, value] : params) {
-    if (!rig.params.count(key))
+    // uniform_scale is documented as optional (default 0): a rig that omits it may set it.
+    if (!rig.params.count(key) && key != "uniform_scale")
       throw InputError(at, fmt::format("rig '{}' has no deformer parameter '{}' to set", rig.name, key));
     if (value < 0) throw InputError(at, fmt::format("deformer parameter '{}' cannot be {}", key, value));
     out.params[key] = value;

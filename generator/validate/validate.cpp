@@ -30,8 +30,8 @@ std::string nonFiniteReport(Interpreter& reference, const EmittedOutput& o, size
   bool g = !std::isfinite(gpu), r = !std::isfinite(ref);
   std::string side = g && r ? "GPU and reference" : g ? "GPU" : "reference";
   auto show = [](double x) { return std::isnan(x) ? std::string("nan") : fmt::format("{}", x); };  // no "-nan"
-  std::string s = fmt::format("{} gives {} at vertex {}, output {} component {} (GPU {}, reference {})", side,
-                              show(g ? gpu : ref), v, o.name, c, show(gpu), show(ref));
+  std::string s = fmt::format("{} {} {} at vertex {}, output {} component {} (GPU {}, reference {})", side,
+                              g && r ? "give" : "gives", show(g ? gpu : ref), v, o.name, c, show(gpu), show(ref));
   for (const auto& sem : o.semantics) {
     try {
       auto inputs = reference.inputsAt(sem, v);

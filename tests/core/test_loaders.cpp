@@ -26,6 +26,7 @@
 #include "common/types.h"
 #include "interface/fragment_interface.h"
 #include "rig/rig.h"
+#include "rig/rig_lod.h"
 #include "rules/expr.h"
 #include "rules/rules.h"
 #include "rules/snippet.h"
@@ -314,6 +315,22 @@ TEST(RigLoader, Formats) {
   EXPECT_EQ(rig.attributes[0].shaderType, sg::Type::Vec4);
   EXPECT_EQ(rig.attributes[1].shaderType, sg::Type::UVec4);
   EXPECT_EQ(rig.attributes[2].shaderType, sg::Type::Float);
+}
+
+// --set (rigWithParameters) refuses a parameter the rig does not have (a typo), except
+// uniform_scale, which rig-format.md documents as optional with a default of 0.
+TEST(RigLoader, SetReachesTheOptionalUniformScaleButNoUnknownParameter) {
+  const sg::Rig rig = sg::loadRigText(
+      "rig: t\n"
+      "deformers: { bones: 2, influences: 1 }\n"
+      "attributes:\n"
+      "  p: { format: float32x3, provides: vertex.position }\n"
+      "  j: { format: uint8x4, provides: \"skin.joints[0]\" }\n",
+      "t.rig.yaml");
+  EXPECT_EQ(rig.param("uniform_scale"), 0);
+  EXPECT_EQ(sg::rigWithParameters(rig, {{"uniform_scale", 1}}, sg::SourceLoc{}).param("uniform_scale"), 1);
+  auto d = errorOf([&] { sg::rigWithParameters(rig, {{"uniform_scales", 1}}, sg::SourceLoc{}); });
+  EXPECT_MSG(d, "rig 't' has no deformer parameter 'uniform_scales' to set");
 }
 
 TEST(RigLoader, MalformedYaml) {
