@@ -264,6 +264,20 @@ Rig loadRigText(const std::string& text, const std::string& fileName) {
             throw InputError(a.loc, fmt::format("'{}' ({} {}) is decoded with the uniform '{}', which the rig does not "
                                                 "declare (docs/rig-format.md, \"Encodings\")", p.semantic, e->name,
                                                 e->decodesText(), u));
+  // A unit direction or a morph delta is signed; an unsigned normalized format clamps its
+  // negative components to 0 (a normal along -x reads as zero). Allowed, but almost surely
+  // a slip for snorm: warned at the attribute (importDiagnostics: generate prints it).
+  for (const RigAttribute& a : rig.attributes)
+    for (const auto& p : a.provides) {
+      static const std::set<std::string> kSigned = {"vertex.normal", "vertex.tangent", "vertex.binormal"};
+      if (formatKind(partFormat(a, p)) != FormatKind::Unorm || (!kSigned.count(p.semantic) && !a.perMorphTarget)) continue;
+      rig.importDiagnostics.push_back(Diagnostic{
+          Severity::Warning, a.loc,
+          fmt::format("attribute '{}' stores {} as {}, which clamps negative components to 0; a signed value wants "
+                      "an snorm format",
+                      a.name, p.semantic, formatName(partFormat(a, p))),
+          ""});
+    }
   checkRig(rig);
   return rig;
 }

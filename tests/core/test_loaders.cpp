@@ -333,6 +333,24 @@ TEST(RigLoader, SetReachesTheOptionalUniformScaleButNoUnknownParameter) {
   EXPECT_MSG(d, "rig 't' has no deformer parameter 'uniform_scales' to set");
 }
 
+// An unsigned normalized format clamps a normal's negative components to 0 (Vulkan's unorm
+// conversion): the loader warns at the attribute; snorm, and unorm colours, get no warning.
+TEST(RigLoader, AnUnsignedFormatForASignedValueIsWarned) {
+  const std::string text =
+      "rig: t\n"
+      "attributes:\n"
+      "  p: { format: float32x3, provides: vertex.position }\n"
+      "  n: { format: unorm8x4, provides: { vertex.normal: xyz } }\n"
+      "  t: { format: snorm8x4, provides: { vertex.tangent: xyz, vertex.handedness: w } }\n"
+      "  c: { format: unorm8x4, provides: vertex.color0 }\n";
+  const sg::Rig rig = sg::loadRigText(text, "t.rig.yaml");
+  ASSERT_EQ(rig.importDiagnostics.size(), 1u);
+  const sg::Diagnostic& d = rig.importDiagnostics[0];
+  EXPECT_EQ(d.severity, sg::Severity::Warning);
+  EXPECT_LOC(d, "t.rig.yaml", 4, 3);
+  EXPECT_MSG(d, "attribute 'n' stores vertex.normal as unorm8x4, which clamps negative components to 0");
+}
+
 TEST(RigLoader, MalformedYaml) {
   const std::string text =
       "rig: bad\n"
