@@ -1630,7 +1630,7 @@ TEST(Hostile, RigNameCannotCarryControlCharacters) {
   EXPECT_LOC(d, "r.yaml", 1, 6);
   EXPECT_MSG(d, "control character 0x0a");
   auto d2 = errorOf([&] { sg::loadRigText("rig: " + std::string(300, 'n') + "\n" + kMiniRig.substr(kMiniRig.find("attributes")), "r.yaml"); });
-  EXPECT_MSG(d2, "1..256 characters");
+  EXPECT_MSG(d2, "1..256 bytes of UTF-8");
 }
 
 TEST(Hostile, RigCountsAreLimited) {
