@@ -56,13 +56,7 @@ void checkYamlShape(const YAML::Node& root, const std::string& file) {
 YAML::Node parseYaml(const std::string& text, const std::string& file) {
   YAML::Node root;
   try {
-    // One document per file: a second one ("---" and more) would otherwise be dropped unread.
-    std::vector<YAML::Node> docs = YAML::LoadAll(text);
-    for (size_t i = 1; i < docs.size(); ++i)
-      if (!docs[i].IsNull())
-        throw InputError(locOf(docs[i], file), "a second YAML document: a file holds one (remove the '---' before it, "
-                                               "or put it in a file of its own)");
-    if (!docs.empty()) root = docs[0];
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     std::string msg = e.msg.empty() ? "malformed YAML" : e.msg;
     throw InputError(SourceLoc{file, e.mark.line + 1, e.mark.column + 1}, "malformed YAML: " + msg);
