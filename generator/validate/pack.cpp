@@ -15,13 +15,18 @@ PackedVertices packVertices(const GenerateResult& r, const rt::Mesh& mesh) {
   const rt::Mesh quantized = quantizeForRig(rig, mesh);
   PackedVertices out;
   out.vertexCount = mesh.vertexCount;
+  // Appends `n` bytes at a 16-byte aligned offset (any API's buffer-offset alignment); returns it.
+  auto append = [&](const uint8_t* data, size_t n) {
+    const size_t offset = (out.bytes.size() + 15) / 16 * 16;
+    out.bytes.resize(offset);
+    out.bytes.insert(out.bytes.end(), data, data + n);
+    return offset;
+  };
   nlohmann::json streams = nlohmann::json::array();
   for (const EmittedInput& in : r.glsl.inputs) {
     const RigAttribute& a = rig.attributes[static_cast<size_t>(in.attribute)];
     rt::VertexStream s = vertexStream(rig, in, quantized);
-    const size_t offset = (out.bytes.size() + 15) / 16 * 16;  // any API's buffer-offset alignment
-    out.bytes.resize(offset);
-    out.bytes.insert(out.bytes.end(), s.data.begin(), s.data.end());
+    const size_t offset = append(s.data.data(), s.data.size());
     nlohmann::json provides = nlohmann::json::array();
     for (const auto& p : a.provides) {
       const VertexFormat format = partFormat(a, p);
@@ -69,9 +74,7 @@ PackedVertices packVertices(const GenerateResult& r, const rt::Mesh& mesh) {
     }
     const auto it = std::find_if(data.begin(), data.end(), [&](const auto& d) { return d.binding == b["binding"]; });
     const size_t size = out.vertexCount * b["count"].get<size_t>() * b["stride"].get<size_t>();
-    const size_t offset = (out.bytes.size() + 15) / 16 * 16;
-    out.bytes.resize(offset);
-    out.bytes.insert(out.bytes.end(), it->data.begin(), it->data.begin() + static_cast<std::ptrdiff_t>(size));
+    const size_t offset = append(it->data.data(), size);
     b["offset"] = offset;
     b["size"] = size;
     buffers.push_back(std::move(b));
