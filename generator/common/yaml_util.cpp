@@ -7,6 +7,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <string_view>
 #include <vector>
 
 namespace sg {
@@ -51,6 +52,39 @@ void checkYamlShape(const YAML::Node& root, const std::string& file) {
   }
 }
 
+// YAML::Load reads the first document and drops the rest without a word, and YAML::LoadAll hung
+// on a 26-byte tagged scalar (tests/bad-input/rules/tag_that_hung_load_all); so a second document
+// is found by its markers, which YAML allows only at the start of a line and never inside a scalar.
+void refuseSecondDocument(const std::string& text, const std::string& file) {
+  auto isMarker = [](std::string_view line, std::string_view marker) {
+    return line.substr(0, 3) == marker && (line.size() == 3 || line[3] == ' ' || line[3] == '\t' || line[3] == '\r');
+  };
+  bool started = false, ended = false;  // a '---' seen; a '...' seen
+  int lineNo = 0;
+  for (size_t at = 0; at < text.size();) {
+    size_t end = text.find('\n', at);
+    if (end == std::string::npos) end = text.size();
+    std::string_view line(text.data() + at, end - at);
+    at = end + 1;
+    ++lineNo;
+    size_t first = line.find_first_not_of(" \t\r");
+    bool blank = first == std::string_view::npos || line[first] == '#';
+    if (isMarker(line, "---")) {
+      if (started || ended)
+        throw InputError(SourceLoc{file, lineNo, 1},
+                         "a second YAML document starts here: a file holds one document (put it in a file of its own)");
+      started = true;
+    } else if (isMarker(line, "...")) {
+      ended = true;
+    } else if (ended && !blank) {
+      throw InputError(SourceLoc{file, lineNo, static_cast<int>(first) + 1},
+                       "content after the document's end marker '...': a file holds one document");
+    }
+    // Content before any '---' is the first document, implicitly started.
+    if (!blank && line[0] != '%' && !isMarker(line, "...")) started = true;
+  }
+}
+
 }  // namespace
 
 YAML::Node parseYaml(const std::string& text, const std::string& file) {
@@ -61,6 +95,7 @@ YAML::Node parseYaml(const std::string& text, const std::string& file) {
     std::string msg = e.msg.empty() ? "malformed YAML" : e.msg;
     throw InputError(SourceLoc{file, e.mark.line + 1, e.mark.column + 1}, "malformed YAML: " + msg);
   }
+  refuseSecondDocument(text, file);
   checkYamlShape(root, file);
   return root;
 }

@@ -364,6 +364,28 @@ TEST(RigLoader, MalformedYaml) {
   EXPECT_EQ(sg::formatDiagnostic(d), "bad.rig.yaml:4:14: error: " + d.message);
 }
 
+// YAML allows document markers only at the start of a line, so they are found without a second
+// parse (yaml-cpp's Load drops a second document silently; its LoadAll hung on fuzzed input).
+TEST(RigLoader, OneDocumentPerFile) {
+  const std::string rig = readText(kSrc + "/tests/bad-input/base/tiny.rig.yaml");
+  for (const std::string& text : {"%YAML 1.2\n# a directive, then the one document\n---\n" + rig,
+                                  "--- # the marker may carry a comment\n" + rig + "...\n# comments after its end\n\n",
+                                  rig + "#---\n  # --- neither is a marker\n"})
+    EXPECT_NO_THROW(sg::loadRigText(text, "one.rig.yaml")) << text;
+  struct Case {
+    std::string text, at, phrase;
+  };
+  for (const Case& c : {Case{rig + "---\nrig: second\n", "---", "a second YAML document starts here"},
+                        Case{"---\n" + rig + "--- \t\n", "--- \t", "a second YAML document starts here"},
+                        Case{rig + "...\n---\n", "---", "a second YAML document starts here"},
+                        Case{rig + "...\n  rig: after\n", "rig: after", "content after the document's end marker"}}) {
+    auto d = errorOf([&] { sg::loadRigText(c.text, "two.rig.yaml"); });
+    Pos p = posOf(c.text, c.at);
+    EXPECT_LOC(d, "two.rig.yaml", p.line, p.col);
+    EXPECT_MSG(d, c.phrase);
+  }
+}
+
 TEST(RigLoader, UnknownTopLevelKey) {
   const std::string text =
       "rig: bad\n"
