@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -267,6 +268,52 @@ std::vector<PrimitiveData> decodePrimitives(const tinygltf::Model& model, size_t
   return prims;
 }
 
+// tinygltf writes an object that has only default members as `null` (`nodes: [{}]`, an empty
+// scene or texture, all valid glTF) and a perspective camera's absent `zfar` (infinite) as 0:
+// both make the output invalid, and our own loader refuses it. Returns whether it changed `j`.
+bool repairTinygltfJson(nlohmann::json& j) {
+  bool changed = false;
+  for (auto& [key, value] : j.items())
+    if (value.is_array())
+      for (auto& e : value)
+        if (e.is_null()) e = nlohmann::json::object(), changed = true;
+  if (j.contains("cameras") && j["cameras"].is_array())
+    for (auto& c : j["cameras"]) {
+      auto p = c.find("perspective");
+      if (p == c.end() || !p->is_object()) continue;
+      auto z = p->find("zfar");
+      if (z != p->end() && z->is_number() && z->get<double>() == 0) p->erase(z), changed = true;
+    }
+  return changed;
+}
+
+uint32_t readU32(const std::string& s, size_t at) {
+  uint32_t v;
+  std::memcpy(&v, s.data() + at, 4);
+  return v;
+}
+void putU32(std::string& s, uint32_t v) { s.append(reinterpret_cast<const char*>(&v), 4); }
+
+// tinygltf's output with its JSON repaired (repairTinygltfJson); byte-identical when nothing
+// needed it. A GLB is rebuilt around the new JSON chunk, its BIN chunk copied as it was.
+std::string repairSerialised(const std::string& bytes, bool binary) {
+  if (!binary) {
+    nlohmann::json j = nlohmann::json::parse(bytes);
+    return repairTinygltfJson(j) ? j.dump(2) + "\n" : bytes;
+  }
+  const size_t jsonLen = readU32(bytes, 12);  // header 12 bytes, then the JSON chunk's length
+  nlohmann::json j = nlohmann::json::parse(bytes.substr(20, jsonLen));
+  if (!repairTinygltfJson(j)) return bytes;
+  std::string json = j.dump();
+  json.append((4 - json.size() % 4) % 4, ' ');
+  const std::string rest = bytes.substr(20 + jsonLen);  // the BIN chunk, if any
+  std::string out = bytes.substr(0, 8);
+  putU32(out, static_cast<uint32_t>(20 + json.size() + rest.size()));
+  putU32(out, static_cast<uint32_t>(json.size()));
+  out += bytes.substr(16, 4);  // "JSON"
+  return out + json + rest;
+}
+
 // The output file: every buffer embedded (buffer 0 in the GLB binary chunk, the others as
 // data URIs); `inputs` gets the model and its buffer files, `notes` the images left external.
 std::string serialise(tinygltf::Model& model, const std::string& file, bool binary, std::vector<std::string>& inputs,
@@ -283,7 +330,7 @@ std::string serialise(tinygltf::Model& model, const std::string& file, bool bina
   tinygltf::TinyGLTF writer;
   std::ostringstream os;
   if (!writer.WriteGltfSceneToStream(&model, os, !binary, binary)) fail(file, "cannot serialise the baked model");
-  return os.str();
+  return repairSerialised(os.str(), binary);
 }
 
 std::vector<Vec3> vec3Stream(const GltfModelData& d, const std::string& name) {

@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -22,6 +23,7 @@
 #include <unistd.h>
 
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 
 #include "../core/core_test_util.h"
 #include "bake/gltf_bake.h"
@@ -300,6 +302,60 @@ TEST(GltfBake, OutputIsDeterministicAndThreadIndependent) {
     return importGltf((dir / "out.glb").string());
   }();
   EXPECT_EQ(back.data.streams["vertex.occlusion"], glb.data.streams["vertex.occlusion"]);
+  fs::remove_all(dir);
+}
+
+// tinygltf writes an object with only default members as `null` and an infinite camera's
+// absent zfar as 0: a valid model with an empty node, scene and texture and such a camera
+// baked to invalid glTF that no loader, ours included, read back.
+TEST(GltfBake, EmptyObjectsAndAnInfiniteCameraStayValid) {
+  fs::path dir = tempDir();
+  tinygltf::Model m;
+  Mesh quad;
+  quad.quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1});
+  addMesh(m, quad);
+  m.nodes.emplace_back();
+  m.nodes[0].mesh = 0;
+  m.scenes.push_back({});
+  m.scenes[0].nodes = {0};
+  m.asset.version = "2.0";
+  tinygltf::TinyGLTF w;
+  std::ostringstream os;
+  ASSERT_TRUE(w.WriteGltfSceneToStream(&m, os, true, false));
+  nlohmann::json j = nlohmann::json::parse(os.str());
+  j["nodes"].push_back(nlohmann::json::object());
+  j["scenes"][0]["nodes"].push_back(1);
+  j["scenes"].push_back(nlohmann::json::object());
+  j["textures"] = nlohmann::json::array({nlohmann::json::object()});
+  j["cameras"] = nlohmann::json::parse(R"([{"type": "perspective", "perspective": {"yfov": 1, "znear": 0.1}}])");
+  j["nodes"][0]["camera"] = 0;
+  writeFile(dir / "in.gltf", j.dump());
+  auto jsonOf = [](const std::string& bytes, bool binary) {
+    if (!binary) return nlohmann::json::parse(bytes);
+    uint32_t n;
+    std::memcpy(&n, bytes.data() + 12, 4);
+    return nlohmann::json::parse(bytes.substr(20, n));
+  };
+  for (bool binary : {false, true}) {
+    GltfBakeOptions o;
+    o.occlusion.rays = 8;
+    o.occlusion.threads = 1;
+    o.binary = binary;
+    const std::string ext = binary ? ".glb" : ".gltf";
+    std::string occ = bakeGltfOcclusion((dir / "in.gltf").string(), o).bytes;
+    std::string tan = bakeGltfTangents((dir / "in.gltf").string(), binary).bytes;
+    writeFile(dir / ("occ" + ext), occ);
+    writeFile(dir / ("tan" + ext), tan);
+    for (const std::string& bytes : {occ, tan}) {
+      nlohmann::json out = jsonOf(bytes, binary);
+      EXPECT_EQ(out["nodes"][1], nlohmann::json::object()) << ext;
+      EXPECT_EQ(out["scenes"][1], nlohmann::json::object()) << ext;
+      EXPECT_EQ(out["textures"][0], nlohmann::json::object()) << ext;
+      EXPECT_FALSE(out["cameras"][0]["perspective"].contains("zfar")) << ext;
+    }
+    EXPECT_NO_THROW(importGltf((dir / ("occ" + ext)).string())) << ext;
+    EXPECT_NO_THROW(importGltf((dir / ("tan" + ext)).string())) << ext;
+  }
   fs::remove_all(dir);
 }
 
