@@ -33,50 +33,18 @@ namespace {
 [[noreturn]] void fail(const std::string& file, const std::string& msg) { throw InputError(SourceLoc{file, 0, 0}, msg); }
 
 // The primitive's triangles as vertex index triples: strips and fans are expanded; points
-// and lines have none (their vertices are baked, but block nothing).
-std::vector<std::array<uint32_t, 3>> primitiveTriangles(const tinygltf::Model& m, const tinygltf::Primitive& p,
-                                                        size_t vertexCount, const std::string& file,
-                                                        const std::string& where) {
+// and lines have none (their vertices are baked, but block nothing). The indices are the
+// import's (`GltfModelData::indices`: read by the checked accessor reader, sparse accessors
+// applied, every index below the vertex count), as `render` draws them.
+std::vector<std::array<uint32_t, 3>> primitiveTriangles(const tinygltf::Primitive& p, const GltfModelData& d,
+                                                        const std::string& file) {
   std::vector<uint32_t> idx;
   if (p.indices >= 0) {
-    if (static_cast<size_t>(p.indices) >= m.accessors.size())
-      fail(file, fmt::format("{}: indices refer to accessor {}, which does not exist", where, p.indices));
-    const auto& a = m.accessors[static_cast<size_t>(p.indices)];
-    int size = a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE    ? 1
-               : a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 2
-               : a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT   ? 4
-                                                                           : 0;
-    if (size == 0 || a.type != TINYGLTF_TYPE_SCALAR || a.sparse.isSparse || a.bufferView < 0)
-      fail(file, fmt::format("{}: indices must be a non-sparse SCALAR of unsigned byte, short or int", where));
-    if (static_cast<size_t>(a.bufferView) >= m.bufferViews.size())
-      fail(file, fmt::format("{}: indices refer to buffer view {}, which does not exist", where, a.bufferView));
-    const auto& v = m.bufferViews[static_cast<size_t>(a.bufferView)];
-    size_t stride = v.byteStride ? v.byteStride : static_cast<size_t>(size);
-    if (v.buffer < 0 || static_cast<size_t>(v.buffer) >= m.buffers.size())
-      fail(file, fmt::format("{}: the index buffer view refers to a missing buffer", where));
-    if (a.count > kMaxGltfElements)
-      fail(file, fmt::format("{}: {} indices exceed the limit of {}", where, a.count, kMaxGltfElements));
-    const auto& buf = m.buffers[static_cast<size_t>(v.buffer)].data;
-    // Overflow-free: count ≤ 2^24 and stride < 2^8 keep the product small; offsets are
-    // compared by subtraction.
-    size_t span = a.count == 0 ? 0 : (a.count - 1) * stride + static_cast<size_t>(size);
-    if (v.byteOffset > buf.size() || v.byteLength > buf.size() - v.byteOffset || a.byteOffset > v.byteLength ||
-        span > v.byteLength - a.byteOffset || stride > 255)
-      fail(file, fmt::format("{}: indices read past the end of buffer view {}", where, a.bufferView));
-    const unsigned char* base = buf.data() + v.byteOffset + a.byteOffset;
-    idx.resize(a.count);
-    for (size_t i = 0; i < a.count; ++i) {
-      uint32_t x = 0;
-      if (size == 1) x = base[i * stride];
-      else if (size == 2) { uint16_t s; std::memcpy(&s, base + i * stride, 2); x = s; }
-      else std::memcpy(&x, base + i * stride, 4);
-      if (x >= vertexCount)
-        fail(file, fmt::format("{}: index {} (element {}) is out of range ({} vertices)", where, x, i, vertexCount));
-      idx[i] = x;
-    }
+    if (!d.indicesError.empty()) fail(file, d.indicesError);
+    idx = d.indices;
   } else {
-    idx.resize(vertexCount);
-    for (size_t i = 0; i < vertexCount; ++i) idx[i] = static_cast<uint32_t>(i);
+    idx.resize(d.vertexCount);
+    for (size_t i = 0; i < d.vertexCount; ++i) idx[i] = static_cast<uint32_t>(i);
   }
   std::vector<std::array<uint32_t, 3>> tris;
   int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
@@ -260,8 +228,7 @@ std::vector<PrimitiveData> decodePrimitives(const tinygltf::Model& model, size_t
       io.mesh = d.mesh;
       io.primitive = d.primitive;
       d.imp = importGltfModel(model, inputBytes, file, io);  // parsed once, not per primitive
-      d.triangles = primitiveTriangles(model, model.meshes[m].primitives[p], d.imp.data.vertexCount, file,
-                                       fmt::format("mesh '{}' primitive {}", d.imp.data.meshName, p));
+      d.triangles = primitiveTriangles(model.meshes[m].primitives[p], d.imp.data, file);
       prims.push_back(std::move(d));
     }
   if (prims.empty()) fail(file, "the model's meshes have no primitives: nothing to bake");

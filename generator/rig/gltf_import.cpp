@@ -462,9 +462,9 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
                                   idx.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
                                   idx.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
         fail(file, fmt::format("{}: indices must be unsigned byte, short or int scalars", where));
-      for (float v : idx.values)
-        if (!(v >= 0.0f) || static_cast<size_t>(v) >= data.vertexCount)
-          fail(file, fmt::format("{}: index {} is out of range ({} vertices)", where, v, data.vertexCount));
+      for (size_t i = 0; i < idx.values.size(); ++i)
+        if (const float v = idx.values[i]; !(v >= 0.0f) || static_cast<size_t>(v) >= data.vertexCount)
+          fail(file, fmt::format("{}: index {} (element {}) is out of range ({} vertices)", where, v, i, data.vertexCount));
       data.indices.assign(idx.values.begin(), idx.values.end());
     } catch (const InputError& e) {
       data.indices.clear();

@@ -305,6 +305,50 @@ TEST(GltfBake, OutputIsDeterministicAndThreadIndependent) {
   fs::remove_all(dir);
 }
 
+// A sparse index accessor (valid glTF, which `render` draws) was refused by the baker, which
+// read indices itself ("indices must be a non-sparse SCALAR"); the triangles are now the
+// import's, sparse values applied: the bake equals that of the same indices stored densely.
+TEST(GltfBake, SparseIndicesAreApplied) {
+  fs::path dir = tempDir();
+  const Mesh box = cavityBox();
+  Mesh dense = box;  // the first wall's two triangles (elements 12..17) collapsed onto vertex 0
+  for (size_t e = 12; e < 18; ++e) dense.indices[e] = 0;
+  saveSingleMesh(dense, dir / "dense.glb");
+  tinygltf::Model m;
+  addMesh(m, box);
+  const std::vector<uint8_t> at = {12, 13, 14, 15, 16, 17};
+  const std::vector<uint32_t> zeros(at.size(), 0);
+  const int zeroAcc = addAccessor(m, zeros.data(), zeros.size() * 4, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+                                  TINYGLTF_TYPE_SCALAR, zeros.size());  // 4-byte aligned: all before is
+  const int atAcc = addAccessor(m, at.data(), at.size(), TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_TYPE_SCALAR, at.size());
+  auto& idx = m.accessors[static_cast<size_t>(m.meshes[0].primitives[0].indices)];
+  idx.sparse.isSparse = true;
+  idx.sparse.count = static_cast<int>(at.size());
+  idx.sparse.indices.bufferView = m.accessors[static_cast<size_t>(atAcc)].bufferView;
+  idx.sparse.indices.byteOffset = 0;
+  idx.sparse.indices.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+  idx.sparse.values.bufferView = m.accessors[static_cast<size_t>(zeroAcc)].bufferView;
+  idx.sparse.values.byteOffset = 0;
+  m.accessors.resize(m.accessors.size() - 2);  // their views stay: the sparse data
+  m.nodes.emplace_back();
+  m.nodes[0].mesh = 0;
+  m.scenes.push_back({});
+  m.scenes[0].nodes = {0};
+  save(m, dir / "sparse.glb");
+  saveSingleMesh(box, dir / "box.glb");
+  GltfBakeOptions o;
+  o.occlusion.rays = 256;
+  o.occlusion.threads = 1;
+  auto occlusion = [&](const std::string& name) {
+    return bakeAndImport(dir / (name + ".glb"), dir / (name + ".baked.glb"), o).data.streams["vertex.occlusion"];
+  };
+  const auto sparse = occlusion("sparse");
+  EXPECT_EQ(sparse, occlusion("dense"));
+  EXPECT_NE(sparse, occlusion("box"));  // the sparse values matter
+  EXPECT_NO_THROW(bakeGltfTangents((dir / "sparse.glb").string(), true));
+  fs::remove_all(dir);
+}
+
 // tinygltf writes an object with only default members as `null` and an infinite camera's
 // absent zfar as 0: a valid model with an empty node, scene and texture and such a camera
 // baked to invalid glTF that no loader, ours included, read back.
