@@ -403,6 +403,37 @@ TEST(GltfBake, EmptyObjectsAndAnInfiniteCameraStayValid) {
   fs::remove_all(dir);
 }
 
+// tinygltf keeps no data URI of an image: the baker wrote an embedded texture as
+// `"bufferView": -1` (invalid, and the image lost). It is written back as it was.
+TEST(GltfBake, EmbeddedImageIsKept) {
+  fs::path dir = tempDir();
+  tinygltf::Model m;
+  Mesh quad;
+  quad.quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1});
+  addMesh(m, quad);
+  m.nodes.emplace_back();
+  m.nodes[0].mesh = 0;
+  m.scenes.push_back({});
+  m.scenes[0].nodes = {0};
+  m.asset.version = "2.0";
+  tinygltf::TinyGLTF w;
+  std::ostringstream os;
+  ASSERT_TRUE(w.WriteGltfSceneToStream(&m, os, true, false));
+  nlohmann::json j = nlohmann::json::parse(os.str());
+  const std::string uri = "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAIAAACQd1PeAAAADElEQVR4nGP4z8AAAAMBAQDJ/pLvAAAAAElFTkSuQmCC";
+  j["images"] = nlohmann::json::array({{{"uri", uri}}});
+  j["textures"] = nlohmann::json::array({{{"source", 0}}});
+  writeFile(dir / "in.gltf", j.dump());
+  GltfBakeOptions o;
+  o.occlusion.rays = 8;
+  o.occlusion.threads = 1;
+  o.binary = false;
+  const nlohmann::json occ = nlohmann::json::parse(bakeGltfOcclusion((dir / "in.gltf").string(), o).bytes);
+  const nlohmann::json tan = nlohmann::json::parse(bakeGltfTangents((dir / "in.gltf").string(), false).bytes);
+  for (const nlohmann::json& out : {occ, tan}) EXPECT_EQ(out["images"], j["images"]);
+  fs::remove_all(dir);
+}
+
 // --- Dawn's head: a procedural head with eye sockets and a closed-eye morph target --------
 // An ellipsoid (UV grid, the poles left open) with two eye sockets: bowls pushed in along
 // the radius. Target 0 closes the eyes: the socket vertices move back onto the ellipsoid
