@@ -22,6 +22,23 @@
 namespace sg {
 namespace {
 
+// The rig's name, "<stem>/<mesh>/<primitive>", as a rig file must spell it (rig_loader.cpp:
+// one printable line of at most kMaxRigNameBytes), since `rig import` writes it into YAML
+// that is read back: glTF names may hold control characters and be any length. Control
+// characters become '?'; a long name is cut at a UTF-8 character boundary.
+std::string gltfRigName(const std::string& stem, const std::string& mesh, int primitive) {
+  std::string name = stem + "/" + mesh;
+  for (char& c : name)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  const std::string tail = fmt::format("/{}", primitive);
+  if (name.size() + tail.size() > kMaxRigNameBytes) {
+    size_t cut = kMaxRigNameBytes - tail.size();
+    while (cut > 0 && (static_cast<unsigned char>(name[cut]) & 0xC0) == 0x80) --cut;  // a continuation byte
+    name.resize(cut);
+  }
+  return name + tail;
+}
+
 using gltf::AccessorData;
 using gltf::componentTypeName;
 using gltf::fail;
@@ -396,7 +413,7 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
 
   Rig& rig = imp.rig;
   rig.file = file;
-  rig.name = fmt::format("{}/{}/{}", data.stem, data.meshName, opts.primitive);
+  rig.name = gltfRigName(data.stem, data.meshName, opts.primitive);
   rig.params = {{"bones", 0}, {"influences", 0}, {"morph_targets", 0}};
 
   auto info = [&](const std::string& name, const tinygltf::Accessor& a) {
