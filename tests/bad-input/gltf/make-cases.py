@@ -470,6 +470,22 @@ case("pack-model-joints-past-rig",
      "@D/rig.yaml:9:3: error: mesh 'm/tri/0' vertex 0 uses joint 5 (skin.joints[0]), but rig 'tri/tri/0' has 2 bones "
      "in 'joints0' stored as uint8x4: the model's skin is not the rig's")
 
+# `pack --rig rig.yaml --model m.gltf -o m` beside the model: m.bin is the model's buffer file,
+# an input, which pack overwrote (only the .gltf was checked).
+RIGID_RIG = b"""rig: "m/tri/0"
+attributes:
+  position: { format: float32x3, provides: "vertex.position" }
+uniforms:
+  camera_position: { type: vec3, semantic: "camera.position" }
+  view: { type: mat4, semantic: "camera.view" }
+  projection: { type: mat4, semantic: "camera.projection" }
+  model: { type: mat4, semantic: "model.matrix" }
+"""
+case("pack-output-is-model-buffer",
+     {"rig.yaml": RIGID_RIG, "m.gltf": text(model([pos()], uri="m.bin")), "m.bin": TRI},
+     "pack --rig @D/rig.yaml --model @D/m.gltf -f tests/gltf/data/minimal.frag -r rules/standard.yaml -o @D/m", 1,
+     "shadergen: error: output '@D/m.bin' is an input ('@D/m.bin'); refusing to overwrite an input")
+
 def main():
     for name in sorted(os.listdir(HERE)):
         if os.path.isdir(os.path.join(HERE, name)) and name not in cases:
