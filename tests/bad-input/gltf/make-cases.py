@@ -486,6 +486,15 @@ case("pack-output-is-model-buffer",
      "pack --rig @D/rig.yaml --model @D/m.gltf -f tests/gltf/data/minimal.frag -r rules/standard.yaml -o @D/m", 1,
      "shadergen: error: output '@D/m.bin' is an input ('@D/m.bin'); refusing to overwrite an input")
 
+# The same for a glTF rig's own buffer file: validate's --report and --save-poses and render's
+# -o were checked against the model file only.
+EXTERNAL = {"m.gltf": text(model([pos()], uri="m.bin")), "m.bin": TRI}
+for name, run in [("validate-report-is-model-buffer", "validate --rig @D/m.gltf --report @D/m.bin"),
+                  ("validate-save-poses-is-model-buffer", "validate --rig @D/m.gltf --save-poses @D/m.bin"),
+                  ("render-output-is-model-buffer", "render --rig @D/m.gltf -o @D/m.bin")]:
+    case(name, EXTERNAL, run + " -f tests/gltf/data/minimal.frag -r rules/standard.yaml --no-validation-layers", 1,
+         "shadergen: error: output '@D/m.bin' is the rig ('@D/m.bin'); refusing to overwrite an input")
+
 def main():
     for name in sorted(os.listdir(HERE)):
         if os.path.isdir(os.path.join(HERE, name)) and name not in cases:
