@@ -633,8 +633,8 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
     int joints = static_cast<int>(skin.joints.size());
     if (joints == 0) fail(file, fmt::format("the skin of {} has no joints", meshDesc));
     if (joints > opts.maxBones)
-      fail(file, fmt::format("{}: {} uses {} joints; the bone palette holds at most {} (kMaxBones)",
-                             std::filesystem::path(file).filename().string(), meshDesc, joints, opts.maxBones));
+      fail(file, fmt::format("{} uses {} joints; the bone palette holds at most {} (kMaxBones)", meshDesc, joints,
+                             opts.maxBones));
     data.skin = skinIndex;
     imp.joints = joints;
     imp.influences = 4 * sets;

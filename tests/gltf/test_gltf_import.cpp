@@ -355,14 +355,14 @@ TEST(GltfImport, TooManyJointsNamesModelMeshAndLimit) {
       R"("skins":[{{"joints":[{}]}}],"nodes":[{}],"scenes":[{{"nodes":[0]}}])",
       pos, joints, weights, jointList, nodes));
   std::string e = errorOf([&] { importGltfText(json, "models/Fox.glb"); });
-  EXPECT_NE(e.find("Fox.glb: mesh 'fox' uses 1100 joints; the bone palette holds at most 1024 (kMaxBones)"),
+  EXPECT_NE(e.find("Fox.glb: error: mesh 'fox' uses 1100 joints; the bone palette holds at most 1024 (kMaxBones)"),
             std::string::npos)
       << e;
   // The same limit, lowered, on the real Fox.
   GltfImportOptions o;
   o.maxBones = 16;
   e = errorOf([&] { importGltf(modelPath("Fox/Fox.glb"), o); });
-  EXPECT_NE(e.find("Fox.glb: mesh 'fox1' uses 24 joints; the bone palette holds at most 16 (kMaxBones)"),
+  EXPECT_NE(e.find("Fox.glb: error: mesh 'fox1' uses 24 joints; the bone palette holds at most 16 (kMaxBones)"),
             std::string::npos)
       << e;
   o.maxBones = 24;
