@@ -100,7 +100,16 @@ function(shadergen_add_vertex_shader target)
   _shadergen_executable(shadergen_add_vertex_shader _sg_exe)
 
   # Absolute input paths: the depfile then names the same files the DEPENDS do.
-  get_filename_component(_rig "${SG_RIG}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+  # A glTF rig may select a primitive, "MODEL.glb#M/P" (docs/gltf.md): the build depends on
+  # the model file, and the generator gets the selection as written.
+  set(_rig_sel "")
+  set(_rig_path "${SG_RIG}")
+  if(SG_RIG MATCHES "^(.*\\.([gG][lL][tT][fF]|[gG][lL][bB]))(#[^#]*)$")
+    set(_rig_path "${CMAKE_MATCH_1}")
+    set(_rig_sel "${CMAKE_MATCH_3}")
+  endif()
+  get_filename_component(_rig_file "${_rig_path}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+  set(_rig "${_rig_file}${_rig_sel}")
   get_filename_component(_frag "${SG_FRAGMENT}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
   set(_rules "")
   set(_rule_args "")
@@ -191,7 +200,7 @@ function(shadergen_add_vertex_shader target)
   add_custom_command(
     OUTPUT ${_outputs}
     COMMAND ${_sg_exe} ${_args}
-    DEPENDS "${_rig}" "${_frag}" ${_rules} ${_extra} ${_sg_exe}
+    DEPENDS "${_rig_file}" "${_frag}" ${_rules} ${_extra} ${_sg_exe}
     DEPFILE "${_depfile}"
     WORKING_DIRECTORY "${CMAKE_CURRENT_BINARY_DIR}"
     COMMENT "shadergen: generating vertex shader ${_name} for ${target}"

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -32,50 +33,18 @@ namespace {
 [[noreturn]] void fail(const std::string& file, const std::string& msg) { throw InputError(SourceLoc{file, 0, 0}, msg); }
 
 // The primitive's triangles as vertex index triples: strips and fans are expanded; points
-// and lines have none (their vertices are baked, but block nothing).
-std::vector<std::array<uint32_t, 3>> primitiveTriangles(const tinygltf::Model& m, const tinygltf::Primitive& p,
-                                                        size_t vertexCount, const std::string& file,
-                                                        const std::string& where) {
+// and lines have none (their vertices are baked, but block nothing). The indices are the
+// import's (`GltfModelData::indices`: read by the checked accessor reader, sparse accessors
+// applied, every index below the vertex count), as `render` draws them.
+std::vector<std::array<uint32_t, 3>> primitiveTriangles(const tinygltf::Primitive& p, const GltfModelData& d,
+                                                        const std::string& file) {
   std::vector<uint32_t> idx;
   if (p.indices >= 0) {
-    if (static_cast<size_t>(p.indices) >= m.accessors.size())
-      fail(file, fmt::format("{}: indices refer to accessor {}, which does not exist", where, p.indices));
-    const auto& a = m.accessors[static_cast<size_t>(p.indices)];
-    int size = a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE    ? 1
-               : a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 2
-               : a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT   ? 4
-                                                                           : 0;
-    if (size == 0 || a.type != TINYGLTF_TYPE_SCALAR || a.sparse.isSparse || a.bufferView < 0)
-      fail(file, fmt::format("{}: indices must be a non-sparse SCALAR of unsigned byte, short or int", where));
-    if (static_cast<size_t>(a.bufferView) >= m.bufferViews.size())
-      fail(file, fmt::format("{}: indices refer to buffer view {}, which does not exist", where, a.bufferView));
-    const auto& v = m.bufferViews[static_cast<size_t>(a.bufferView)];
-    size_t stride = v.byteStride ? v.byteStride : static_cast<size_t>(size);
-    if (v.buffer < 0 || static_cast<size_t>(v.buffer) >= m.buffers.size())
-      fail(file, fmt::format("{}: the index buffer view refers to a missing buffer", where));
-    if (a.count > kMaxGltfElements)
-      fail(file, fmt::format("{}: {} indices exceed the limit of {}", where, a.count, kMaxGltfElements));
-    const auto& buf = m.buffers[static_cast<size_t>(v.buffer)].data;
-    // Overflow-free: count ≤ 2^24 and stride < 2^8 keep the product small; offsets are
-    // compared by subtraction.
-    size_t span = a.count == 0 ? 0 : (a.count - 1) * stride + static_cast<size_t>(size);
-    if (v.byteOffset > buf.size() || v.byteLength > buf.size() - v.byteOffset || a.byteOffset > v.byteLength ||
-        span > v.byteLength - a.byteOffset || stride > 255)
-      fail(file, fmt::format("{}: indices read past the end of buffer view {}", where, a.bufferView));
-    const unsigned char* base = buf.data() + v.byteOffset + a.byteOffset;
-    idx.resize(a.count);
-    for (size_t i = 0; i < a.count; ++i) {
-      uint32_t x = 0;
-      if (size == 1) x = base[i * stride];
-      else if (size == 2) { uint16_t s; std::memcpy(&s, base + i * stride, 2); x = s; }
-      else std::memcpy(&x, base + i * stride, 4);
-      if (x >= vertexCount)
-        fail(file, fmt::format("{}: index {} (element {}) is out of range ({} vertices)", where, x, i, vertexCount));
-      idx[i] = x;
-    }
+    if (!d.indicesError.empty()) fail(file, d.indicesError);
+    idx = d.indices;
   } else {
-    idx.resize(vertexCount);
-    for (size_t i = 0; i < vertexCount; ++i) idx[i] = static_cast<uint32_t>(i);
+    idx.resize(d.vertexCount);
+    for (size_t i = 0; i < d.vertexCount; ++i) idx[i] = static_cast<uint32_t>(i);
   }
   std::vector<std::array<uint32_t, 3>> tris;
   int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
@@ -259,12 +228,57 @@ std::vector<PrimitiveData> decodePrimitives(const tinygltf::Model& model, size_t
       io.mesh = d.mesh;
       io.primitive = d.primitive;
       d.imp = importGltfModel(model, inputBytes, file, io);  // parsed once, not per primitive
-      d.triangles = primitiveTriangles(model, model.meshes[m].primitives[p], d.imp.data.vertexCount, file,
-                                       fmt::format("mesh '{}' primitive {}", d.imp.data.meshName, p));
+      d.triangles = primitiveTriangles(model.meshes[m].primitives[p], d.imp.data, file);
       prims.push_back(std::move(d));
     }
   if (prims.empty()) fail(file, "the model's meshes have no primitives: nothing to bake");
   return prims;
+}
+
+// tinygltf writes an object that has only default members as `null` (`nodes: [{}]`, an empty
+// scene or texture, all valid glTF) and a perspective camera's absent `zfar` (infinite) as 0:
+// both make the output invalid, and our own loader refuses it. Returns whether it changed `j`.
+bool repairTinygltfJson(nlohmann::json& j) {
+  bool changed = false;
+  for (auto& [key, value] : j.items())
+    if (value.is_array())
+      for (auto& e : value)
+        if (e.is_null()) e = nlohmann::json::object(), changed = true;
+  if (j.contains("cameras") && j["cameras"].is_array())
+    for (auto& c : j["cameras"]) {
+      auto p = c.find("perspective");
+      if (p == c.end() || !p->is_object()) continue;
+      auto z = p->find("zfar");
+      if (z != p->end() && z->is_number() && z->get<double>() == 0) p->erase(z), changed = true;
+    }
+  return changed;
+}
+
+uint32_t readU32(const std::string& s, size_t at) {
+  uint32_t v;
+  std::memcpy(&v, s.data() + at, 4);
+  return v;
+}
+void putU32(std::string& s, uint32_t v) { s.append(reinterpret_cast<const char*>(&v), 4); }
+
+// tinygltf's output with its JSON repaired (repairTinygltfJson); byte-identical when nothing
+// needed it. A GLB is rebuilt around the new JSON chunk, its BIN chunk copied as it was.
+std::string repairSerialised(const std::string& bytes, bool binary) {
+  if (!binary) {
+    nlohmann::json j = nlohmann::json::parse(bytes);
+    return repairTinygltfJson(j) ? j.dump(2) + "\n" : bytes;
+  }
+  const size_t jsonLen = readU32(bytes, 12);  // header 12 bytes, then the JSON chunk's length
+  nlohmann::json j = nlohmann::json::parse(bytes.substr(20, jsonLen));
+  if (!repairTinygltfJson(j)) return bytes;
+  std::string json = j.dump();
+  json.append((4 - json.size() % 4) % 4, ' ');
+  const std::string rest = bytes.substr(20 + jsonLen);  // the BIN chunk, if any
+  std::string out = bytes.substr(0, 8);
+  putU32(out, static_cast<uint32_t>(20 + json.size() + rest.size()));
+  putU32(out, static_cast<uint32_t>(json.size()));
+  out += bytes.substr(16, 4);  // "JSON"
+  return out + json + rest;
 }
 
 // The output file: every buffer embedded (buffer 0 in the GLB binary chunk, the others as
@@ -283,7 +297,7 @@ std::string serialise(tinygltf::Model& model, const std::string& file, bool bina
   tinygltf::TinyGLTF writer;
   std::ostringstream os;
   if (!writer.WriteGltfSceneToStream(&model, os, !binary, binary)) fail(file, "cannot serialise the baked model");
-  return os.str();
+  return repairSerialised(os.str(), binary);
 }
 
 std::vector<Vec3> vec3Stream(const GltfModelData& d, const std::string& name) {

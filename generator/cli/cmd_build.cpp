@@ -88,6 +88,9 @@ struct BuildCommand {
     Manifest m = loadManifest(manifest);
     if (!output.empty()) m.outputDir = output;
     m.rules.insert(m.rules.begin(), rules.begin(), rules.end());
+    if (m.rules.empty())
+      throw InputError(SourceLoc{m.file, 1, 1}, "no rules: the manifest needs 'rules' (a rules file or a list of "
+                                                  "them), or the command line -r FILE");
     if (!deviceProfiles.empty()) {
       m.deviceProfile = deviceProfiles.front();
       m.portableProfiles.assign(deviceProfiles.begin() + 1, deviceProfiles.end());

@@ -33,13 +33,21 @@ struct PackCommand {
     // The model at its rest pose: vertex data does not depend on the pose.
     GltfSceneOptions so;
     so.read = o.gltf;
-    ValidationScene scene = source.empty() ? proceduralScene(r.in.rig, mesh, 1, 1) : gltfScene(source, so);
+    // The model's files (its buffer files too) are inputs the outputs must not overwrite:
+    // `-o M` beside M.gltf would write M.bin.
+    std::vector<std::string> extra;
+    ValidationScene scene;
+    if (source.empty()) {
+      scene = proceduralScene(r.in.rig, mesh, 1, 1);
+    } else {
+      GltfImport imp = importGltfRef(source, so.read);
+      extra = imp.rig.sourceFiles;
+      scene = gltfScene(imp, so);
+    }
     PackedVertices packed = packVertices(r, scene.mesh);
     std::vector<PendingFile> files = {{output + ".bin", std::string(packed.bytes.begin(), packed.bytes.end())},
                                       {output + ".json", packed.layoutJson}};
     std::vector<std::string> outPaths = {files[0].path, files[1].path};
-    std::vector<std::string> extra;
-    if (!source.empty()) extra.push_back(source.substr(0, source.find('#')));
     refuseClobbering(outPaths, inputFiles(r.in, extra));
     writeFilesAtomically(files);
     for (const auto& n : r.in.notes) std::cerr << formatDiagnostic(n) << "\n";

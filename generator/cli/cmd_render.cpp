@@ -93,6 +93,10 @@ struct RenderCommand {
     std::vector<InputFile> inputs{{parts ? parseGltfRef(ro.gen.rigPath, true).file : ro.gen.rigPath, "the rig"},
                                   {ro.gen.fragmentPath, "the fragment shader"}};
     for (const auto& r : ro.gen.rulesPaths) inputs.push_back({r, "a rules file"});
+    // A glTF model's buffer files are inputs too: `-o M.bin` beside M.gltf.
+    if (isGltfPath(ro.gen.rigPath))
+      for (const auto& f : importGltfRef(parts ? parts->front().ref : ro.gen.rigPath, ro.gen.gltf).rig.sourceFiles)
+        inputs.push_back({f, "the rig"});
     refuseClobbering({output}, inputs);
 
     RenderSession session(ro.device, ro.validationLayers);

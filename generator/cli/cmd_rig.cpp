@@ -14,6 +14,13 @@
 namespace sg {
 namespace {
 
+// The model and its buffer files: `-o M.bin` beside M.gltf must not overwrite one.
+std::vector<InputFile> modelFiles(const GltfImport& imp) {
+  std::vector<InputFile> files;
+  for (const auto& f : imp.rig.sourceFiles) files.push_back({f, "the glTF model"});
+  return files;
+}
+
 struct RigImportCommand {
   std::string model;
   int mesh = -1;
@@ -69,7 +76,7 @@ struct RigImportCommand {
     if (output.empty() || output == "-") {
       std::cout << yaml;
     } else {
-      refuseClobbering({output}, {{ref.file, "the glTF model"}});
+      refuseClobbering({output}, modelFiles(imp));
       writeFilesAtomically({PendingFile{output, yaml}});
     }
     return 0;
@@ -86,6 +93,7 @@ struct RigImportCommand {
                                            "): it names the directory that gets one rig per primitive");
     const std::string file = parseGltfRef(model, true).file;
     std::vector<PendingFile> files;
+    std::vector<InputFile> inputs{{file, "the glTF model"}};
     std::vector<nlohmann::ordered_json> entries(parts.size());
     std::vector<std::string> failed = forEachPart(parts, [&](const GltfPart& part) {
       GltfImportOptions o;
@@ -94,6 +102,7 @@ struct RigImportCommand {
       o.packOcclusionInNormal = packOcclusion;
       o.read = read;
       GltfImport imp = importGltf(file, o);
+      inputs = modelFiles(imp);  // the same for every part
       std::string path = (std::filesystem::path(output) / (part.name + ".yaml")).string();
       files.push_back({path, rigYaml(imp, file, path)});
       nlohmann::ordered_json& e = entries[static_cast<size_t>(&part - parts.data())];
@@ -111,7 +120,7 @@ struct RigImportCommand {
                      wholeModelIndex("rig import", model, parts, entries)});
     std::vector<std::string> outPaths;
     for (const auto& f : files) outPaths.push_back(f.path);
-    refuseClobbering(outPaths, {{file, "the glTF model"}});
+    refuseClobbering(outPaths, inputs);
     writeFilesAtomically(files);
     if (!quiet) std::cout << fmt::format("{}: {} rig(s) and index.json written to {}\n", model, parts.size(), output);
     return 0;

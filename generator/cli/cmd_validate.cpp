@@ -35,6 +35,7 @@ struct ValidateCommand {
   bool optimize = false;
   CrossArgs cross;
   std::string reportPath;  // --report FILE.json
+  std::vector<std::string> modelFiles;  // the glTF model and its buffer files: inputs
   std::string saveOutputs;  // --save-outputs DIR
 
   // A glTF primitive at every instance and time: its section of the text report, and what
@@ -94,6 +95,7 @@ struct ValidateCommand {
     for (const auto& f : files) paths.push_back(f.path);
     std::vector<InputFile> inputs{{parseGltfRef(vo.gen.rigPath, true).file, "the rig"},
                                   {vo.gen.fragmentPath, "the fragment shader"}};
+    for (const auto& f : modelFiles) inputs.push_back({f, "the rig"});  // `--report M.bin` beside M.gltf
     for (const auto& r : vo.gen.rulesPaths) inputs.push_back({r, "a rules file"});
     refuseClobbering(paths, inputs);
     writeFilesAtomically(files);
@@ -136,12 +138,15 @@ struct ValidateCommand {
       so.allInstances = true;
       const GltfRef ref = parseGltfRef(vo.gen.rigPath);
       GltfImport model = importGltfRef(vo.gen.rigPath, vo.gen.gltf);
+      modelFiles = model.rig.sourceFiles;
       Validator v(vo);
       GltfSceneInfo info;
       std::vector<ValidatedPart> parts{validatePrimitive(v, model, vo.gen, so,
                                                          gltfPartName(ref.mesh, ref.primitive, model.data.meshName), info)};
       if (!savePoses.empty()) {
-        refuseClobbering({savePoses}, {{ref.file, "the rig"}});
+        std::vector<InputFile> inputs{{ref.file, "the rig"}};
+        for (const auto& f : modelFiles) inputs.push_back({f, "the rig"});
+        refuseClobbering({savePoses}, inputs);
         writeFilesAtomically({{savePoses, formatPoseFile(parts.front().report.poses)}});
       }
       std::string ts;
@@ -203,6 +208,7 @@ struct ValidateCommand {
       done[i].rig = part.ref;
       done[i].error = "not run: see the diagnostics";
       GltfImport model = importGltfRef(part.ref, vo.gen.gltf);
+      modelFiles = model.rig.sourceFiles;  // the same for every part
       GenerateOptions gen = partOptions(vo.gen, part.ref);
       GltfSceneInfo info;
       done[i] = validatePrimitive(v, model, gen, so, part.name, info);

@@ -22,6 +22,23 @@
 namespace sg {
 namespace {
 
+// The rig's name, "<stem>/<mesh>/<primitive>", as a rig file must spell it (rig_loader.cpp:
+// one printable line of at most kMaxRigNameBytes), since `rig import` writes it into YAML
+// that is read back: glTF names may hold control characters and be any length. Control
+// characters become '?'; a long name is cut at a UTF-8 character boundary.
+std::string gltfRigName(const std::string& stem, const std::string& mesh, int primitive) {
+  std::string name = stem + "/" + mesh;
+  for (char& c : name)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  const std::string tail = fmt::format("/{}", primitive);
+  if (name.size() + tail.size() > kMaxRigNameBytes) {
+    size_t cut = kMaxRigNameBytes - tail.size();
+    while (cut > 0 && (static_cast<unsigned char>(name[cut]) & 0xC0) == 0x80) --cut;  // a continuation byte
+    name.resize(cut);
+  }
+  return name + tail;
+}
+
 using gltf::AccessorData;
 using gltf::componentTypeName;
 using gltf::fail;
@@ -396,7 +413,7 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
 
   Rig& rig = imp.rig;
   rig.file = file;
-  rig.name = fmt::format("{}/{}/{}", data.stem, data.meshName, opts.primitive);
+  rig.name = gltfRigName(data.stem, data.meshName, opts.primitive);
   rig.params = {{"bones", 0}, {"influences", 0}, {"morph_targets", 0}};
 
   auto info = [&](const std::string& name, const tinygltf::Accessor& a) {
@@ -462,9 +479,9 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
                                   idx.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
                                   idx.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
         fail(file, fmt::format("{}: indices must be unsigned byte, short or int scalars", where));
-      for (float v : idx.values)
-        if (!(v >= 0.0f) || static_cast<size_t>(v) >= data.vertexCount)
-          fail(file, fmt::format("{}: index {} is out of range ({} vertices)", where, v, data.vertexCount));
+      for (size_t i = 0; i < idx.values.size(); ++i)
+        if (const float v = idx.values[i]; !(v >= 0.0f) || static_cast<size_t>(v) >= data.vertexCount)
+          fail(file, fmt::format("{}: index {} (element {}) is out of range ({} vertices)", where, v, i, data.vertexCount));
       data.indices.assign(idx.values.begin(), idx.values.end());
     } catch (const InputError& e) {
       data.indices.clear();
@@ -616,8 +633,8 @@ GltfImport importModel(const tinygltf::Model& model, const std::string& file, co
     int joints = static_cast<int>(skin.joints.size());
     if (joints == 0) fail(file, fmt::format("the skin of {} has no joints", meshDesc));
     if (joints > opts.maxBones)
-      fail(file, fmt::format("{}: {} uses {} joints; the bone palette holds at most {} (kMaxBones)",
-                             std::filesystem::path(file).filename().string(), meshDesc, joints, opts.maxBones));
+      fail(file, fmt::format("{} uses {} joints; the bone palette holds at most {} (kMaxBones)", meshDesc, joints,
+                             opts.maxBones));
     data.skin = skinIndex;
     imp.joints = joints;
     imp.influences = 4 * sets;

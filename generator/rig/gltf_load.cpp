@@ -26,7 +26,13 @@ namespace sg::gltf {
 namespace {
 
 // Textures are not needed (and the test models ship without them): accept every image as is.
-bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+// tinygltf keeps an external image's URI but not a data URI's: one is made again from the
+// decoded bytes, so that `bake` writes the image back instead of `"bufferView": -1`.
+bool skipImage(tinygltf::Image* image, const int, std::string*, std::string*, int, int, const unsigned char* bytes,
+               int size, void*) {
+  if (image && image->uri.empty() && image->bufferView < 0 && bytes && size > 0)
+    image->uri = "data:" + (image->mimeType.empty() ? std::string("application/octet-stream") : image->mimeType) +
+                 ";base64," + tinygltf::base64_encode(bytes, static_cast<unsigned int>(size));
   return true;
 }
 

@@ -1,5 +1,6 @@
 #include "validate/pack.h"
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -9,9 +10,36 @@
 #include "validate/program_inputs.h"
 
 namespace sg {
+namespace {
+
+// Data from another file (`pack --rig rig.yaml --model M.glb#m/p`) was never checked against
+// the rig as its own import is: a joint index past the rig's palette would be packed as is
+// (the program reads outside `bones`) or saturated by a narrower format (joint 299 stored as
+// 255 in uint8x4, another bone). Sets the rig does not read are left out on purpose (a
+// level-of-detail rig reads fewer influences).
+void checkJoints(const Rig& rig, const rt::Mesh& mesh) {
+  const int64_t bones = rig.param("bones");
+  for (const RigAttribute& a : rig.attributes)
+    for (const ProvidedPart& p : a.provides) {
+      if (p.semantic.rfind("skin.joints[", 0) != 0 || !mesh.has(p.semantic)) continue;
+      const VertexFormat format = partFormat(a, p);
+      const auto& joints = mesh.at(p.semantic);
+      for (size_t v = 0; v < mesh.vertexCount; ++v)
+        for (int c = 0; c < formatComponents(format) && c < 4; ++c) {
+          const float j = joints[v][c];
+          if (j >= static_cast<float>(bones) || storedValue(format, c, j) != j)
+            throw InputError(a.loc, fmt::format("mesh '{}' vertex {} uses joint {} ({}), but rig '{}' has {} bones in "
+                                                "'{}' stored as {}: the model's skin is not the rig's",
+                                                mesh.name, v, j, p.semantic, rig.name, bones, a.name, formatName(format)));
+        }
+    }
+}
+
+}  // namespace
 
 PackedVertices packVertices(const GenerateResult& r, const rt::Mesh& mesh) {
   const Rig& rig = r.in.rig;
+  checkJoints(rig, mesh);
   const rt::Mesh quantized = quantizeForRig(rig, mesh);
   PackedVertices out;
   out.vertexCount = mesh.vertexCount;

@@ -117,8 +117,10 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
                      "axes", "exclude", "name", "device_profile", "max_error", "hlsl_shader_model", "msl_version",
                      "msl_platform", "validate", "cache_url", "mesh"});
   m.outputDir = resolvePath(file, root["output"] ? y.scalar(root["output"], "'output'") : "shaders");
-  if (!root["rules"]) y.fail(root, "the manifest needs 'rules' (a rules file or a list of them)");
-  for (const auto& r : scalarOrList(y, root["rules"], "'rules'")) m.rules.push_back(resolvePath(file, r));
+  // Optional: the command line may name every rules file (-r, the CMake function's RULES: a
+  // manifest cannot reach an installed library by a relative path); `build` checks for none.
+  if (root["rules"])
+    for (const auto& r : scalarOrList(y, root["rules"], "'rules'")) m.rules.push_back(resolvePath(file, r));
   if (root["templates"]) m.templates = resolvePath(file, y.scalar(root["templates"], "'templates'"));
   if (root["target_env"]) {
     std::string env = y.scalar(root["target_env"], "'target_env'");

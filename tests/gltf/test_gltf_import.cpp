@@ -299,6 +299,29 @@ TEST(GltfImport, SparseAccessorsAreApplied) {
   EXPECT_NO_THROW(loadRigText(rigToYaml(imp.rig), "tiny.rig.yaml"));
 }
 
+// glTF names may hold control characters and be any length; the rig name, written into the
+// YAML of `rig import` and read back, must be one printable line of at most kMaxRigNameBytes.
+// Such a mesh made `rig import` fail at a line of the file it had not written.
+TEST(GltfImport, AnyMeshNameGivesALoadableRigName) {
+  std::string longName;
+  for (int i = 0; i < 200; ++i) longName += "\u00e9";  // é: two bytes each in UTF-8
+  for (const std::string& name : {std::string(R"(we\"ird\n\t*/ #: {x})"), longName}) {
+    std::string text = tinySkinnedModel();
+    const size_t at = text.find(R"("name":"tri")");
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, 12, R"("name":")" + name + "\"");
+    GltfImport imp = importGltfText(text, "tiny.gltf");
+    SCOPED_TRACE(imp.rig.name);
+    EXPECT_LE(imp.rig.name.size(), kMaxRigNameBytes);
+    EXPECT_EQ(imp.rig.name.substr(0, 5), "tiny/");
+    EXPECT_EQ(imp.rig.name.substr(imp.rig.name.size() - 2), "/0");
+    Rig back;
+    ASSERT_NO_THROW(back = loadRigText(rigToYaml(imp.rig), "tiny.rig.yaml"));
+    EXPECT_EQ(back.name, imp.rig.name);
+  }
+  EXPECT_EQ(importGltfText(tinySkinnedModel(), "tiny.gltf").rig.name, "tiny/tri/0");
+}
+
 TEST(GltfImport, MoreThanSixteenInfluencesIsRejected) {
   EXPECT_EQ(importGltfText(tinySkinnedModel(1), "tiny.gltf").rig.param("influences"), 8);
   // JOINTS_2/WEIGHTS_2 and JOINTS_3/WEIGHTS_3: 16 influences, every set imported.
@@ -332,14 +355,14 @@ TEST(GltfImport, TooManyJointsNamesModelMeshAndLimit) {
       R"("skins":[{{"joints":[{}]}}],"nodes":[{}],"scenes":[{{"nodes":[0]}}])",
       pos, joints, weights, jointList, nodes));
   std::string e = errorOf([&] { importGltfText(json, "models/Fox.glb"); });
-  EXPECT_NE(e.find("Fox.glb: mesh 'fox' uses 1100 joints; the bone palette holds at most 1024 (kMaxBones)"),
+  EXPECT_NE(e.find("Fox.glb: error: mesh 'fox' uses 1100 joints; the bone palette holds at most 1024 (kMaxBones)"),
             std::string::npos)
       << e;
   // The same limit, lowered, on the real Fox.
   GltfImportOptions o;
   o.maxBones = 16;
   e = errorOf([&] { importGltf(modelPath("Fox/Fox.glb"), o); });
-  EXPECT_NE(e.find("Fox.glb: mesh 'fox1' uses 24 joints; the bone palette holds at most 16 (kMaxBones)"),
+  EXPECT_NE(e.find("Fox.glb: error: mesh 'fox1' uses 24 joints; the bone palette holds at most 16 (kMaxBones)"),
             std::string::npos)
       << e;
   o.maxBones = 24;

@@ -443,6 +443,60 @@ case("gpu-instancing-attributes-missing", {"m.gltf": text(instanced({}))}, rig_i
      INST_AT + "): its \"attributes\" have no TRANSLATION, ROTATION or SCALE")
 
 
+# `pack --rig rig.yaml --model M`: the model's skin is not the rig's import, so nothing checked
+# its joints against the rig; joint 5 of a 6-joint skin was packed for a 2-bone palette.
+TRI_RIG = b"""rig: "tri/tri/0"
+deformers:
+  bones: 2
+  influences: 4
+  morph_targets: 0
+  uniform_scale: 1
+attributes:
+  position: { format: float32x3, provides: "vertex.position" }
+  joints0: { format: uint8x4, provides: "skin.joints[0]" }
+  weights0: { format: float32x4, provides: "skin.weights[0]" }
+uniforms:
+  bones: { type: mat4, array: bones, semantic: "skin.bones" }
+  camera_position: { type: vec3, semantic: "camera.position" }
+  view: { type: mat4, semantic: "camera.view" }
+  projection: { type: mat4, semantic: "camera.projection" }
+"""
+case("pack-model-joints-past-rig",
+     {"rig.yaml": TRI_RIG,
+      "m.gltf": text(skinned(joints=((0, 5, 0, 0),) * 3, weights=((0.5, 0.5, 0, 0),) * 3,
+                             nodes=[{"mesh": 0, "skin": 0}, {"children": [2, 3, 4, 5, 6, 7]}] + [{}] * 6,
+                             skins=[{"joints": [2, 3, 4, 5, 6, 7]}]))},
+     "pack --rig @D/rig.yaml --model @D/m.gltf -f tests/gltf/data/minimal.frag -r rules/standard.yaml -o @O/p", 1,
+     "@D/rig.yaml:9:3: error: mesh 'm/tri/0' vertex 0 uses joint 5 (skin.joints[0]), but rig 'tri/tri/0' has 2 bones "
+     "in 'joints0' stored as uint8x4: the model's skin is not the rig's")
+
+# `pack --rig rig.yaml --model m.gltf -o m` beside the model: m.bin is the model's buffer file,
+# an input, which pack overwrote (only the .gltf was checked).
+RIGID_RIG = b"""rig: "m/tri/0"
+attributes:
+  position: { format: float32x3, provides: "vertex.position" }
+uniforms:
+  camera_position: { type: vec3, semantic: "camera.position" }
+  view: { type: mat4, semantic: "camera.view" }
+  projection: { type: mat4, semantic: "camera.projection" }
+  model: { type: mat4, semantic: "model.matrix" }
+"""
+case("pack-output-is-model-buffer",
+     {"rig.yaml": RIGID_RIG, "m.gltf": text(model([pos()], uri="m.bin")), "m.bin": TRI},
+     "pack --rig @D/rig.yaml --model @D/m.gltf -f tests/gltf/data/minimal.frag -r rules/standard.yaml -o @D/m", 1,
+     "shadergen: error: output '@D/m.bin' is an input ('@D/m.bin'); refusing to overwrite an input")
+
+# The same for a glTF rig's own buffer file: validate's --report and --save-poses and render's
+# -o were checked against the model file only.
+EXTERNAL = {"m.gltf": text(model([pos()], uri="m.bin")), "m.bin": TRI}
+for name, run in [("validate-report-is-model-buffer", "validate --rig @D/m.gltf --report @D/m.bin"),
+                  ("validate-save-poses-is-model-buffer", "validate --rig @D/m.gltf --save-poses @D/m.bin"),
+                  ("render-output-is-model-buffer", "render --rig @D/m.gltf -o @D/m.bin")]:
+    case(name, EXTERNAL, run + " -f tests/gltf/data/minimal.frag -r rules/standard.yaml --no-validation-layers", 1,
+         "shadergen: error: output '@D/m.bin' is the rig ('@D/m.bin'); refusing to overwrite an input")
+case("rig-import-output-is-model-buffer", EXTERNAL, "rig import @D/m.gltf -o @D/m.bin", 1,
+     "shadergen: error: output '@D/m.bin' is the glTF model ('@D/m.bin'); refusing to overwrite an input")
+
 def main():
     for name in sorted(os.listdir(HERE)):
         if os.path.isdir(os.path.join(HERE, name)) and name not in cases:
