@@ -263,7 +263,8 @@ size_t loadChecked(const std::string& file, const std::string* text, const std::
   if (!text && !readBounded(file, bytes, why)) fail(file, "cannot read the glTF model: " + why);
   const std::string& b = text ? *text : bytes;
   if (b.size() > kMaxGltfFileBytes) fail(file, fmt::format("the glTF model is larger than {}", mib(kMaxGltfFileBytes)));
-  bool glb = !text && lower(std::filesystem::path(file).extension().string()) == ".glb";
+  // A binary model is known by its magic, as viewers know it, whatever its file is called.
+  bool glb = !text && (lower(std::filesystem::path(file).extension().string()) == ".glb" || b.rfind("glTF", 0) == 0);
   auto [jsonAt, jsonSize] = glb ? checkGlb(b, file) : std::make_pair(size_t{0}, b.size());
   if (auto deep = tooDeep(b.data() + jsonAt, jsonSize)) {
     std::string msg = fmt::format("JSON nested deeper than {} levels", kMaxGltfJsonDepth);

@@ -8,6 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <filesystem>
+
+#include <unistd.h>
 
 #include "gltf_test_util.h"
 #include "pipeline/generate.h"
@@ -236,6 +239,18 @@ TEST(GltfImport, LoadRigDispatchesOnTheExtension) {
   EXPECT_NE(e.find("does not select a primitive"), std::string::npos) << e;
   e = errorOf([] { loadRig(modelPath("Fox/Missing.glb")); });
   EXPECT_NE(e.find("Missing.glb"), std::string::npos) << e;
+}
+
+// A binary model called .gltf is read by its magic, as viewers read it (it was "invalid JSON").
+TEST(GltfImport, ABinaryModelIsKnownByItsMagicNotItsName) {
+  const std::filesystem::path copy =
+      std::filesystem::path(::testing::TempDir()) / ("fox-binary-" + std::to_string(::getpid()) + ".gltf");
+  std::filesystem::copy_file(modelPath("Fox/Fox.glb"), copy, std::filesystem::copy_options::overwrite_existing);
+  GltfImportOptions o;
+  GltfImport imp = importGltf(copy.string(), o);
+  std::filesystem::remove(copy);
+  EXPECT_EQ(imp.data.vertexCount, 1728u);
+  EXPECT_EQ(imp.joints, 24);
 }
 
 // The Fox has no normals: asking for world_normal names what is missing.
