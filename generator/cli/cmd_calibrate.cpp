@@ -246,7 +246,8 @@ struct CalibrateCommand {
     co.fit.form = chosenForm();
     if (!output.empty()) {
       std::vector<InputFile> inputs;
-      for (const auto& r : co.rigs) inputs.push_back({isGltfPath(r) ? parseGltfRef(r).file : r, "a rig"});
+      for (const auto& r : co.rigs)  // a glTF model's buffer files too: `-o M.bin` beside M.gltf
+        for (const auto& f : loadRig(r).sourceFiles) inputs.push_back({f, "a rig"});
       if (!co.rigs.empty()) inputs.push_back({co.plans.fragmentPath, "the fragment shader"});
       for (const auto& r : co.plans.rulesPaths) inputs.push_back({r, "a rules file"});
       refuseClobbering({output}, inputs);

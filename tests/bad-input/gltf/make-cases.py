@@ -494,6 +494,9 @@ for name, run in [("validate-report-is-model-buffer", "validate --rig @D/m.gltf 
                   ("render-output-is-model-buffer", "render --rig @D/m.gltf -o @D/m.bin")]:
     case(name, EXTERNAL, run + " -f tests/gltf/data/minimal.frag -r rules/standard.yaml --no-validation-layers", 1,
          "shadergen: error: output '@D/m.bin' is the rig ('@D/m.bin'); refusing to overwrite an input")
+case("calibrate-output-is-model-buffer", EXTERNAL,
+     "calibrate --rig @D/m.gltf -f tests/gltf/data/minimal.frag -r rules/standard.yaml -o @D/m.bin --no-validation-layers", 1,
+     "shadergen: error: output '@D/m.bin' is a rig ('@D/m.bin'); refusing to overwrite an input")
 case("rig-import-output-is-model-buffer", EXTERNAL, "rig import @D/m.gltf -o @D/m.bin", 1,
      "shadergen: error: output '@D/m.bin' is the glTF model ('@D/m.bin'); refusing to overwrite an input")
 
