@@ -186,6 +186,13 @@ struct BuildCommand {
       std::cerr << fmt::format("{}: error: variant '{}' failed:\n", m.file, b.variant->name);
       for (const auto& d : b.errors) std::cerr << renderDiagnostic(d) << "\n";
     }
+    // No output may be an input (a rig called NAME.json beside its variant's reflection).
+    std::vector<InputFile> inputs{{m.file, "the manifest"}};
+    for (const auto& b : r.variants)
+      for (const auto& f : b.inputs) inputs.push_back({f, fmt::format("an input of variant '{}'", b.variant->name)});
+    std::vector<std::string> outputs;
+    for (const auto& f : r.files) outputs.push_back(f.path);
+    refuseClobbering(outputs, inputs);
     // Unchanged outputs are left alone (their timestamps too, so dependents do not rebuild);
     // the index is always rewritten: it is the build step's output, newer than its inputs.
     std::vector<PendingFile> changed;
