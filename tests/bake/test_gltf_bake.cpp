@@ -108,6 +108,23 @@ int addMesh(tinygltf::Model& m, const Mesh& mesh) {
   return static_cast<int>(m.meshes.size()) - 1;
 }
 
+// A one-quad model (one node, one scene) as JSON, for tests that add what tinygltf cannot write.
+nlohmann::json quadModelJson() {
+  tinygltf::Model m;
+  Mesh quad;
+  quad.quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1});
+  addMesh(m, quad);
+  m.nodes.emplace_back();
+  m.nodes[0].mesh = 0;
+  m.scenes.push_back({});
+  m.scenes[0].nodes = {0};
+  m.asset.version = "2.0";
+  tinygltf::TinyGLTF w;
+  std::ostringstream os;
+  EXPECT_TRUE(w.WriteGltfSceneToStream(&m, os, true, false));
+  return nlohmann::json::parse(os.str());
+}
+
 void save(tinygltf::Model& m, const fs::path& file);
 
 // A model whose scene is one node drawing `mesh`, saved as `file`.
@@ -354,19 +371,7 @@ TEST(GltfBake, SparseIndicesAreApplied) {
 // baked to invalid glTF that no loader, ours included, read back.
 TEST(GltfBake, EmptyObjectsAndAnInfiniteCameraStayValid) {
   fs::path dir = tempDir();
-  tinygltf::Model m;
-  Mesh quad;
-  quad.quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1});
-  addMesh(m, quad);
-  m.nodes.emplace_back();
-  m.nodes[0].mesh = 0;
-  m.scenes.push_back({});
-  m.scenes[0].nodes = {0};
-  m.asset.version = "2.0";
-  tinygltf::TinyGLTF w;
-  std::ostringstream os;
-  ASSERT_TRUE(w.WriteGltfSceneToStream(&m, os, true, false));
-  nlohmann::json j = nlohmann::json::parse(os.str());
+  nlohmann::json j = quadModelJson();
   j["nodes"].push_back(nlohmann::json::object());
   j["scenes"][0]["nodes"].push_back(1);
   j["scenes"].push_back(nlohmann::json::object());
@@ -407,19 +412,7 @@ TEST(GltfBake, EmptyObjectsAndAnInfiniteCameraStayValid) {
 // `"bufferView": -1` (invalid, and the image lost). It is written back as it was.
 TEST(GltfBake, EmbeddedImageIsKept) {
   fs::path dir = tempDir();
-  tinygltf::Model m;
-  Mesh quad;
-  quad.quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1});
-  addMesh(m, quad);
-  m.nodes.emplace_back();
-  m.nodes[0].mesh = 0;
-  m.scenes.push_back({});
-  m.scenes[0].nodes = {0};
-  m.asset.version = "2.0";
-  tinygltf::TinyGLTF w;
-  std::ostringstream os;
-  ASSERT_TRUE(w.WriteGltfSceneToStream(&m, os, true, false));
-  nlohmann::json j = nlohmann::json::parse(os.str());
+  nlohmann::json j = quadModelJson();
   const std::string uri = "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAIAAACQd1PeAAAADElEQVR4nGP4z8AAAAMBAQDJ/pLvAAAAAElFTkSuQmCC";
   j["images"] = nlohmann::json::array({{{"uri", uri}}});
   j["textures"] = nlohmann::json::array({{{"source", 0}}});
