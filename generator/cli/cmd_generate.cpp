@@ -10,6 +10,7 @@
 #include "cli/commands.h"
 #include "cli/output_files.h"
 #include "cli/whole_model.h"
+#include "common/content_hash.h"
 #include "emit/reflection.h"
 #include "measure/workload.h"
 #include "rig/vertex_encoding.h"
@@ -60,6 +61,10 @@ void GenerateArgs::add(CLI::App& cmd) {
       ->check(CLI::IsMember({"vulkan", "vulkan1.0", "vulkan1.1", "vulkan1.2", "vulkan1.3"}));
   cmd.add_option("--templates", opts.templateDir, "Directory with vertex.glsl templates");
   cmd.add_option("--ban", opts.bannedRules, "Exclude a rule from the search (force an alternative)");
+  cmd.add_option("--pin", pin,
+                 "A pin file (bench --pin-out): the plan a device timed fastest among the cheapest candidates, written "
+                 "without the device or its profile; an error if these inputs no longer give that plan "
+                 "(docs/performance.md, \"A measured choice\")");
   cmd.add_option("--set", sets, "Set a rig deformer parameter: NAME=VALUE (level-of-detail rigs: morph_targets=2)");
   cmd.add_option("--max-error", maxErrors,
                  "Error budget of an encoded vertex semantic: SEMANTIC=ERROR, an angle in deg or rad for a direction "
@@ -72,6 +77,7 @@ void GenerateArgs::add(CLI::App& cmd) {
 GenerateOptions GenerateArgs::resolve() const {
   GenerateOptions o = opts;
   parseTargetEnv(targetEnv, o.targetEnv);
+  if (!pin.empty()) o.pin = loadPin(pin);
   if (!profiles.empty()) {
     o.deviceProfilePath = profiles.front();
     o.portableProfilePaths.assign(profiles.begin() + 1, profiles.end());
@@ -263,7 +269,10 @@ struct GenerateCommand {
     // The workload prices nothing without a profile: outputs stay those of the slot model.
     if (o.deviceProfilePath.empty())
       refuseOption(*cmd, "--mesh", "without --device-profile: the workload it measures prices nothing under instruction slots");
-    if (auto parts = wholeModelParts(o.rigPath)) return runModel(o, kinds, *parts);
+    if (auto parts = wholeModelParts(o.rigPath)) {
+      if (o.pin) throw CLI::ValidationError("--pin", "pins one rig's plan: name one primitive (MODEL.glb#m/p), not the whole model");
+      return runModel(o, kinds, *parts);
+    }
     if (!o.deviceProfilePath.empty()) measureWorkloadOf(o, mesh);
     bool single = kinds.size() == 1 && !output.empty();
     std::string path = output.empty() ? std::filesystem::path(o.fragmentPath).stem().string() : output;
@@ -279,6 +288,13 @@ struct GenerateCommand {
     writeFilesAtomically(files);
     if (stats) std::cout << describeStats(r.stats);
     for (const auto& n : r.in.notes) std::cerr << formatDiagnostic(n) << "\n";
+    // The pin still gives its plan (generate checked); bytes it was not measured with are said.
+    if (o.pin && sha256OfFiles(r.pinnedInputs) != o.pin->inputs)
+      std::cerr << formatDiagnostic(Diagnostic{Severity::Warning, o.pin->inputsLoc,
+                                               fmt::format("the inputs' bytes differ from those the pin was measured with on "
+                                                           "{} (the pin still gives its plan, which is written; its timing "
+                                                           "may not hold)", o.pin->device)})
+                << "\n";
     if (!quiet) {
       printPlan(r);
       for (const auto& f : files) std::cout << "wrote " << f.path << "\n";

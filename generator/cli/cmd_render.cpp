@@ -2,12 +2,15 @@
 // fragment shader into a PNG (docs/render.md).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <iostream>
+#include <set>
 
 #include "cli/commands.h"
 #include "cli/fresh_process.h"
 #include "cli/whole_model.h"
 #include "measure/gpu_bench.h"
+#include "pipeline/pin.h"
 #include "render/render.h"
 
 namespace sg {
@@ -35,6 +38,22 @@ glm::vec3 parseVec3(const std::string& option, const std::string& text) {
     start = comma + 1;
   }
   return v;
+}
+
+// The files the options name, for an output to be checked against before anything runs: the
+// rig (and a glTF model's buffer files: `-o M.bin` beside M.gltf), the fragment shader, the
+// rules and the device profiles.
+std::vector<InputFile> optionInputs(const GenerateOptions& gen) {
+  auto parts = wholeModelParts(gen.rigPath);
+  std::vector<InputFile> inputs{{parts ? parseGltfRef(gen.rigPath, true).file : gen.rigPath, "the rig"},
+                                {gen.fragmentPath, "the fragment shader"}};
+  for (const auto& r : gen.rulesPaths) inputs.push_back({r, "a rules file"});
+  if (!gen.deviceProfilePath.empty()) inputs.push_back({gen.deviceProfilePath, "a device profile"});
+  for (const auto& d : gen.portableProfilePaths) inputs.push_back({d, "a device profile"});
+  if (isGltfPath(gen.rigPath))
+    for (const auto& f : importGltfRef(parts ? parts->front().ref : gen.rigPath, gen.gltf).rig.sourceFiles)
+      inputs.push_back({f, "the rig"});
+  return inputs;
 }
 
 struct RenderCommand {
@@ -90,14 +109,7 @@ struct RenderCommand {
       throw CLI::ValidationError("--light", "a light direction must not be zero");
 
     auto parts = wholeModelParts(ro.gen.rigPath);
-    std::vector<InputFile> inputs{{parts ? parseGltfRef(ro.gen.rigPath, true).file : ro.gen.rigPath, "the rig"},
-                                  {ro.gen.fragmentPath, "the fragment shader"}};
-    for (const auto& r : ro.gen.rulesPaths) inputs.push_back({r, "a rules file"});
-    // A glTF model's buffer files are inputs too: `-o M.bin` beside M.gltf.
-    if (isGltfPath(ro.gen.rigPath))
-      for (const auto& f : importGltfRef(parts ? parts->front().ref : ro.gen.rigPath, ro.gen.gltf).rig.sourceFiles)
-        inputs.push_back({f, "the rig"});
-    refuseClobbering({output}, inputs);
+    refuseClobbering({output}, optionInputs(ro.gen));
 
     RenderSession session(ro.device, ro.validationLayers);
     RenderResult r = parts ? renderModel(session, *parts) : session.render(ro);
@@ -127,6 +139,7 @@ struct BenchCommand {
   // report goes. Hidden options; the parent adds them to its own command line.
   std::string timePart, reportPath;
   std::vector<std::string> commandLine;
+  std::string pinOut;  // --pin-out: the fastest validated plan, pinned (pipeline/pin.h)
 
   int run() {
     bo.render.gen = args.resolve();
@@ -144,6 +157,13 @@ struct BenchCommand {
     bo.rasterOff = raster != "on";
     bo.alternatives = !noAlternatives;
     bo.floor = !noFloor;
+    if (!pinOut.empty()) {
+      if (wholeModelParts(bo.render.gen.rigPath))
+        throw CLI::ValidationError("--pin-out", "pins one rig's plan: name one primitive (MODEL.glb#m/p), not the whole model");
+      std::vector<InputFile> inputs = optionInputs(bo.render.gen);
+      if (!bo.handPortPath.empty()) inputs.push_back({bo.handPortPath, "the hand port"});
+      refuseClobbering({pinOut}, inputs);
+    }
     if (!timePart.empty()) {  // the child of a whole-model bench: one part, its report to the parent
       if (reportPath.empty()) throw CLI::ValidationError("--time-part", "needs --child-report");
       bo.render.gen.rigPath = timePart;
@@ -169,7 +189,33 @@ struct BenchCommand {
       failIfPartsFailed(model, parts->size(), broken, "the others were timed");
       return failed ? 1 : 0;
     }
-    return report(runGpuBench(bo)) ? 1 : 0;
+    const GpuBenchReport rep = runGpuBench(bo);
+    if (report(rep)) return 1;  // no pin from a run where a program failed on the device
+    if (!pinOut.empty()) writePin(rep);
+    return 0;
+  }
+
+  // The fastest validated plan as a pin (pipeline/pin.h).
+  void writePin(const GpuBenchReport& rep) const {
+    if (rep.fastestPlan < 0) throw std::runtime_error("--pin-out: no plan was timed by " + rep.predictionClock);
+    const GpuBenchRow& f = rep.rows[size_t(rep.fastestPlan)];
+    Pin pin;
+    pin.device = rep.device;
+    pin.driver = rep.driver;
+    pin.clock = rep.predictionClock;
+    pin.label = f.label;
+    std::set<std::string> rules(f.rules.begin(), f.rules.end());
+    pin.rules.assign(rules.begin(), rules.end());
+    pin.bans = f.pin;
+    pin.inputs = rep.inputs;
+    // The prediction clock's best round, as checkPredictions picked the fastest by.
+    auto best = [](const GpuBenchRow& r) { return *std::min_element(r.roundNsPerVertex.begin(), r.roundNsPerVertex.end()); };
+    pin.nsPerVertex = best(f);
+    pin.generatedNsPerVertex = best(rep.rows.front());
+    for (const auto& row : rep.rows) pin.candidates += row.hasCost && row.validation == "pass";
+    writeFilesAtomically({{pinOut, formatPin(pin)}});
+    std::cout << fmt::format("{}: pins {} ({:.4f} ns per vertex; the generated plan {:.4f})\n", pinOut, f.label,
+                             pin.nsPerVertex, pin.generatedNsPerVertex);
   }
 
   // Prints the report; returns how many programs failed on the device.
@@ -249,6 +295,13 @@ void registerRender(CLI::App& app, CliState& state) {
       ->check(CLI::IsMember({"on", "off", "both"}));
   b->add_flag("--no-alternatives", bench->noAlternatives, "Only the generated plan (and the hand port and floor)");
   b->add_flag("--no-floor", bench->noFloor, "Leave out the pass-through floor");
+  b->add_option("--candidates", bench->bo.candidates,
+                "Time the K plans cheapest under the search's objective (the device profile's predicted time), the generated "
+                "one first, instead of its forced alternatives: the candidates of a measured choice (--pin-out)")
+      ->check(CLI::Range(1, 64));
+  b->add_option("--pin-out", bench->pinOut,
+                "Write the fastest validated plan as a pin file (YAML): generate --pin writes that plan on any machine "
+                "(docs/performance.md, \"A measured choice\")");
   b->add_option("--device", bench->bo.render.device,
                 "Vulkan device name (substring); default lavapipe. A named device's own limits constrain the search, "
                 "as in validate --device");

@@ -29,10 +29,11 @@ struct GenerateArgs {
   std::vector<std::string> maxErrors;  // "semantic=0.1deg" (error budgets)
   std::vector<std::string> profiles;   // --device-profile, once per device (several: a portable plan)
   std::string targetEnv = "vulkan1.0";
+  std::string pin;  // --pin: a measured choice (pipeline/pin.h), read by resolve
   CLI::Option* maxAttributes = nullptr;  // whether the device limits were given (applyDeviceLimits)
   CLI::Option* maxUniformBytes = nullptr;
   void add(CLI::App& cmd);
-  GenerateOptions resolve() const;  // parses --map and --target-env (throws CLI::ValidationError)
+  GenerateOptions resolve() const;  // parses --map and --target-env (throws CLI::ValidationError), reads --pin
 };
 
 // --hlsl-shader-model, --msl-version, --msl-platform (generate; validate --via hlsl takes

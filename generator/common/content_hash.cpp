@@ -1,5 +1,9 @@
 #include "common/content_hash.h"
 
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
 #include <openssl/evp.h>
 
 #include <cstdint>
@@ -46,5 +50,17 @@ std::string Sha256::hex() {
 }
 
 std::string sha256Hex(std::string_view bytes) { return Sha256().update(bytes).hex(); }
+
+std::string sha256OfFiles(const std::vector<std::string>& paths) {
+  Sha256 h;
+  for (const auto& path : paths) {
+    std::ifstream f(path, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << f.rdbuf();
+    if (!f) throw std::runtime_error("cannot read " + path);
+    h.field(bytes.str());
+  }
+  return h.hex();
+}
 
 }  // namespace sg

@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 struct evp_md_ctx_st;
 
@@ -30,5 +31,8 @@ class Sha256 {
 };
 
 std::string sha256Hex(std::string_view bytes);
+// Over the bytes of each file in order, each a field (paths left out: a pin moves between
+// machines and checkouts). Throws std::runtime_error for a file it cannot read.
+std::string sha256OfFiles(const std::vector<std::string>& paths);
 
 }  // namespace sg

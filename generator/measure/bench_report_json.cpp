@@ -42,6 +42,7 @@ json rowJson(const GpuBenchRow& r) {
   return {{"label", r.label},
           {"rules", r.rules},
           {"bans", r.bans},
+          {"pin", r.pin},
           {"has_cost", r.hasCost},
           {"has_amounts", r.hasAmounts},
           {"plan_cost", r.planCost},
@@ -63,6 +64,7 @@ GpuBenchRow rowFrom(const json& j) {
   r.label = j.at("label");
   r.rules = j.at("rules").get<std::vector<std::string>>();
   r.bans = j.at("bans").get<std::vector<std::string>>();
+  r.pin = j.at("pin").get<std::vector<std::string>>();
   r.hasCost = j.at("has_cost");
   r.hasAmounts = j.at("has_amounts");
   r.planCost = j.at("plan_cost");
@@ -123,7 +125,8 @@ std::string benchReportJson(const GpuBenchReport& r) {
                   {"input_memory", r.inputMemory},
                   {"fastest_plan", r.fastestPlan},
                   {"fastest_over_generated", number(r.fastestOverGenerated)},
-                  {"notes", notes}};
+                  {"notes", notes},
+                  {"inputs", r.inputs}};
   return j.dump();
 }
 
@@ -175,6 +178,7 @@ GpuBenchReport benchReportFromJson(const std::string& text) {
     r.fastestPlan = j.at("fastest_plan");
     r.fastestOverGenerated = number(j.at("fastest_over_generated"));
     for (const auto& n : j.at("notes")) r.notes.push_back(noteFrom(n));
+    r.inputs = j.at("inputs");
     return r;
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(std::string("bench report: not a report this shadergen writes: ") + e.what());

@@ -359,6 +359,9 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     p.row.label = label;
     p.row.bans = std::move(bans);
     for (int a : p.render.plan.actions) p.row.rules.push_back(p.render.in.problem.actions[a].name);
+    std::set<std::string> pin(render.bannedRules.begin(), render.bannedRules.end());
+    for (const std::string& r : bansPinning(p.render.in.problem, p.render.plan)) pin.insert(r);
+    p.row.pin.assign(pin.begin(), pin.end());
     for (const auto& q : programs)
       if (q.row.hasCost && q.row.rules == p.row.rules) return false;  // the same plan again
     p.capture = generateFrom(in, capture);
@@ -377,7 +380,11 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   // A portable choice's alternatives are priced by their regret against each device's optimum
   // of the unbanned problem, as the chosen plan is: comparable plan costs.
   in.portableBest = chosen.in.portableBest;
-  if (opts.alternatives) {
+  if (opts.candidates > 0) {
+    const std::vector<RankedPlan> ranked = cheapestPlans(in, gen, opts.candidates);
+    for (size_t i = 0; i < ranked.size(); ++i)
+      if (!ranked[i].bans.empty()) addGenerated(fmt::format("cheapest plan #{}", i + 1), ranked[i].bans);
+  } else if (opts.alternatives) {
     const Problem& p = chosen.in.problem;
     for (int a : chosen.plan.actions) {
       std::vector<std::string> producers;
@@ -439,6 +446,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
 
   GpuBenchReport rep;
   rep.notes = in.notes;
+  rep.inputs = sha256OfFiles(chosen.pinnedInputs);
   rep.device = validator.harness().deviceName();
   rep.limits = limits;
   rep.driver = renderer.driver();

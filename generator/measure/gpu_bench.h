@@ -23,6 +23,10 @@ struct GpuBenchOptions {
   std::string handPortPath;    // "" = none; GLSL with the generated shader's interface
   bool floor = true;           // the pass-through program
   bool alternatives = true;    // every forced alternative (as validate --cross-check)
+  // 0: the alternatives above. K: instead, the K plans cheapest under the search's objective
+  // (pipeline/generate.h cheapestPlans), the generated one first: the candidates a measured
+  // choice (bench --pin-out) picks from.
+  size_t candidates = 0;
   bool rasterOn = true, rasterOff = true;
   uint32_t drawsPerFrame = 8;
   // A mesh too small to keep the device busy over drawsPerFrame draws is drawn more often, so
@@ -43,6 +47,10 @@ struct GpuBenchRow {
   // The rules to --ban, beside the options' own, that make generate write this program: a
   // forced alternative's are the other rules producing its fact ("generated": none).
   std::vector<std::string> bans;
+  // The rules to --ban that leave this plan the only derivation of its facts, whatever the
+  // costs it is searched under (pipeline/generate.h bansPinning, with the bans above and the
+  // options' own): what bench --pin-out records. Empty for the hand port and the floors.
+  std::vector<std::string> pin;
   bool hasCost = false;            // a plan of the search (planCost)
   bool hasAmounts = false;         // amounts known: the plans and the floors
   int64_t planCost = 0;
@@ -106,6 +114,7 @@ struct GpuBenchReport {
   int fastestPlan = -1;
   double fastestOverGenerated = NAN;  // its time over the generated program's, by that clock
   std::vector<Diagnostic> notes;  // loading's (which stored form is read, what budgets removed)
+  std::string inputs;  // the digest of the files the plans were generated from (pipeline/pin.h)
 };
 
 GpuBenchReport runGpuBench(const GpuBenchOptions& opts);

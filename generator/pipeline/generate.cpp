@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <queue>
 #include <set>
 #include <stdexcept>
 #include <tuple>
@@ -265,8 +266,43 @@ std::vector<std::string> inputsRead(const LoadedInputs& in, const TemplateSet& t
 
 // ---- the stages in order ------------------------------------------------------------------
 
+namespace {
+
+std::vector<std::string> pinnedInputs(const LoadedInputs& in, const TemplateSet& templates) {
+  std::set<std::string> profiles;
+  if (in.profile) profiles.insert(in.profile->file);
+  for (const DeviceProfile& d : in.portable) profiles.insert(d.file);
+  std::vector<std::string> files;
+  for (const auto& f : inputsRead(in, templates))
+    if (!profiles.count(f)) files.push_back(f);
+  return files;
+}
+
+// After searching with the pin's bans: the plan's rule names must be the pin's, else the
+// inputs changed what the bans leave and the pin is stale (a located error at its rules).
+void checkPin(const Pin& pin, const Problem& problem, const Plan& plan) {
+  std::set<std::string> got;
+  for (int a : plan.actions) got.insert(problem.actions[size_t(a)].name);
+  if (!std::equal(got.begin(), got.end(), pin.rules.begin(), pin.rules.end())) {
+    std::vector<std::string> missing, extra;
+    for (const auto& r : pin.rules)
+      if (!got.count(r)) missing.push_back(r);
+    for (const auto& r : got)
+      if (!std::binary_search(pin.rules.begin(), pin.rules.end(), r)) extra.push_back(r);
+    throw InputError(pin.rulesLoc,
+                     fmt::format("the pinned plan is not what these inputs give under its bans (without: {}; instead: {}): "
+                                 "the rig, request or rules changed since it was measured; time the candidates again "
+                                 "(bench --candidates N --pin-out)",
+                                 missing.empty() ? "-" : fmt::format("{}", fmt::join(missing, ", ")),
+                                 extra.empty() ? "-" : fmt::format("{}", fmt::join(extra, ", "))));
+  }
+}
+
+}  // namespace
+
 Plan searchUnderOptions(LoadedInputs& in, const GenerateOptions& opts, SearchStats* stats) {
   if (!opts.bannedRules.empty()) in.problem = withoutRules(in.problem, opts.bannedRules);
+  if (opts.pin && !opts.pin->bans.empty()) in.problem = withoutRules(in.problem, opts.pin->bans);
   setDeviceLimits(in.problem, opts.maxAttributes, opts.maxUniformBlockBytes, opts.maxStorageBuffers);
   dropOversizedBuffers(in.problem, opts.maxVertices, opts.maxStorageBufferBytes);
   const SearchOptions search{opts.searchEngine, opts.heuristic, opts.searchLimits};
@@ -286,6 +322,63 @@ Plan searchUnderOptions(LoadedInputs& in, const GenerateOptions& opts, SearchSta
     applyPortableProfiles(in.problem, all, in.portableBest);
   }
   return searchStage(in, search, stats);
+}
+
+std::vector<RankedPlan> cheapestPlans(const LoadedInputs& in, const GenerateOptions& opts, size_t k, size_t maxSearches) {
+  struct Node {
+    int64_t cost;
+    std::string names;  // the plan's rule names, sorted and joined: the tie-break and the identity
+    std::vector<std::string> bans;
+    std::vector<std::string> rules;
+  };
+  auto later = [](const Node& a, const Node& b) { return std::tie(a.cost, a.names, a.bans) > std::tie(b.cost, b.names, b.bans); };
+  std::priority_queue<Node, std::vector<Node>, decltype(later)> open(later);
+  std::set<std::vector<std::string>> tried;
+  std::set<std::string> found;
+  size_t searches = 0;
+  auto expand = [&](std::vector<std::string> bans) {
+    std::sort(bans.begin(), bans.end());
+    if (!tried.insert(bans).second || searches >= maxSearches) return;
+    ++searches;
+    LoadedInputs one = in;
+    GenerateOptions o = opts;
+    o.bannedRules.insert(o.bannedRules.end(), bans.begin(), bans.end());
+    try {
+      Plan plan = searchUnderOptions(one, o, nullptr);
+      std::set<std::string> names;
+      for (int a : plan.actions) names.insert(one.problem.actions[size_t(a)].name);
+      std::vector<std::string> rules(names.begin(), names.end());
+      open.push(Node{plan.cost, fmt::format("{}", fmt::join(rules, " ")), std::move(bans), std::move(rules)});
+    } catch (const InputError&) {
+      // nothing serves the request without these rules
+    }
+  };
+  expand({});
+  std::vector<RankedPlan> out;
+  while (!open.empty() && out.size() < k) {
+    Node n = open.top();
+    open.pop();
+    if (!found.insert(n.names).second) continue;  // the same plan by another set of bans
+    out.push_back(RankedPlan{n.bans, n.rules, n.cost});
+    for (const std::string& r : n.rules) {
+      std::vector<std::string> child = n.bans;
+      child.push_back(r);
+      expand(std::move(child));
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> bansPinning(const Problem& p, const Plan& plan) {
+  std::set<std::string> used, others;
+  std::set<int> facts;
+  for (int a : plan.actions) {
+    used.insert(p.actions[size_t(a)].name);
+    facts.insert(p.actions[size_t(a)].add);
+  }
+  for (const auto& act : p.actions)
+    if (facts.count(act.add) && !used.count(act.name)) others.insert(act.name);
+  return {others.begin(), others.end()};
 }
 
 namespace {
@@ -398,6 +491,12 @@ LoadedInputs loadInputs(const GenerateOptions& opts) {
   for (const auto& b : opts.bannedRules)  // a misspelt --ban would otherwise change nothing silently
     if (!in.rules.findRule(b))
       throw InputError(SourceLoc{}, fmt::format("--ban {}: no rule of that name in the rules files", b));
+  if (opts.pin)
+    for (const auto& b : opts.pin->bans)
+      if (!in.rules.findRule(b))
+        throw InputError(opts.pin->banLoc, fmt::format("the pin bans '{}', a rule the rules files do not have: they changed "
+                                                       "since it was measured; time the candidates again "
+                                                       "(bench --candidates N --pin-out)", b));
   return in;
 }
 
@@ -423,6 +522,7 @@ GenerateResult generateFrom(LoadedInputs in, const GenerateOptions& opts) {
 GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const GenerateOptions& opts) {
   GenerateResult res;
   res.plan = searchUnderOptions(in, opts, &res.stats);
+  if (opts.pin) checkPin(*opts.pin, in.problem, res.plan);
   EmitOptions eo;
   eo.capture = opts.capture;
   eo.heuristic = opts.heuristic;
@@ -438,6 +538,8 @@ GenerateResult generateWith(LoadedInputs in, const TemplateSet& templates, const
   if (opts.hlsl) res.hlsl = translateToHlsl(res.spirv.words, res.glsl, *opts.hlsl, opts.outputName);
   if (opts.msl) res.msl = translateToMsl(res.spirv.words, res.glsl, *opts.msl, opts.outputName);
   res.inputsRead = inputsRead(in, templates);
+  res.pinnedInputs = pinnedInputs(in, templates);
+  if (opts.pin) res.inputsRead.push_back(opts.pin->file);
   res.in = std::move(in);
   return res;
 }

@@ -19,6 +19,7 @@
 #include "search/search.h"
 #include "search/plan.h"
 #include "search/problem.h"
+#include "pipeline/pin.h"
 #include "pipeline/stages.h"
 
 namespace sg {
@@ -38,6 +39,9 @@ struct GenerateOptions {
   // fraction of the bounds diagonal for a position (--max-error; rig/vertex_encoding.h).
   std::map<std::string, double> maxError;
   std::vector<std::string> bannedRules;  // force alternatives (cross-check, explain)
+  // A measured choice (--pin, pipeline/pin.h): its bans are searched with as bannedRules are,
+  // and the plan found must be the one it pins.
+  std::optional<Pin> pin;
   std::string heuristic = "lmcut";
   std::string searchEngine = "auto";  // auto, regression, forward, ip (search/search.h)
   SearchLimits searchLimits;
@@ -86,6 +90,9 @@ struct GenerateResult {
   SpirvModule spirv;
   std::optional<CrossShader> hlsl, msl;  // translated from spirv.words when asked for
   std::vector<std::string> inputsRead;  // every file read (for depfiles)
+  // The files a pin's digest covers (pipeline/pin.h): those read but the device profiles and the
+  // pin (generate --pin needs no profile: the bans fix the plan).
+  std::vector<std::string> pinnedInputs;
 };
 
 const char* shadergenVersion();
@@ -97,6 +104,23 @@ LoadedInputs loadInputs(const GenerateOptions& opts);
 // re-searches each choice's alternative under the same limits. Throws the located error when no
 // plan fits.
 Plan searchUnderOptions(LoadedInputs& in, const GenerateOptions& opts, SearchStats* stats = nullptr);
+// The k plans cheapest under the search's objective (a device profile's predicted time, a
+// portable choice's worst regret, or instruction slots), cheapest first (ties: by rule names),
+// each with the rules to ban, beside opts' own, that make the search return it. Found by
+// banning each rule of a plan found, one at a time, and searching again (Lawler's partition
+// without its inclusion constraints): every plan is reached whose rule names are not a superset
+// of a cheaper plan's. Fewer than k where fewer exist; at most `maxSearches` searches.
+struct RankedPlan {
+  std::vector<std::string> bans;   // sorted
+  std::vector<std::string> rules;  // the plan's rule names, sorted, each once
+  int64_t cost = 0;                // the search's objective
+};
+std::vector<RankedPlan> cheapestPlans(const LoadedInputs& in, const GenerateOptions& opts, size_t k,
+                                      size_t maxSearches = 512);
+// The bans that leave `plan` the only derivation its facts have: every other rule producing a
+// fact the plan produces. A plan pinned by them stays the plan whatever the costs (the
+// workload, the profile) it is searched under (bench --pin-out, generate --pin).
+std::vector<std::string> bansPinning(const Problem& p, const Plan& plan);
 // The stages after loading, for a rig already loaded (loadInputs and `build` share them):
 // the error budgets (opts.maxError) take over-budget encodings out of the rig; a value the
 // rig stores both as itself and encoded is read in the form whose plan is cheapest; then
