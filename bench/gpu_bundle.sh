@@ -39,6 +39,6 @@ for m in LeePerrySmith/LeePerrySmith.glb MorphStressTest/MorphStressTest.gltf; d
 done
 cp "$root/tests/gltf/data/gltfpack/AnimatedMorphSphere.meshopt-cc-kv.glb" "$stage/sg/examples/models/"
 cp "$root/bench/gpu_env.sh" "$root/bench/gpu_run.sh" "$root/bench/gpu_calibrate.sh" "$root/bench/gpu_layouts.sh" \
-  "$root/bench/gpu_collect.sh" "$root/bench/gpu_verify.sh" "$stage/sg/"
+  "$root/bench/gpu_collect.sh" "$root/bench/gpu_verify.sh" "$root/bench/gpu_pin.sh" "$stage/sg/"
 tar -C "$stage" -czf "$out" sg
 echo "$out: $(du -h "$out" | cut -f1)"

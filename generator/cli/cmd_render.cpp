@@ -204,6 +204,7 @@ struct BenchCommand {
     pin.driver = rep.driver;
     pin.clock = rep.predictionClock;
     pin.label = f.label;
+    pin.program = f.program;
     std::set<std::string> rules(f.rules.begin(), f.rules.end());
     pin.rules.assign(rules.begin(), rules.end());
     pin.bans = f.pin;

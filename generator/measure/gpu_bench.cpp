@@ -359,9 +359,7 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     p.row.label = label;
     p.row.bans = std::move(bans);
     for (int a : p.render.plan.actions) p.row.rules.push_back(p.render.in.problem.actions[a].name);
-    std::set<std::string> pin(render.bannedRules.begin(), render.bannedRules.end());
-    for (const std::string& r : bansPinning(p.render.in.problem, p.render.plan)) pin.insert(r);
-    p.row.pin.assign(pin.begin(), pin.end());
+    p.row.pin = bansPinning(p.render.in.problem, p.render.plan, render.bannedRules);
     for (const auto& q : programs)
       if (q.row.hasCost && q.row.rules == p.row.rules) return false;  // the same plan again
     p.capture = generateFrom(in, capture);

@@ -358,8 +358,9 @@ std::vector<RankedPlan> cheapestPlans(const LoadedInputs& in, const GenerateOpti
   while (!open.empty() && out.size() < k) {
     Node n = open.top();
     open.pop();
-    if (!found.insert(n.names).second) continue;  // the same plan by another set of bans
-    out.push_back(RankedPlan{n.bans, n.rules, n.cost});
+    // The same plan by another set of bans is not listed again, but its bans still partition
+    // what is left: a cheaper plan may need them and one more.
+    if (found.insert(n.names).second) out.push_back(RankedPlan{n.bans, n.rules, n.cost});
     for (const std::string& r : n.rules) {
       std::vector<std::string> child = n.bans;
       child.push_back(r);
@@ -369,8 +370,8 @@ std::vector<RankedPlan> cheapestPlans(const LoadedInputs& in, const GenerateOpti
   return out;
 }
 
-std::vector<std::string> bansPinning(const Problem& p, const Plan& plan) {
-  std::set<std::string> used, others;
+std::vector<std::string> bansPinning(const Problem& p, const Plan& plan, const std::vector<std::string>& searchedWith) {
+  std::set<std::string> used, others(searchedWith.begin(), searchedWith.end());
   std::set<int> facts;
   for (int a : plan.actions) {
     used.insert(p.actions[size_t(a)].name);

@@ -106,10 +106,11 @@ LoadedInputs loadInputs(const GenerateOptions& opts);
 Plan searchUnderOptions(LoadedInputs& in, const GenerateOptions& opts, SearchStats* stats = nullptr);
 // The k plans cheapest under the search's objective (a device profile's predicted time, a
 // portable choice's worst regret, or instruction slots), cheapest first (ties: by rule names),
-// each with the rules to ban, beside opts' own, that make the search return it. Found by
-// banning each rule of a plan found, one at a time, and searching again (Lawler's partition
-// without its inclusion constraints): every plan is reached whose rule names are not a superset
-// of a cheaper plan's. Fewer than k where fewer exist; at most `maxSearches` searches.
+// each with the rules to ban, beside opts' own, that make the search return it. Found best
+// first over sets of bans: each plan's set spawns one set per rule of the plan, that rule
+// added (Lawler's partition without its inclusion constraints; a plan found twice still
+// spawns). Every plan is reached whose rule names are not a superset of a cheaper plan's.
+// Fewer than k where fewer exist; at most `maxSearches` searches.
 struct RankedPlan {
   std::vector<std::string> bans;   // sorted
   std::vector<std::string> rules;  // the plan's rule names, sorted, each once
@@ -118,9 +119,10 @@ struct RankedPlan {
 std::vector<RankedPlan> cheapestPlans(const LoadedInputs& in, const GenerateOptions& opts, size_t k,
                                       size_t maxSearches = 512);
 // The bans that leave `plan` the only derivation its facts have: every other rule producing a
-// fact the plan produces. A plan pinned by them stays the plan whatever the costs (the
-// workload, the profile) it is searched under (bench --pin-out, generate --pin).
-std::vector<std::string> bansPinning(const Problem& p, const Plan& plan);
+// fact the plan produces, and the bans it was searched with (`p` no longer has those rules). A
+// plan pinned by them stays the plan whatever the costs (the workload, the profile) it is
+// searched under (bench --pin-out, generate --pin). Sorted.
+std::vector<std::string> bansPinning(const Problem& p, const Plan& plan, const std::vector<std::string>& searchedWith);
 // The stages after loading, for a rig already loaded (loadInputs and `build` share them):
 // the error budgets (opts.maxError) take over-budget encodings out of the rig; a value the
 // rig stores both as itself and encoded is read in the form whose plan is cheapest; then

@@ -58,6 +58,7 @@ std::string formatPin(const Pin& p) {
   s += fmt::format("clock: {}\n", quoted(p.clock));
   s += fmt::format("candidates: {}\n", p.candidates);
   s += fmt::format("plan: {}\n", quoted(p.label));
+  s += fmt::format("program: {}\n", quoted(p.program));
   s += fmt::format("ns_per_vertex: {:.4f}\n", p.nsPerVertex);
   s += fmt::format("generated_ns_per_vertex: {:.4f}\n", p.generatedNsPerVertex);
   s += fmt::format("rules: {}\n", flowList(p.rules));
@@ -70,9 +71,9 @@ Pin parsePin(const std::string& text, const std::string& file) {
   const YAML::Node root = parseYaml(text, file);
   YamlCtx y{file};
   y.expectMap(root, "a pin (bench --pin-out writes them)");
-  y.checkKeys(root, {"device", "driver", "clock", "candidates", "plan", "ns_per_vertex", "generated_ns_per_vertex", "rules",
+  y.checkKeys(root, {"device", "driver", "clock", "candidates", "plan", "program", "ns_per_vertex", "generated_ns_per_vertex", "rules",
                      "ban", "inputs"});
-  for (const char* key : {"device", "driver", "clock", "candidates", "plan", "ns_per_vertex", "generated_ns_per_vertex",
+  for (const char* key : {"device", "driver", "clock", "candidates", "plan", "program", "ns_per_vertex", "generated_ns_per_vertex",
                           "rules", "ban", "inputs"})
     if (!root[key]) y.fail(root, fmt::format("a pin needs '{}' (bench --pin-out writes every key)", key));
   Pin p;
@@ -84,6 +85,7 @@ Pin parsePin(const std::string& text, const std::string& file) {
   if (candidates < 1) y.fail(root["candidates"], "candidates: expected a count of at least 1");
   p.candidates = size_t(candidates);
   p.label = y.scalar(root["plan"], "plan");
+  p.program = y.scalar(root["program"], "program");
   p.nsPerVertex = time(y, root["ns_per_vertex"], "ns_per_vertex");
   p.generatedNsPerVertex = time(y, root["generated_ns_per_vertex"], "generated_ns_per_vertex");
   p.rules = names(y, root["rules"], "rules");

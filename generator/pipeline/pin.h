@@ -16,6 +16,7 @@ struct Pin {
   std::string file;                   // where it was read from (read pins; a depfile lists it)
   std::string device, driver, clock;  // where and by which clock it was timed
   std::string label;                  // bench's row: "generated", "cheapest plan #3"
+  std::string program;                // the SPIR-V timed (bench's GpuBenchRow::program)
   std::vector<std::string> rules;     // the pinned plan's rule names, sorted, each once
   std::vector<std::string> bans;      // sorted
   std::string inputs;                 // sha256OfFiles (common/content_hash.h) of GenerateResult::pinnedInputs

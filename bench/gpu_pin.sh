@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# Runs on the GPU machine, from the unpacked bundle (bench/gpu_bundle.sh): a measured choice
+# (docs/performance.md, "A measured choice") on rigs no profile was fitted on. For each (rig,
+# request, mesh): `bench --candidates K --pin-out` times the K plans cheapest under the profile,
+# each validated on the device first, and pins the fastest (tune/, pins/); then, with
+# SG_PIN_CHECK=N (default 12), a second, independent bench times the N cheapest (check/), the
+# figures the pin is judged by. bench/pin_table.py makes the table from OUTDIR.
+# Usage: bash gpu_pin.sh [DEVICE=NVIDIA] [OUTDIR=.] ; SG_SEEDS="68 69" (corpus seeds, 6 rigs each),
+# SG_PROFILE (default the bundle's devices/nvidia-h200-raster.yaml), SG_CANDIDATES (4),
+# SG_MESHES ("dawn head"), SG_SUITE=1 also the Dawn body's depth pass and the suite's held-out rigs.
+set -uo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+device=${1-NVIDIA}
+outdir=${2:-.}
+source "$here/gpu_env.sh"
+profile=${SG_PROFILE:-$here/devices/nvidia-h200-raster.yaml}
+t=(--no-validation-layers --raster on --no-floor --draws 32 --min-frame-vertices 64000 --frames 7 --rounds 2
+   --device "$device" --device-profile "$profile")
+dawnRules=(-r "$here/examples/dawn/rules.yaml" --templates "$here/templates")
+std=(-r "$here/rules/standard.yaml" --templates "$here/templates")
+mkdir -p "$outdir/pins" "$outdir/tune" "$outdir/check" "$outdir/corpus"
+pair() {  # pair NAME RIG FRAG RULES...: every mesh of SG_MESHES
+  local name=$1 rig=$2 frag=$3; shift 3
+  for mesh in ${SG_MESHES:-dawn head}; do
+    local t0=$SECONDS
+    "$sg" bench "${t[@]}" --mesh "$mesh" --rig "$rig" -f "$frag" "$@" --candidates "${SG_CANDIDATES:-4}" \
+      --pin-out "$outdir/pins/$name-$mesh.pin.yaml" > "$outdir/tune/$name-$mesh.log" 2>&1
+    local rc=$?
+    if [ "${SG_PIN_CHECK:-12}" -gt 0 ]; then
+      "$sg" bench "${t[@]}" --mesh "$mesh" --rig "$rig" -f "$frag" "$@" --candidates "${SG_PIN_CHECK:-12}" \
+        > "$outdir/check/$name-$mesh.log" 2>&1
+    fi
+    echo "== $name $mesh: tune exit $rc, $((SECONDS - t0)) s"
+  done
+}
+for seed in ${SG_SEEDS:-68}; do
+  "$sg" calibrate --corpus 6 --seed "$seed" -f "$here/examples/dawn/face.frag" "${dawnRules[@]}" \
+    --write-corpus "$outdir/corpus/s$seed" > /dev/null
+  for rig in "$outdir/corpus/s$seed"/*.rig.yaml; do
+    name=$(basename "$rig" .rig.yaml)
+    pair "s$seed-$name" "$rig" "${rig%.rig.yaml}.frag" "${dawnRules[@]}"
+  done
+done
+if [ "${SG_SUITE:-0}" = 1 ]; then
+  data="$here/examples/heldout"
+  pair body-depth "$here/examples/dawn/body.rig.yaml" "$here/examples/dawn/depth.frag" "${dawnRules[@]}"
+  for r in limb16 limb8_palette300 face52 octahedral qtangent; do pair "world-$r" "$data/$r.rig.yaml" "$data/world.frag" "${std[@]}"; done
+  for r in pbr_character limb8_palette300; do pair "pbr-$r" "$data/$r.rig.yaml" "$data/standard_normalmap.frag" "${std[@]}"; done
+fi
