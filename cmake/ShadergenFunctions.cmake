@@ -20,6 +20,7 @@
 #                               # portable plan, least worst-case regret (docs/device-profiles.md)
 #     [MESH head|limb|dawn]     # --mesh: the procedural mesh a YAML rig's profile prices (needs DEVICE_PROFILE)
 #     [BAN <rule>...]           # --ban: pin a plan (the fastest one `shadergen bench` names)
+#     [PIN <file>]              # --pin: the plan a device timed fastest (bench --pin-out); no device needed
 #     [SET <NAME=VALUE>...]     # --set: a rig deformer parameter (level of detail)
 #     [DEPENDS <file>...])      # extra dependencies of the generator run
 #
@@ -62,7 +63,7 @@ endfunction()
 
 function(shadergen_add_vertex_shader target)
   set(options OPTIMIZE EMBED CAPTURE HLSL MSL)
-  set(one RIG FRAGMENT OUTPUT_NAME TARGET_ENV TEMPLATES MESH HLSL_SHADER_MODEL MSL_VERSION MSL_PLATFORM)
+  set(one RIG FRAGMENT OUTPUT_NAME TARGET_ENV TEMPLATES MESH HLSL_SHADER_MODEL MSL_VERSION MSL_PLATFORM PIN)
   set(multi RULES MAP DEPENDS DEVICE_PROFILE BAN SET)
   cmake_parse_arguments(PARSE_ARGV 1 SG "${options}" "${one}" "${multi}")
 
@@ -193,6 +194,11 @@ function(shadergen_add_vertex_shader target)
   foreach(b IN LISTS SG_BAN)
     list(APPEND _args --ban "${b}")
   endforeach()
+  if(SG_PIN)
+    get_filename_component(_pin "${SG_PIN}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+    list(APPEND _args --pin "${_pin}")
+    list(APPEND _extra "${_pin}")
+  endif()
   foreach(v IN LISTS SG_SET)
     list(APPEND _args --set "${v}")
   endforeach()

@@ -769,6 +769,45 @@ fresh_process)
     fail "bench: $(diff <(verdicts bench-fresh.out) <(verdicts last.out) | head -5)"
   ;;
 
+pin)
+  # A measured choice (docs/performance.md, "A measured choice"): bench --candidates K times the K plans
+  # cheapest under a profile on lavapipe and pins the fastest; generate --pin writes that plan without
+  # the device, under any profile or none; a pin the inputs no longer give is a located error.
+  BENCH=("${DAWN[@]}" --device-profile "$SRC/devices/llvmpipe-2core.yaml" --mesh head --raster off --draws 1
+         --min-frame-vertices 0 --frames 2 --rounds 1 --no-floor --no-validation-layers)
+  expect 0 "bench --candidates 3 --pin-out" -- "$SG" bench "${BENCH[@]}" --candidates 3 --pin-out face.pin.yaml
+  mv last.out bench.out
+  rows=$(grep -cE '^\| (generated|cheapest plan #[0-9]+) \| pass' bench.out)
+  [ "$rows" -eq 3 ] && ok "bench: 3 candidates timed, each validated" || fail "bench: $rows candidates passed, expected 3: $(cat bench.out)"
+  label=$(sed -n 's/^plan: "\(.*\)"$/\1/p' face.pin.yaml)
+  grep -q "^fastest validated plan (.*): \(the generated one\|$label\)" bench.out && [ -n "$label" ] &&
+    ok "the pin is bench's fastest ($label)" || fail "pin plan '$label' is not bench's fastest: $(grep fastest bench.out)"
+  # The rules the generated GLSL names (one comment per rule) are the pin's, with or without a profile.
+  glsl_rules() { sed -n 's|^  // \([a-z0-9_]*\) -> .*|\1|p' "$1" | sort -u | tr '\n' ' '; }
+  pin_rules=$(sed -n 's/^rules: \[\(.*\)\]$/\1/p' face.pin.yaml | tr -d ',' | tr ' ' '\n' | sort -u | tr '\n' ' ')
+  for profile in "" "$SRC/devices/nvidia-h200-raster.yaml"; do
+    args=(); [ -n "$profile" ] && args=(--device-profile "$profile" --mesh dawn)
+    expect 0 "generate --pin ${profile:+under another profile}" -- "$SG" generate "${DAWN[@]}" --pin face.pin.yaml "${args[@]}" --emit glsl -o pinned.vert -q
+    [ -s last.err ] && fail "generate --pin printed: $(cat last.err)"
+    [ "$(glsl_rules pinned.vert)" = "$pin_rules" ] && ok "generate --pin ${profile:+(another profile) }writes the pinned plan" ||
+      fail "generate --pin: rules $(glsl_rules pinned.vert), pinned $pin_rules"
+    [ -z "$profile" ] && cp pinned.vert pinned-slots.vert
+  done
+  expect 0 "generate --pin again" -- "$SG" generate "${DAWN[@]}" --pin face.pin.yaml --emit glsl -o again.vert -q
+  cmp -s pinned-slots.vert again.vert && ok "generate --pin: two runs, the same bytes" || fail "generate --pin: two runs differ"
+  # A byte the pin was not measured with: the same plan, written, with a warning at its inputs line.
+  cp "$E/face.frag" edited.frag && echo "// edited" >> edited.frag
+  expect 0 "generate --pin, the request edited" -- "$SG" generate --rig "$E/face.rig.yaml" -f edited.frag -r "$E/rules.yaml" --pin face.pin.yaml --emit glsl -o edited.vert -q
+  grep -q "^face.pin.yaml:[0-9]*:[0-9]*: warning: the inputs' bytes differ" last.err && ok "an edited input is reported at the pin" ||
+    fail "no warning for an edited input: $(cat last.err)"
+  # The pin no longer what the inputs give (a rule taken from its plan): a located error, nothing written.
+  first=$(echo $pin_rules | cut -d' ' -f1)
+  sed "s/^rules: \[$first, /rules: [/" face.pin.yaml > stale.pin.yaml
+  expect 1 "generate --pin, a stale pin" -- "$SG" generate "${DAWN[@]}" --pin stale.pin.yaml --emit glsl -o stale.vert -q
+  grep -q "^stale.pin.yaml:[0-9]*:[0-9]*: error: the pinned plan is not what these inputs give under its bans (without: -; instead: $first)" last.err &&
+    [ ! -e stale.vert ] && ok "a stale pin: located error, nothing written" || fail "stale pin: $(cat last.err)"
+  ;;
+
 *)
   echo "unknown case $case_name" >&2
   exit 2

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# shadergen_add_vertex_shader(... DEVICE_PROFILE <a> <b> MESH ... BAN ... SET ...) (docs/cmake.md):
+# shadergen_add_vertex_shader(... DEVICE_PROFILE <a> <b> MESH ... BAN ... SET ... PIN ...) (docs/cmake.md):
 # each shader is byte-identical to `shadergen generate` with the same flags; the mesh, a ban and
 # a --set each change the plan as they do on the command line; both profiles are dependencies
 # (editing the second regenerates the shaders, nothing else does); MESH without a profile, or
@@ -40,8 +40,13 @@ shaders() {  # shaders <dir> <shadergen_add_vertex_shader arguments after the fa
   project "$1" "$calls"
 }
 
+# A pin (bench --pin-out on lavapipe, the 3 plans cheapest under the second profile): PIN is --pin.
+XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/shadergen-xdg} "$SG" bench --rig "$D/face.rig.yaml" -f "$D/face.frag" -r "$D/rules.yaml" \
+  --device-profile "$P2" --mesh head --raster off --draws 1 --min-frame-vertices 0 --frames 2 --rounds 1 --no-floor \
+  --no-validation-layers --candidates 3 --pin-out "$T/face.pin.yaml" >"$T/bench.log" 2>&1 || { cat "$T/bench.log"; fail "bench --pin-out"; }
 # name | the function's arguments | the same as generate flags
 cases=(
+  "pinned|PIN $T/face.pin.yaml|--pin $T/face.pin.yaml"
   "dawn|DEVICE_PROFILE $P1 $P2 MESH dawn|--device-profile $P1 --device-profile $P2 --mesh dawn"
   "head|DEVICE_PROFILE $P1 $P2 MESH head|--device-profile $P1 --device-profile $P2 --mesh head"
   "banned|DEVICE_PROFILE $P1 $P2 MESH dawn BAN skin_matrix_blend|--device-profile $P1 --device-profile $P2 --mesh dawn --ban skin_matrix_blend"
@@ -77,6 +82,7 @@ blend() { grep -o '// [a-z_]* -> skin.matrix' "$G/$1.vert" | cut -d' ' -f2; }
 case "$(blend rigid)" in skin_matrix_rigid*) ok "SET influences=1: a rigid skin ($(blend rigid))" ;; *) fail "SET: '$(blend rigid)'" ;; esac
 
 grep -q "$P2" "$G/dawn.d" && grep -q "$P1" "$G/dawn.d" && ok "the depfile names both profiles" || fail "depfile: $(cat "$G/dawn.d")"
+grep -q "$T/face.pin.yaml" "$G/pinned.d" && ok "the depfile names the pin" || fail "pinned depfile: $(cat "$G/pinned.d")"
 "$NINJA" -C "$T/ok/b" | grep -qx 'ninja: no work to do.' && ok "no-op rebuild" || fail "a rebuild ran something"
 touch "$P2"
 n=$("$NINJA" -C "$T/ok/b" | grep -c 'shadergen: generating vertex shader')
