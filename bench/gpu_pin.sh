@@ -7,14 +7,15 @@
 # figures the pin is judged by. bench/pin_table.py makes the table from OUTDIR.
 # Usage: bash gpu_pin.sh [DEVICE=NVIDIA] [OUTDIR=.] ; SG_SEEDS="68 69" (corpus seeds, 6 rigs each),
 # SG_PROFILE (default the bundle's devices/nvidia-h200-raster.yaml), SG_CANDIDATES (4),
-# SG_MESHES ("dawn head"), SG_SUITE=1 also the Dawn body's depth pass and the suite's held-out rigs.
+# SG_MESHES ("dawn head"), SG_SUITE=1 also the Dawn face, its body's depth pass and the suite's held-out
+# rigs, SG_RASTER (on; off on lavapipe: its clock is then the process's CPU time, as calibrate's).
 set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 device=${1-NVIDIA}
 outdir=${2:-.}
 source "$here/gpu_env.sh"
 profile=${SG_PROFILE:-$here/devices/nvidia-h200-raster.yaml}
-t=(--no-validation-layers --raster on --no-floor --draws 32 --min-frame-vertices 64000 --frames 7 --rounds 2
+t=(--no-validation-layers --raster "${SG_RASTER:-on}" --no-floor --draws 32 --min-frame-vertices 64000 --frames 7 --rounds 2
    --device "$device" --device-profile "$profile")
 dawnRules=(-r "$here/examples/dawn/rules.yaml" --templates "$here/templates")
 std=(-r "$here/rules/standard.yaml" --templates "$here/templates")
@@ -43,6 +44,7 @@ for seed in ${SG_SEEDS:-68}; do
 done
 if [ "${SG_SUITE:-0}" = 1 ]; then
   data="$here/examples/heldout"
+  pair dawn-face "$here/examples/dawn/face.rig.yaml" "$here/examples/dawn/face.frag" "${dawnRules[@]}"
   pair body-depth "$here/examples/dawn/body.rig.yaml" "$here/examples/dawn/depth.frag" "${dawnRules[@]}"
   for r in limb16 limb8_palette300 face52 octahedral qtangent; do pair "world-$r" "$data/$r.rig.yaml" "$data/world.frag" "${std[@]}"; done
   for r in pbr_character limb8_palette300; do pair "pbr-$r" "$data/$r.rig.yaml" "$data/standard_normalmap.frag" "${std[@]}"; done

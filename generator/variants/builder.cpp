@@ -80,16 +80,18 @@ SharedInputs loadShared(const Manifest& m, const std::vector<Variant>& variants,
     s.portable.push_back(loadDeviceProfileStage(p));
     keep(p);
   }
+  for (const auto& [name, pin] : m.pins) keep(pin.file);
   return s;
 }
 
-std::vector<std::string> inputsOf(const SharedInputs& s, const Variant& v) {
+std::vector<std::string> inputsOf(const Manifest& m, const SharedInputs& s, const Variant& v) {
   std::vector<std::string> files = s.rigs.at(v.rig->path).sourceFiles;
   files.push_back(s.fragments.at(v.pass->fragment).file);
   files.insert(files.end(), s.rules.files.begin(), s.rules.files.end());
   files.push_back(s.templates.file());
   if (s.profile) files.push_back(s.profile->file);  // an input, so part of the cache key and the depfile
   for (const auto& d : s.portable) files.push_back(d.file);
+  if (auto pin = m.pins.find(v.name); pin != m.pins.end()) files.push_back(pin->second.file);  // as a profile is
   return files;
 }
 
@@ -226,6 +228,7 @@ GenerateOptions generateOptionsOf(const Manifest& m, const Variant& v, const Bui
   o.conventions = v.pass->conventions;
   o.rigParams = v.params;
   o.bannedRules = v.rig->bans;
+  if (auto pin = m.pins.find(v.name); pin != m.pins.end()) o.pin = pin->second;
   o.maxError = m.maxError;
   o.heuristic = m.heuristic;
   o.templateDir = m.templates;
@@ -265,7 +268,7 @@ void generateVariant(const Manifest& m, const SharedInputs& s, const Variant& v,
 void buildOne(const Manifest& m, const SharedInputs& s, const BuildOptions& opts, CacheStore& store,
               const std::string& validatorIdentity, BuiltVariant& out) {
   const Variant& v = *out.variant;
-  out.inputs = inputsOf(s, v);
+  out.inputs = inputsOf(m, s, v);
   out.skinWeights = s.rigs.at(v.rig->path).skinWeights;
   auto w = opts.workloads.find(v.name);
   const Workload* workload = w == opts.workloads.end() ? nullptr : &w->second;
@@ -403,6 +406,9 @@ std::string indexEntry(const Manifest& m, const BuiltVariant& b) {
   out += fmt::format("      \"rules\": {},\n", jsonStringArray(b.rules));
   if (!v.rig->bans.empty())  // a pinned plan (docs/variants.md): what its search left out
     out += fmt::format("      \"bans\": {},\n", jsonStringArray(v.rig->bans));
+  if (auto pin = m.pins.find(v.name); pin != m.pins.end())  // a measured choice: where it was timed fastest
+    out += fmt::format("      \"pin\": {{\"file\": {}, \"device\": {}, \"plan\": {}}},\n", jsonString(pin->second.file),
+                       jsonString(pin->second.device), jsonString(pin->second.label));
   out += fmt::format("      \"spirv_sha256\": {},\n", jsonString(b.spirvHash));
   out += fmt::format("      \"validated\": {},\n", b.validation ? "true" : "false");
   if (const auto& val = b.validation)  // where and when the result was made (cached with it)
@@ -469,6 +475,21 @@ bool parseEntry(const std::string& text, std::string& entry, std::vector<std::st
 BuildReport buildVariants(const Manifest& m, const std::vector<Variant>& variants, const BuildOptions& opts) {
   BuildReport report;
   SharedInputs shared = loadShared(m, variants, opts.gltf, report.warnings);
+  // A pin measured with other bytes still gives its plan (generation checks); the build says so,
+  // as generate --pin does. Its digest covers the files but the profiles and the pin.
+  for (const Variant& v : variants)
+    if (auto pin = m.pins.find(v.name); pin != m.pins.end()) {
+      std::vector<std::string> files;
+      for (const auto& f : inputsOf(m, shared, v))
+        if (f != pin->second.file && f != m.deviceProfile &&
+            std::find(m.portableProfiles.begin(), m.portableProfiles.end(), f) == m.portableProfiles.end())
+          files.push_back(f);
+      if (sha256OfFiles(files) != pin->second.inputs)
+        report.warnings.push_back(Diagnostic{Severity::Warning, pin->second.inputsLoc,
+                                             fmt::format("variant '{}': the inputs' bytes differ from those the pin was measured "
+                                                         "with on {} (the pin still gives its plan; its timing may not hold)",
+                                                         v.name, pin->second.device)});
+    }
   CacheStore store({opts.cacheDir, opts.cacheUrl, opts.cacheAuth, 1500, 20000, opts.warn});
   const std::string identity = opts.validator ? opts.validator->identity() : "";
   report.variants.resize(variants.size());
@@ -577,7 +598,7 @@ std::vector<PlannedVariant> planVariants(const Manifest& m, const std::vector<Va
   SharedInputs shared = loadShared(m, variants, GltfReadOptions{}, warnings);
   std::vector<PlannedVariant> out;
   for (const auto& v : variants) {
-    PlannedVariant p{inputsOf(shared, v), namedOutputs(m, v), ""};
+    PlannedVariant p{inputsOf(m, shared, v), namedOutputs(m, v), ""};
     Sha256 h;
     h.field(cacheKey(m, shared, v, p.inputs, nullptr, false)).field(v.name).field(v.rig->name).field(v.pass->name).field(m.outputDir);
     for (const auto& kind : m.emit) h.field(kind);

@@ -115,7 +115,7 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
   y.expectMap(root, "a manifest");
   y.checkKeys(root, {"output", "rules", "templates", "target_env", "optimize", "heuristic", "emit", "rigs", "passes",
                      "axes", "exclude", "name", "device_profile", "max_error", "hlsl_shader_model", "msl_version",
-                     "msl_platform", "validate", "cache_url", "mesh"});
+                     "msl_platform", "validate", "cache_url", "mesh", "pins"});
   m.outputDir = resolvePath(file, root["output"] ? y.scalar(root["output"], "'output'") : "shaders");
   // Optional: the command line may name every rules file (-r, the CMake function's RULES: a
   // manifest cannot reach an installed library by a relative path); `build` checks for none.
@@ -332,6 +332,16 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
       std::string axis = m.nameFormat.substr(i + 1, close - i - 1);
       if (!std::any_of(m.axes.begin(), m.axes.end(), [&](const ManifestAxis& a) { return a.name == axis; }))
         y.fail(root["name"], fmt::format("'name' uses unknown axis '{{{}}}'", axis));
+    }
+  }
+  if (root["pins"]) {  // { variant: pin file }: checked against the variants' names
+    y.expectMap(root["pins"], "'pins' (variant name: pin file)");
+    const std::vector<Variant> variants = expandVariants(m);
+    for (const auto& kv : root["pins"]) {
+      const std::string name = y.scalar(kv.first, "a variant name");
+      if (std::none_of(variants.begin(), variants.end(), [&](const Variant& v) { return v.name == name; }))
+        y.fail(kv.first, fmt::format("'pins' names '{}', which is no variant of this manifest", name));
+      m.pins.emplace(name, loadPin(resolvePath(file, y.scalar(kv.second, "a pin file"))));
     }
   }
   return m;

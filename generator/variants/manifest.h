@@ -12,6 +12,7 @@
 #include "common/glsl_compile.h"
 #include "emit/cross_compile.h"
 #include "interface/fragment_interface.h"
+#include "pipeline/pin.h"
 
 namespace sg {
 
@@ -96,6 +97,9 @@ struct Manifest {
   MslOptions msl;             // `msl_version:`, `msl_platform:`, when emit has msl
   ManifestValidation validate;  // `validate:`
   std::string cacheUrl;         // `cache_url:`, the shared cache (no credentials here)
+  // `pins:` variant name -> its pin (`bench --pin-out`, pipeline/pin.h): that variant's plan is the
+  // one a device timed fastest (docs/variants.md, "Pinning a plan"). Every name is a variant's.
+  std::map<std::string, Pin> pins;
   bool emits(const std::string& kind) const;
 };
 

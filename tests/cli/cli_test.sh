@@ -795,6 +795,18 @@ pin)
   done
   expect 0 "generate --pin again" -- "$SG" generate "${DAWN[@]}" --pin face.pin.yaml --emit glsl -o again.vert -q
   cmp -s pinned-slots.vert again.vert && ok "generate --pin: two runs, the same bytes" || fail "generate --pin: two runs differ"
+  # A manifest's variant pinned the same way (pins: { variant: file }): generate --pin's program.
+  cat > pins.variants.yaml <<YAML
+rules: $E/rules.yaml
+output: built
+rigs: { face: $E/face.rig.yaml }
+passes: { color: $E/face.frag }
+pins: { face-color: face.pin.yaml }
+YAML
+  expect 0 "build, a pinned variant" -- "$SG" build pins.variants.yaml -q --no-cache
+  cmp -s built/face-color.vert pinned-slots.vert && grep -q '"pin": {"file": "face.pin.yaml"' built/index.json &&
+    ok "a manifest's pin: the variant is generate --pin's program, index.json names the pin" ||
+    fail "pinned variant: $(diff built/face-color.vert pinned-slots.vert | head -5) $(grep pin built/index.json)"
   # A byte the pin was not measured with: the same plan, written, with a warning at its inputs line.
   cp "$E/face.frag" edited.frag && echo "// edited" >> edited.frag
   expect 0 "generate --pin, the request edited" -- "$SG" generate --rig "$E/face.rig.yaml" -f edited.frag -r "$E/rules.yaml" --pin face.pin.yaml --emit glsl -o edited.vert -q
