@@ -197,8 +197,9 @@ struct BenchCommand {
 
   // The fastest validated plan as a pin (pipeline/pin.h).
   void writePin(const GpuBenchReport& rep) const {
-    if (rep.fastestPlan < 0) throw std::runtime_error("--pin-out: no plan was timed by " + rep.predictionClock);
-    const GpuBenchRow& f = rep.rows[size_t(rep.fastestPlan)];
+    const int chosen = pinnedPlan(rep);
+    if (chosen < 0) throw std::runtime_error("--pin-out: no plan was timed by " + rep.predictionClock);
+    const GpuBenchRow& f = rep.rows[size_t(chosen)];
     Pin pin;
     pin.device = rep.device;
     pin.driver = rep.driver;
@@ -209,14 +210,12 @@ struct BenchCommand {
     pin.rules.assign(rules.begin(), rules.end());
     pin.bans = f.pin;
     pin.inputs = rep.inputs;
-    // The prediction clock's best round, as checkPredictions picked the fastest by.
-    auto best = [](const GpuBenchRow& r) { return *std::min_element(r.roundNsPerVertex.begin(), r.roundNsPerVertex.end()); };
-    pin.nsPerVertex = best(f);
-    pin.generatedNsPerVertex = best(rep.rows.front());
+    pin.nsPerVertex = slowestRound(f);
+    pin.generatedNsPerVertex = slowestRound(rep.rows.front());
     for (const auto& row : rep.rows) pin.candidates += row.hasCost && row.validation == "pass";
     writeFilesAtomically({{pinOut, formatPin(pin)}});
-    std::cout << fmt::format("{}: pins {} ({:.4f} ns per vertex; the generated plan {:.4f})\n", pinOut, f.label,
-                             pin.nsPerVertex, pin.generatedNsPerVertex);
+    std::cout << fmt::format("{}: pins {} (its slowest round {:.4f} ns per vertex; the generated plan's {:.4f})\n", pinOut,
+                             f.label, pin.nsPerVertex, pin.generatedNsPerVertex);
   }
 
   // Prints the report; returns how many programs failed on the device.

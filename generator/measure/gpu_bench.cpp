@@ -253,6 +253,21 @@ uint32_t drawsPerFrame(uint32_t draws, uint32_t minVertices, size_t vertices) {
   return uint32_t(std::min<uint64_t>(kMostDrawsPerFrame, std::max<uint64_t>({1, draws, needed})));
 }
 
+double slowestRound(const GpuBenchRow& row) {
+  if (row.roundNsPerVertex.empty()) return NAN;
+  return *std::max_element(row.roundNsPerVertex.begin(), row.roundNsPerVertex.end());
+}
+
+int pinnedPlan(const GpuBenchReport& r) {
+  int best = -1;
+  for (size_t i = 0; i < r.rows.size(); ++i) {
+    const GpuBenchRow& row = r.rows[i];
+    if (!row.hasCost || row.validation != "pass" || std::isnan(slowestRound(row))) continue;
+    if (best < 0 || slowestRound(row) < slowestRound(r.rows[size_t(best)])) best = int(i);
+  }
+  return best;
+}
+
 bool isCpuDevice(const std::string& deviceName) { return deviceName.find("llvmpipe") != std::string::npos; }
 
 void timeCpuDevicesSingleThreaded() { setenv("LP_NUM_THREADS", "0", /*overwrite=*/0); }

@@ -781,7 +781,7 @@ pin)
   [ "$rows" -eq 3 ] && ok "bench: 3 candidates timed, each validated" || fail "bench: $rows candidates passed, expected 3: $(cat bench.out)"
   label=$(sed -n 's/^plan: "\(.*\)"$/\1/p' face.pin.yaml)
   grep -q "^fastest validated plan (.*): \(the generated one\|$label\)" bench.out && [ -n "$label" ] &&
-    ok "the pin is bench's fastest ($label)" || fail "pin plan '$label' is not bench's fastest: $(grep fastest bench.out)"
+    ok "one round: the pin is bench's fastest ($label)" || fail "pin plan '$label' is not bench's fastest: $(grep fastest bench.out)"
   # The rules the generated GLSL names (one comment per rule) are the pin's, with or without a profile.
   glsl_rules() { sed -n 's|^  // \([a-z0-9_]*\) -> .*|\1|p' "$1" | sort -u | tr '\n' ' '; }
   pin_rules=$(sed -n 's/^rules: \[\(.*\)\]$/\1/p' face.pin.yaml | tr -d ',' | tr ' ' '\n' | sort -u | tr '\n' ' ')
