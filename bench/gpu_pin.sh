@@ -8,14 +8,14 @@
 # Usage: bash gpu_pin.sh [DEVICE=NVIDIA] [OUTDIR=.] ; SG_SEEDS="68 69" (corpus seeds, 6 rigs each),
 # SG_PROFILE (default the bundle's devices/nvidia-h200-raster.yaml), SG_CANDIDATES (4),
 # SG_MESHES ("dawn head"), SG_SUITE=1 also the Dawn face, its body's depth pass and the suite's held-out
-# rigs, SG_RASTER (on; off on lavapipe: its clock is then the process's CPU time, as calibrate's), SG_ROUNDS (2).
+# rigs, SG_RASTER (on; off on lavapipe: its clock is then the process's CPU time, as calibrate's), SG_ROUNDS (3).
 set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 device=${1-NVIDIA}
 outdir=${2:-.}
 source "$here/gpu_env.sh"
 profile=${SG_PROFILE:-$here/devices/nvidia-h200-raster.yaml}
-t=(--no-validation-layers --raster "${SG_RASTER:-on}" --no-floor --draws 32 --min-frame-vertices 64000 --frames 7 --rounds "${SG_ROUNDS:-2}"
+t=(--no-validation-layers --raster "${SG_RASTER:-on}" --no-floor --draws 32 --min-frame-vertices 64000 --frames 7 --rounds "${SG_ROUNDS:-3}"
    --device "$device" --device-profile "$profile")
 dawnRules=(-r "$here/examples/dawn/rules.yaml" --templates "$here/templates")
 std=(-r "$here/rules/standard.yaml" --templates "$here/templates")

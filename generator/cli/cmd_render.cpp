@@ -210,11 +210,11 @@ struct BenchCommand {
     pin.rules.assign(rules.begin(), rules.end());
     pin.bans = f.pin;
     pin.inputs = rep.inputs;
-    pin.nsPerVertex = slowestRound(f);
-    pin.generatedNsPerVertex = slowestRound(rep.rows.front());
+    pin.nsPerVertex = medianRound(f);
+    pin.generatedNsPerVertex = medianRound(rep.rows.front());
     for (const auto& row : rep.rows) pin.candidates += row.hasCost && row.validation == "pass";
     writeFilesAtomically({{pinOut, formatPin(pin)}});
-    std::cout << fmt::format("{}: pins {} (its slowest round {:.4f} ns per vertex; the generated plan's {:.4f})\n", pinOut,
+    std::cout << fmt::format("{}: pins {} (its median round {:.4f} ns per vertex; the generated plan's {:.4f})\n", pinOut,
                              f.label, pin.nsPerVertex, pin.generatedNsPerVertex);
   }
 

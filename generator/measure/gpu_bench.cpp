@@ -253,17 +253,17 @@ uint32_t drawsPerFrame(uint32_t draws, uint32_t minVertices, size_t vertices) {
   return uint32_t(std::min<uint64_t>(kMostDrawsPerFrame, std::max<uint64_t>({1, draws, needed})));
 }
 
-double slowestRound(const GpuBenchRow& row) {
+double medianRound(const GpuBenchRow& row) {
   if (row.roundNsPerVertex.empty()) return NAN;
-  return *std::max_element(row.roundNsPerVertex.begin(), row.roundNsPerVertex.end());
+  return medianOf(row.roundNsPerVertex);
 }
 
 int pinnedPlan(const GpuBenchReport& r) {
   int best = -1;
   for (size_t i = 0; i < r.rows.size(); ++i) {
     const GpuBenchRow& row = r.rows[i];
-    if (!row.hasCost || row.validation != "pass" || std::isnan(slowestRound(row))) continue;
-    if (best < 0 || slowestRound(row) < slowestRound(r.rows[size_t(best)])) best = int(i);
+    if (!row.hasCost || row.validation != "pass" || std::isnan(medianRound(row))) continue;
+    if (best < 0 || medianRound(row) < medianRound(r.rows[size_t(best)])) best = int(i);
   }
   return best;
 }

@@ -120,11 +120,12 @@ struct GpuBenchReport {
 GpuBenchReport runGpuBench(const GpuBenchOptions& opts);
 
 // The plan a measured choice pins (bench --pin-out): of the validated plans the prediction clock
-// timed, the one whose slowest round is the fastest (-1: none). Not the best round, which the
+// timed, the one whose median round is the fastest (-1: none). Not the best round, which the
 // report's "fastest" line uses: on lavapipe one round of one program once read 0.37x its other
-// round and every other program's, and a best round would pin that artifact.
+// round and every other program's, and a best round pinned that. Not the slowest round either:
+// one slow round of the fastest program (another process on the CPU) then pinned a slower one.
 int pinnedPlan(const GpuBenchReport& r);
-double slowestRound(const GpuBenchRow& row);  // NaN: never timed
+double medianRound(const GpuBenchRow& row);  // NaN: never timed
 
 // Draws per timed frame of a mesh of `vertices`: at least `draws`, and enough that the frame
 // draws `minVertices` vertices, at most kMostDrawsPerFrame.

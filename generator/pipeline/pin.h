@@ -20,7 +20,7 @@ struct Pin {
   std::vector<std::string> rules;     // the pinned plan's rule names, sorted, each once
   std::vector<std::string> bans;      // sorted
   std::string inputs;                 // sha256OfFiles (common/content_hash.h) of GenerateResult::pinnedInputs
-  double nsPerVertex = -1;            // the pinned plan's slowest round (measure/gpu_bench.h pinnedPlan)
+  double nsPerVertex = -1;            // the pinned plan's median round (measure/gpu_bench.h pinnedPlan)
   double generatedNsPerVertex = -1;   // the search's own choice's, in the same run
   size_t candidates = 0;              // how many validated plans were timed
   SourceLoc rulesLoc, banLoc, inputsLoc;  // where a check against them points (read pins)
