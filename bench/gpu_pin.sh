@@ -8,7 +8,7 @@
 # Usage: bash gpu_pin.sh [DEVICE=NVIDIA] [OUTDIR=.] ; SG_SEEDS="68 69" (corpus seeds, 6 rigs each),
 # SG_PROFILE (default the bundle's devices/nvidia-h200-raster.yaml), SG_CANDIDATES (4),
 # SG_MESHES ("dawn head"), SG_SUITE=1 also the Dawn face, its body's depth pass and the suite's held-out
-# rigs, SG_RASTER (on; off on lavapipe: its clock is then the process's CPU time, as calibrate's), SG_ROUNDS (3).
+# rigs, SG_MODELS=1 the shared glTF models' skinned and morphed parts on their own meshes, SG_RASTER (on; off on lavapipe: its clock is then the process's CPU time, as calibrate's), SG_ROUNDS (3).
 set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 device=${1-NVIDIA}
@@ -34,7 +34,26 @@ pair() {  # pair NAME RIG FRAG RULES...: every mesh of SG_MESHES
     echo "== $name $mesh: tune exit $rc, $((SECONDS - t0)) s"
   done
 }
-for seed in ${SG_SEEDS:-68}; do
+model() {  # model NAME RIG FRAG RULES...: a glTF primitive, drawn on its own mesh
+  local name=$1 rig=$2 frag=$3; shift 3
+  local t0=$SECONDS
+  "$sg" bench "${t[@]}" --rig "$rig" -f "$frag" "$@" --candidates "${SG_CANDIDATES:-4}" \
+    --pin-out "$outdir/pins/$name-own.pin.yaml" > "$outdir/tune/$name-own.log" 2>&1
+  local rc=$?
+  if [ "${SG_PIN_CHECK:-12}" -gt 0 ]; then
+    "$sg" bench "${t[@]}" --rig "$rig" -f "$frag" "$@" --candidates "${SG_PIN_CHECK:-12}" > "$outdir/check/$name-own.log" 2>&1
+  fi
+  echo "== $name own mesh: tune exit $rc, $((SECONDS - t0)) s"
+}
+if [ "${SG_MODELS:-0}" = 1 ]; then  # the shared glTF models' skinned and morphed parts, on their own meshes
+  m="$here/examples/models"
+  model fox "$m/Fox.glb#0/0" "$here/examples/gltf/solid.frag" "${std[@]}"
+  model cesiumman "$m/CesiumMan.glb#0/0" "$here/examples/gltf/lit.frag" "${std[@]}"
+  for part in 1/0 2/0 12/0; do
+    model "robot-${part/\//_}" "$m/RobotExpressive.glb#$part" "$here/examples/gltf/lit.frag" "${std[@]}"
+  done
+fi
+for seed in ${SG_SEEDS-68}; do
   "$sg" calibrate --corpus 6 --seed "$seed" -f "$here/examples/dawn/face.frag" "${dawnRules[@]}" \
     --write-corpus "$outdir/corpus/s$seed" > /dev/null
   for rig in "$outdir/corpus/s$seed"/*.rig.yaml; do
