@@ -92,6 +92,32 @@ TEST(GpuBench, TheGeneratedOverTheFastestIsAlsoTakenWithinEachRound) {
   EXPECT_TRUE(std::isnan(s.least) && std::isnan(s.most));
 }
 
+TEST(GpuBench, APinTakesThePlanWhoseMedianRoundIsFastest) {
+  // Medians: generated 10, a 9.5 (one round read far low: best round 3), b 9 (one slow round:
+  // slowest 20), c 9.8. The best round would pin a, the slowest round c; the median pins b.
+  // Floors, failed plans and plans never timed are not pinned.
+  auto row = [](const char* label, bool cost, const char* validation, std::vector<double> rounds) {
+    sg::GpuBenchRow r;
+    r.label = label;
+    r.hasCost = cost;
+    r.validation = validation;
+    r.roundNsPerVertex = std::move(rounds);
+    return r;
+  };
+  sg::GpuBenchReport rep;
+  rep.rows = {row("generated", true, "pass", {10, 10, 10}), row("a", true, "pass", {3, 9.5, 9.6}),
+              row("b", true, "pass", {9, 20, 8.9}),         row("c", true, "pass", {9.8, 9.8, 9.9}),
+              row("floor", false, "", {1, 1, 1}),           row("failed", true, "FAIL: x", {1, 1, 1}),
+              row("untimed", true, "pass", {})};
+  EXPECT_EQ(sg::pinnedPlan(rep), 2);
+  EXPECT_DOUBLE_EQ(sg::medianRound(rep.rows[2]), 9.0);
+  EXPECT_TRUE(std::isnan(sg::medianRound(rep.rows[6])));
+  rep.rows.resize(1);
+  EXPECT_EQ(sg::pinnedPlan(rep), 0);  // alone, the generated plan is its own pin
+  rep.rows[0].validation = "FAIL: y";
+  EXPECT_EQ(sg::pinnedPlan(rep), -1);
+}
+
 TEST(GpuBench, CaptureQualifiersGoOnEveryOutputAndUnknownOutputsAreErrors) {
   sg::EmittedGlsl capture;
   capture.captureStride = 32;
@@ -182,6 +208,38 @@ TEST(GpuBench, BufferFedAlternativesAreValidatedAndTimed) {
     programs.insert(row.program);
   }
   EXPECT_EQ(programs.size(), rep.rows.size());
+}
+
+TEST(GpuBench, CandidatesAreTheCheapestPlansEachPinnedAndTimed) {
+  // --candidates 4: the generated plan and the next three by predicted time, in that order,
+  // each validated and timed; each row's pin, searched under another profile, is its plan.
+  sg::GpuBenchOptions b = quickBench(sourcePath("examples/dawn/rules.yaml"));
+  b.render.gen.deviceProfilePath = sourcePath("devices/llvmpipe-2core.yaml");
+  b.candidates = 4;
+  b.floor = false;
+  const sg::GpuBenchReport rep = sg::runGpuBench(b);
+  ASSERT_EQ(rep.rows.size(), 4u);
+  EXPECT_EQ(rep.rows[0].label, "generated");
+  for (size_t i = 0; i < rep.rows.size(); ++i) {
+    const sg::GpuBenchRow& row = rep.rows[i];
+    EXPECT_EQ(row.validation, "pass") << row.label;
+    EXPECT_GT(row.rasterOnNsPerVertex, 0) << row.label;
+    if (i > 0) {
+      EXPECT_EQ(row.label, "cheapest plan #" + std::to_string(i + 1));
+      EXPECT_LE(rep.rows[i - 1].predictedNsPerVertex, row.predictedNsPerVertex) << row.label;
+    }
+    sg::GenerateOptions o = b.render.gen;
+    o.deviceProfilePath = sourcePath("devices/nvidia-h200-raster.yaml");
+    o.bannedRules = row.pin;
+    const sg::GenerateResult g = sg::generate(o);
+    std::vector<std::string> rules;
+    for (int a : g.plan.actions) rules.push_back(g.in.problem.actions[size_t(a)].name);
+    std::vector<std::string> want = row.rules;
+    std::sort(rules.begin(), rules.end());
+    std::sort(want.begin(), want.end());
+    EXPECT_EQ(rules, want) << row.label << ": its pin gives another plan under another profile";
+  }
+  EXPECT_EQ(rep.inputs.size(), 64u);
 }
 
 TEST(GpuBench, AProgramHasTheSameNameInEveryRun) {
