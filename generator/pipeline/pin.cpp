@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <set>
 
 #include "common/input_file.h"
@@ -13,11 +14,13 @@
 namespace sg {
 namespace {
 
-// A YAML flow sequence of plain names (rule names are identifiers; quoted all the same).
+// Written by yaml-cpp's emitter, so that any name or text reads back as itself.
 std::string flowList(const std::vector<std::string>& names) {
-  std::vector<std::string> quoted;
-  for (const auto& n : names) quoted.push_back(YAML::Dump(YAML::Node(n)));
-  return "[" + fmt::format("{}", fmt::join(quoted, ", ")) + "]";
+  YAML::Emitter e;
+  e << YAML::Flow << YAML::BeginSeq;
+  for (const auto& n : names) e << YAML::DoubleQuoted << n;
+  e << YAML::EndSeq;
+  return e.c_str();
 }
 
 std::string quoted(const std::string& s) {
@@ -26,10 +29,36 @@ std::string quoted(const std::string& s) {
   return e.c_str();
 }
 
+// Well-formed UTF-8 without control characters: what bench writes (device names, labels, rule
+// names), and what the writer's quoting gives back unchanged.
+bool plainText(const std::string& s) {
+  for (size_t i = 0; i < s.size();) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    size_t n = c < 0x80 ? 0 : (c & 0xE0) == 0xC0 ? 1 : (c & 0xF0) == 0xE0 ? 2 : (c & 0xF8) == 0xF0 ? 3 : 4;
+    if (n == 4 || (n == 0 && (c < 0x20 || c == 0x7F)) || (n == 1 && c < 0xC2) || (n > 0 && i + n >= s.size())) return false;
+    uint32_t cp = n == 0 ? c : c & (0x3F >> n);
+    for (size_t k = 1; k <= n; ++k) {
+      const unsigned char d = static_cast<unsigned char>(s[i + k]);
+      if ((d & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (d & 0x3F);
+    }
+    // Overlong forms, surrogates and code points past Unicode.
+    if ((n == 2 && cp < 0x800) || (n == 3 && cp < 0x10000) || (cp >= 0xD800 && cp <= 0xDFFF) || cp > 0x10FFFF) return false;
+    i += n + 1;
+  }
+  return true;
+}
+
+std::string textOf(const YamlCtx& y, const YAML::Node& n, const char* what) {
+  std::string s = y.scalar(n, what);
+  if (!plainText(s)) y.fail(n, fmt::format("{}: expected text (UTF-8, no control characters)", what));
+  return s;
+}
+
 std::vector<std::string> names(const YamlCtx& y, const YAML::Node& n, const char* what) {
   y.expectSeq(n, what);
   std::vector<std::string> out;
-  for (const auto& item : n) out.push_back(y.scalar(item, what));
+  for (const auto& item : n) out.push_back(textOf(y, item, what));
   std::vector<std::string> sorted = out;
   std::sort(sorted.begin(), sorted.end());
   if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) y.fail(n, fmt::format("{} names a rule twice", what));
@@ -37,14 +66,14 @@ std::vector<std::string> names(const YamlCtx& y, const YAML::Node& n, const char
 }
 
 double time(const YamlCtx& y, const YAML::Node& n, const char* what) {
-  const std::string text = y.scalar(n, what);
+  const std::string number = y.scalar(n, what);
   double v = NAN;
   size_t used = 0;
   try {
-    v = std::stod(text, &used);
+    v = std::stod(number, &used);
   } catch (const std::exception&) {
   }
-  if (used != text.size() || !std::isfinite(v) || v <= 0) y.fail(n, fmt::format("{}: expected a positive number of nanoseconds", what));
+  if (used != number.size() || !std::isfinite(v) || v <= 0) y.fail(n, fmt::format("{}: expected a positive number of nanoseconds", what));
   return v;
 }
 
@@ -59,8 +88,8 @@ std::string formatPin(const Pin& p) {
   s += fmt::format("candidates: {}\n", p.candidates);
   s += fmt::format("plan: {}\n", quoted(p.label));
   s += fmt::format("program: {}\n", quoted(p.program));
-  s += fmt::format("ns_per_vertex: {:.4f}\n", p.nsPerVertex);
-  s += fmt::format("generated_ns_per_vertex: {:.4f}\n", p.generatedNsPerVertex);
+  s += fmt::format("ns_per_vertex: {}\n", p.nsPerVertex);  // shortest text that reads back as the same double
+  s += fmt::format("generated_ns_per_vertex: {}\n", p.generatedNsPerVertex);
   s += fmt::format("rules: {}\n", flowList(p.rules));
   s += fmt::format("ban: {}\n", flowList(p.bans));
   s += fmt::format("inputs: {}\n", p.inputs);
@@ -78,14 +107,14 @@ Pin parsePin(const std::string& text, const std::string& file) {
     if (!root[key]) y.fail(root, fmt::format("a pin needs '{}' (bench --pin-out writes every key)", key));
   Pin p;
   p.file = file;
-  p.device = y.scalar(root["device"], "device");
-  p.driver = y.scalar(root["driver"], "driver");
-  p.clock = y.scalar(root["clock"], "clock");
+  p.device = textOf(y, root["device"], "device");
+  p.driver = textOf(y, root["driver"], "driver");
+  p.clock = textOf(y, root["clock"], "clock");
   const long long candidates = y.integer(root["candidates"], "candidates");
   if (candidates < 1) y.fail(root["candidates"], "candidates: expected a count of at least 1");
   p.candidates = size_t(candidates);
-  p.label = y.scalar(root["plan"], "plan");
-  p.program = y.scalar(root["program"], "program");
+  p.label = textOf(y, root["plan"], "plan");
+  p.program = textOf(y, root["program"], "program");
   p.nsPerVertex = time(y, root["ns_per_vertex"], "ns_per_vertex");
   p.generatedNsPerVertex = time(y, root["generated_ns_per_vertex"], "generated_ns_per_vertex");
   p.rules = names(y, root["rules"], "rules");

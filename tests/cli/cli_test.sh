@@ -784,7 +784,7 @@ pin)
     ok "one round: the pin is bench's fastest ($label)" || fail "pin plan '$label' is not bench's fastest: $(grep fastest bench.out)"
   # The rules the generated GLSL names (one comment per rule) are the pin's, with or without a profile.
   glsl_rules() { sed -n 's|^  // \([a-z0-9_]*\) -> .*|\1|p' "$1" | sort -u | tr '\n' ' '; }
-  pin_rules=$(sed -n 's/^rules: \[\(.*\)\]$/\1/p' face.pin.yaml | tr -d ',' | tr ' ' '\n' | sort -u | tr '\n' ' ')
+  pin_rules=$(sed -n 's/^rules: \[\(.*\)\]$/\1/p' face.pin.yaml | tr -d ',"' | tr ' ' '\n' | sort -u | tr '\n' ' ')
   for profile in "" "$SRC/devices/nvidia-h200-raster.yaml"; do
     args=(); [ -n "$profile" ] && args=(--device-profile "$profile" --mesh dawn)
     expect 0 "generate --pin ${profile:+under another profile}" -- "$SG" generate "${DAWN[@]}" --pin face.pin.yaml "${args[@]}" --emit glsl -o pinned.vert -q
@@ -814,7 +814,7 @@ YAML
     fail "no warning for an edited input: $(cat last.err)"
   # The pin no longer what the inputs give (a rule taken from its plan): a located error, nothing written.
   first=$(echo $pin_rules | cut -d' ' -f1)
-  sed "s/^rules: \[$first, /rules: [/" face.pin.yaml > stale.pin.yaml
+  sed "s/^rules: \[\"$first\", /rules: [/" face.pin.yaml > stale.pin.yaml
   expect 1 "generate --pin, a stale pin" -- "$SG" generate "${DAWN[@]}" --pin stale.pin.yaml --emit glsl -o stale.vert -q
   grep -q "^stale.pin.yaml:[0-9]*:[0-9]*: error: the pinned plan is not what these inputs give under its bans (without: -; instead: $first)" last.err &&
     [ ! -e stale.vert ] && ok "a stale pin: located error, nothing written" || fail "stale pin: $(cat last.err)"

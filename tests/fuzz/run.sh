@@ -4,13 +4,13 @@
 # one line per target: runs, exec/s, corpus size, result. Exit status 1 if any target found
 # something (its reproducer is in BUILD/fuzz/artifacts/).
 #
-#   tests/fuzz/run.sh BUILD SECONDS [target...]      targets: rig rules expr fragment gltf generate profile
+#   tests/fuzz/run.sh BUILD SECONDS [target...]      targets: rig rules expr fragment gltf generate profile pin
 set -uo pipefail
 BUILD=$(cd "$1" && pwd) SECS=$2
 shift 2
 SRC=$(cd "$(dirname "$0")/../.." && pwd)
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(rig rules expr fragment gltf generate profile)
+[ ${#targets[@]} -gt 0 ] || targets=(rig rules expr fragment gltf generate profile pin)
 source "$SRC/cmake/sanitizers/env.sh"
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/shadergen-xdg}
 W=$BUILD/fuzz
@@ -36,6 +36,7 @@ seeds() {
     fragment) add "$SRC"/examples/**/*.frag "$SRC"/tests/**/*.frag ;;
     gltf) add "$SRC"/tests/bad-input/gltf/**/*.gltf "$SRC"/tests/bad-input/gltf/**/*.glb "$SRC"/tests/gltf/data/gltfpack/*.glb \
             "$SRC"/../shared/models/**/*.gltf "$SRC"/../shared/models/**/*.glb ;;
+    pin) add "$SRC"/tests/bad-input/cli/*/pin.yaml "$SRC"/bench/data/**/*.pin.yaml ;;
     profile) add "$SRC"/devices/*.yaml "$SRC"/tests/bad-input/profile/**/*.yaml "$SRC"/bench/data/**/*.yaml ;;
     generate)  # rig %% fragment %% rules triples from the examples
       local ex=$SRC/examples
