@@ -63,22 +63,25 @@ TEST(GpuBench, PredictionsAreCheckedByTheClockAsked) {
   EXPECT_DOUBLE_EQ(cpu.generatedOverFastest, 1.0);
 }
 
+// A row as the round checks see it: a plan (cost) or not, its validation, its time in each round.
+sg::GpuBenchRow roundsRow(const char* label, bool cost, const char* validation, std::vector<double> rounds) {
+  sg::GpuBenchRow r;
+  r.label = label;
+  r.hasCost = cost;
+  r.validation = validation;
+  r.roundNsPerVertex = std::move(rounds);
+  return r;
+}
+
 TEST(GpuBench, TheGeneratedOverTheFastestIsAlsoTakenWithinEachRound) {
   // Three rounds; within each, the generated program's time over the fastest passing plan's:
   // round 0: 10 / 8 = 1.25 (b fastest); round 1: 9 / 9 = 1 (itself); round 2: 12 / 10 = 1.2.
   // A floor and a failed plan are not plans to beat; neither is a row timed in fewer rounds
   // (then the rounds every plan has count: here all three).
-  auto row = [](const char* label, bool cost, const char* validation, std::vector<double> rounds) {
-    sg::GpuBenchRow r;
-    r.label = label;
-    r.hasCost = cost;
-    r.validation = validation;
-    r.roundNsPerVertex = std::move(rounds);
-    return r;
-  };
-  std::vector<sg::GpuBenchRow> rows = {row("generated", true, "pass", {10, 9, 12}), row("a", true, "pass", {11, 9.5, 10}),
-                                       row("b", true, "pass", {8, 10, 13}), row("floor", false, "", {1, 1, 1}),
-                                       row("failed", true, "FAIL: x", {1, 1, 1})};
+  std::vector<sg::GpuBenchRow> rows = {
+      roundsRow("generated", true, "pass", {10, 9, 12}), roundsRow("a", true, "pass", {11, 9.5, 10}),
+      roundsRow("b", true, "pass", {8, 10, 13}), roundsRow("floor", false, "", {1, 1, 1}),
+      roundsRow("failed", true, "FAIL: x", {1, 1, 1})};
   sg::RoundSpread s = sg::generatedOverFastestByRound(rows);
   EXPECT_EQ(s.rounds, 3u);
   EXPECT_DOUBLE_EQ(s.least, 1.0);
@@ -96,19 +99,11 @@ TEST(GpuBench, APinTakesThePlanWhoseMedianRoundIsFastest) {
   // Medians: generated 10, a 9.5 (one round read far low: best round 3), b 9 (one slow round:
   // slowest 20), c 9.8. The best round would pin a, the slowest round c; the median pins b.
   // Floors, failed plans and plans never timed are not pinned.
-  auto row = [](const char* label, bool cost, const char* validation, std::vector<double> rounds) {
-    sg::GpuBenchRow r;
-    r.label = label;
-    r.hasCost = cost;
-    r.validation = validation;
-    r.roundNsPerVertex = std::move(rounds);
-    return r;
-  };
   sg::GpuBenchReport rep;
-  rep.rows = {row("generated", true, "pass", {10, 10, 10}), row("a", true, "pass", {3, 9.5, 9.6}),
-              row("b", true, "pass", {9, 20, 8.9}),         row("c", true, "pass", {9.8, 9.8, 9.9}),
-              row("floor", false, "", {1, 1, 1}),           row("failed", true, "FAIL: x", {1, 1, 1}),
-              row("untimed", true, "pass", {})};
+  rep.rows = {roundsRow("generated", true, "pass", {10, 10, 10}), roundsRow("a", true, "pass", {3, 9.5, 9.6}),
+              roundsRow("b", true, "pass", {9, 20, 8.9}),         roundsRow("c", true, "pass", {9.8, 9.8, 9.9}),
+              roundsRow("floor", false, "", {1, 1, 1}),           roundsRow("failed", true, "FAIL: x", {1, 1, 1}),
+              roundsRow("untimed", true, "pass", {})};
   EXPECT_EQ(sg::pinnedPlan(rep), 2);
   EXPECT_DOUBLE_EQ(sg::medianRound(rep.rows[2]), 9.0);
   EXPECT_TRUE(std::isnan(sg::medianRound(rep.rows[6])));
