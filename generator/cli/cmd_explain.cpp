@@ -10,6 +10,7 @@
 #include "analysis/graph.h"
 #include "cli/commands.h"
 #include "cli/output_files.h"
+#include "common/content_hash.h"
 #include "pipeline/generate.h"
 #include "search/astar.h"
 
@@ -29,6 +30,11 @@ std::pair<LoadedInputs, std::optional<Plan>> loadAndSearch(const GenerateOptions
   GenerateOptions searched = o;
   searched.bannedRules.clear();  // applied above
   Plan plan = searchUnderOptions(in, searched);
+  if (o.pin) {  // as generate checks and warns
+    checkPin(*o.pin, in.problem, plan);
+    if (auto changed = pinInputsChanged(*o.pin, sha256OfFiles(pinnedInputs(in, loadTemplatesStage(o.templateDir)))))
+      std::cerr << formatDiagnostic(*changed) << "\n";
+  }
   return {std::move(in), std::move(plan)};
 }
 

@@ -288,13 +288,8 @@ struct GenerateCommand {
     writeFilesAtomically(files);
     if (stats) std::cout << describeStats(r.stats);
     for (const auto& n : r.in.notes) std::cerr << formatDiagnostic(n) << "\n";
-    // The pin still gives its plan (generate checked); bytes it was not measured with are said.
-    if (o.pin && sha256OfFiles(r.pinnedInputs) != o.pin->inputs)
-      std::cerr << formatDiagnostic(Diagnostic{Severity::Warning, o.pin->inputsLoc,
-                                               fmt::format("the inputs' bytes differ from those the pin was measured with on "
-                                                           "{} (the pin still gives its plan, which is written; its timing "
-                                                           "may not hold)", o.pin->device)})
-                << "\n";
+    if (o.pin)
+      if (auto changed = pinInputsChanged(*o.pin, sha256OfFiles(r.pinnedInputs))) std::cerr << formatDiagnostic(*changed) << "\n";
     if (!quiet) {
       printPlan(r);
       for (const auto& f : files) std::cout << "wrote " << f.path << "\n";

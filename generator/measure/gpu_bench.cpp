@@ -460,6 +460,8 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   GpuBenchReport rep;
   rep.notes = in.notes;
   rep.inputs = sha256OfFiles(chosen.pinnedInputs);
+  if (opts.render.gen.pin)
+    if (auto changed = pinInputsChanged(*opts.render.gen.pin, rep.inputs)) rep.notes.push_back(*changed);
   rep.device = validator.harness().deviceName();
   rep.limits = limits;
   rep.driver = renderer.driver();

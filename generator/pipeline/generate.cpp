@@ -266,8 +266,6 @@ std::vector<std::string> inputsRead(const LoadedInputs& in, const TemplateSet& t
 
 // ---- the stages in order ------------------------------------------------------------------
 
-namespace {
-
 std::vector<std::string> pinnedInputs(const LoadedInputs& in, const TemplateSet& templates) {
   std::set<std::string> profiles;
   if (in.profile) profiles.insert(in.profile->file);
@@ -297,8 +295,6 @@ void checkPin(const Pin& pin, const Problem& problem, const Plan& plan) {
                                  extra.empty() ? "-" : fmt::format("{}", fmt::join(extra, ", "))));
   }
 }
-
-}  // namespace
 
 Plan searchUnderOptions(LoadedInputs& in, const GenerateOptions& opts, SearchStats* stats) {
   if (!opts.bannedRules.empty()) in.problem = withoutRules(in.problem, opts.bannedRules);

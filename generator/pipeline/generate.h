@@ -122,6 +122,11 @@ std::vector<RankedPlan> cheapestPlans(const LoadedInputs& in, const GenerateOpti
 // fact the plan produces, and the bans it was searched with (`p` no longer has those rules). A
 // plan pinned by them stays the plan whatever the costs (the workload, the profile) it is
 // searched under (bench --pin-out, generate --pin). Sorted.
+// The checks a pin gets wherever it is read: the plan found under its bans must have its rules
+// (else a located error at `rules:`: the inputs changed what the bans leave), and the files its
+// digest covers (inputsRead less the device profiles and the pin).
+void checkPin(const Pin& pin, const Problem& problem, const Plan& plan);
+std::vector<std::string> pinnedInputs(const LoadedInputs& in, const TemplateSet& templates);
 std::vector<std::string> bansPinning(const Problem& p, const Plan& plan, const std::vector<std::string>& searchedWith);
 // The stages after loading, for a rig already loaded (loadInputs and `build` share them):
 // the error budgets (opts.maxError) take over-budget encodings out of the rig; a value the

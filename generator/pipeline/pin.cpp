@@ -134,4 +134,12 @@ Pin parsePin(const std::string& text, const std::string& file) {
 
 Pin loadPin(const std::string& path) { return parsePin(readInputFile(path), path); }
 
+std::optional<Diagnostic> pinInputsChanged(const Pin& pin, const std::string& inputsDigest) {
+  if (inputsDigest == pin.inputs) return std::nullopt;
+  return Diagnostic{Severity::Warning, pin.inputsLoc,
+                    fmt::format("the inputs' bytes differ from those the pin was measured with on {} (the pin still "
+                                "gives its plan; its timing may not hold)",
+                                pin.device)};
+}
+
 }  // namespace sg

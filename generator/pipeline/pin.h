@@ -5,6 +5,7 @@
 // and a digest of the inputs' bytes (a change is reported). docs/performance.md, "A measured
 // choice".
 #pragma once
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,5 +32,10 @@ struct Pin {
 std::string formatPin(const Pin& pin);
 Pin parsePin(const std::string& text, const std::string& file);
 Pin loadPin(const std::string& path);
+// The warning, at the pin's `inputs:`, when `inputsDigest` (sha256OfFiles of
+// GenerateResult::pinnedInputs: the rig, request, rules and templates) is not the digest of the
+// bytes the pin was measured with; the pin still gives its plan. Every command that reads a pin
+// says it through this. (The caller hashes: libcrypto stays out of shadergen_core.)
+std::optional<Diagnostic> pinInputsChanged(const Pin& pin, const std::string& inputsDigest);
 
 }  // namespace sg

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <map>
 
+#include "common/content_hash.h"
 #include "common/input_file.h"
 #include "runtime/procedural.h"
 #include "runtime/reference.h"
@@ -292,6 +293,8 @@ RenderResult RenderSession::render(const RenderOptions& opts) {
   RenderResult r = render(gen, frag, textures, scene, opts);
   r.limits = limits;
   r.notes = gen.in.notes;
+  if (g.pin)
+    if (auto changed = pinInputsChanged(*g.pin, sha256OfFiles(gen.pinnedInputs))) r.notes.push_back(*changed);
   return r;
 }
 

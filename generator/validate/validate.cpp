@@ -13,6 +13,7 @@
 #include <random>
 #include <set>
 
+#include "common/content_hash.h"
 #include "rig/rig_lod.h"
 #include "runtime/procedural.h"
 #include "validate/float_check.h"
@@ -572,6 +573,8 @@ ValidateReport Validator::run(const ValidationScene& scene, const GenerateOption
   GenerateResult chosen = generateFrom(in, gen);
   double genMs = msSince(t0);
   report.notes = chosen.in.notes;
+  if (gen.pin)
+    if (auto changed = pinInputsChanged(*gen.pin, sha256OfFiles(chosen.pinnedInputs))) report.notes.push_back(*changed);
   // Every run shares the rig's attribute formats: quantize the mesh once.
   const rt::Mesh mesh = quantizeForRig(chosen.in.rig, scene.mesh);
   report.poses = scene.poses;

@@ -484,11 +484,10 @@ BuildReport buildVariants(const Manifest& m, const std::vector<Variant>& variant
         if (f != pin->second.file && f != m.deviceProfile &&
             std::find(m.portableProfiles.begin(), m.portableProfiles.end(), f) == m.portableProfiles.end())
           files.push_back(f);
-      if (sha256OfFiles(files) != pin->second.inputs)
-        report.warnings.push_back(Diagnostic{Severity::Warning, pin->second.inputsLoc,
-                                             fmt::format("variant '{}': the inputs' bytes differ from those the pin was measured "
-                                                         "with on {} (the pin still gives its plan; its timing may not hold)",
-                                                         v.name, pin->second.device)});
+      if (auto changed = pinInputsChanged(pin->second, sha256OfFiles(files))) {
+        changed->message = fmt::format("variant '{}': {}", v.name, changed->message);
+        report.warnings.push_back(*changed);
+      }
     }
   CacheStore store({opts.cacheDir, opts.cacheUrl, opts.cacheAuth, 1500, 20000, opts.warn});
   const std::string identity = opts.validator ? opts.validator->identity() : "";

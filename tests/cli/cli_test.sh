@@ -812,12 +812,27 @@ YAML
   expect 0 "generate --pin, the request edited" -- "$SG" generate --rig "$E/face.rig.yaml" -f edited.frag -r "$E/rules.yaml" --pin face.pin.yaml --emit glsl -o edited.vert -q
   grep -q "^face.pin.yaml:[0-9]*:[0-9]*: warning: the inputs' bytes differ" last.err && ok "an edited input is reported at the pin" ||
     fail "no warning for an edited input: $(cat last.err)"
+  # Every command that reads the pin says so, the same way: explain, validate, and a manifest's build.
+  EDITED=(--rig "$E/face.rig.yaml" -f edited.frag -r "$E/rules.yaml" --pin face.pin.yaml)
+  expect 0 "explain --pin, the request edited" -- "$SG" explain "${EDITED[@]}" --no-alternatives
+  grep -q "^face.pin.yaml:[0-9]*:[0-9]*: warning: the inputs' bytes differ" last.err && ok "explain: the edited input reported at the pin" ||
+    fail "explain: no warning for an edited input: $(cat last.err)"
+  expect 0 "validate --pin, the request edited" -- "$SG" validate "${EDITED[@]}" --mesh head --no-validation-layers
+  grep -q "face.pin.yaml:[0-9]*:[0-9]*: warning: the inputs' bytes differ" last.out last.err && ok "validate: the edited input reported at the pin" ||
+    fail "validate: no warning for an edited input: $(cat last.out last.err)"
+  sed "s|passes: { color: $E/face.frag }|passes: { color: edited.frag }|" pins.variants.yaml > edited.variants.yaml
+  expect 0 "build, a pinned variant's request edited" -- "$SG" build edited.variants.yaml -q --no-cache
+  grep -q "face.pin.yaml:[0-9]*:[0-9]*: warning: variant 'face-color': the inputs' bytes differ" last.out last.err &&
+    ok "build: the edited input reported at the pin" || fail "build: no warning for an edited input: $(cat last.out last.err)"
   # The pin no longer what the inputs give (a rule taken from its plan): a located error, nothing written.
   first=$(echo $pin_rules | cut -d' ' -f1)
   sed "s/^rules: \[\"$first\", /rules: [/" face.pin.yaml > stale.pin.yaml
   expect 1 "generate --pin, a stale pin" -- "$SG" generate "${DAWN[@]}" --pin stale.pin.yaml --emit glsl -o stale.vert -q
   grep -q "^stale.pin.yaml:[0-9]*:[0-9]*: error: the pinned plan is not what these inputs give under its bans (without: -; instead: $first)" last.err &&
     [ ! -e stale.vert ] && ok "a stale pin: located error, nothing written" || fail "stale pin: $(cat last.err)"
+  expect 1 "explain --pin, a stale pin" -- "$SG" explain "${DAWN[@]}" --pin stale.pin.yaml --no-alternatives
+  grep -q "^stale.pin.yaml:[0-9]*:[0-9]*: error: the pinned plan is not what these inputs give" last.err &&
+    ok "explain: a stale pin is the same located error" || fail "explain, stale pin: $(cat last.err)"
   ;;
 
 *)
