@@ -19,10 +19,10 @@ namespace sg {
 
 const char* shadergenVersionString() { return shadergenVersion(); }
 
-void GenerateArgs::add(CLI::App& cmd) {
-  cmd.add_option("--rig", opts.rigPath, "Rig description (YAML)")->required();
-  cmd.add_option("--fragment,-f", opts.fragmentPath, "Fragment shader whose inputs must be fed (GLSL 450)")->required();
-  cmd.add_option("--rules,-r", opts.rulesPaths, "Rules file(s) (YAML)")->required();
+void GenerateArgs::add(CLI::App& cmd, bool inputsRequired) {
+  cmd.add_option("--rig", opts.rigPath, "Rig description (YAML)")->required(inputsRequired);
+  cmd.add_option("--fragment,-f", opts.fragmentPath, "Fragment shader whose inputs must be fed (GLSL 450)")->required(inputsRequired);
+  cmd.add_option("--rules,-r", opts.rulesPaths, "Rules file(s) (YAML)")->required(inputsRequired);
   cmd.add_option("--map", maps, "Map a fragment input to semantics: Name=sem or Name=s1,s2,... (packs)");
   cmd.add_option("--conventions", opts.conventions,
                  "Varying naming conventions to apply, earlier first (threejs, gltf-sample-viewer, filament, ...; "

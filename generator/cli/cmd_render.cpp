@@ -1,8 +1,10 @@
 // `shadergen render`: generate, then draw the rig with the generated vertex shader and the
 // fragment shader into a PNG (docs/render.md).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <iostream>
 #include <set>
 
@@ -12,6 +14,8 @@
 #include "measure/gpu_bench.h"
 #include "pipeline/pin.h"
 #include "render/render.h"
+#include "variants/builder.h"
+#include "variants/manifest.h"
 
 namespace sg {
 namespace {
@@ -140,11 +144,23 @@ struct BenchCommand {
   std::string timePart, reportPath;
   std::vector<std::string> commandLine;
   std::string pinOut;  // --pin-out: the fastest validated plan, pinned (pipeline/pin.h)
+  // --manifest: every variant (or each --variant) timed in place of --rig/-f/-r, each in a fresh
+  // process (--time-variant in the child); --pin-out is then a directory of <variant>.pin.yaml,
+  // what the manifest's `pins: DIR` reads.
+  std::string manifestPath, timeVariant;
+  std::vector<std::string> variantNames;
 
   int run() {
+    if (!manifestPath.empty()) return runManifest();
+    for (const char* o : {"--rig", "--fragment", "--rules"})
+      if (cmd->count(o) == 0) throw CLI::RequiredError(std::string(o) + " (or --manifest)");
+    if (!variantNames.empty()) throw CLI::ValidationError("--variant", "needs --manifest");
     bo.render.gen = args.resolve();
-    if (isGltfPath(bo.render.gen.rigPath))
-      refuseOption(*cmd, "--mesh", "to a glTF rig (" + bo.render.gen.rigPath + "): it is timed on its own mesh");
+    return runRig();
+  }
+
+  // The render and measuring options every mode shares, from the command line.
+  void resolveMeasuring() {
     bo.render.limits = {!bo.render.device.empty(), args.maxAttributes->count() > 0, args.maxUniformBytes->count() > 0};
     bo.render.validationLayers = !noLayers;
     unsigned w = 0, h = 0;
@@ -157,6 +173,12 @@ struct BenchCommand {
     bo.rasterOff = raster != "on";
     bo.alternatives = !noAlternatives;
     bo.floor = !noFloor;
+  }
+
+  int runRig() {
+    if (isGltfPath(bo.render.gen.rigPath))
+      refuseOption(*cmd, "--mesh", "to a glTF rig (" + bo.render.gen.rigPath + "): it is timed on its own mesh");
+    resolveMeasuring();
     if (!pinOut.empty()) {
       if (wholeModelParts(bo.render.gen.rigPath))
         throw CLI::ValidationError("--pin-out", "pins one rig's plan: name one primitive (MODEL.glb#m/p), not the whole model");
@@ -191,12 +213,70 @@ struct BenchCommand {
     }
     const GpuBenchReport rep = runGpuBench(bo);
     if (report(rep)) return 1;  // no pin from a run where a program failed on the device
-    if (!pinOut.empty()) writePin(rep);
+    if (!pinOut.empty()) writePin(rep, pinOut);
     return 0;
   }
 
+  // bench --manifest: each variant as `build` generates it (variants/builder.h generateOptionsOf),
+  // without its old pin; a YAML rig on --mesh, else the manifest's `mesh:`, else dawn; a glTF rig
+  // on its own mesh. A variant that fails is reported and the others still run.
+  int runManifest() {
+    for (const char* o : {"--rig", "--fragment", "--rules", "--map", "--conventions", "--heuristic", "--search",
+                          "--max-attributes", "--max-uniform-bytes", "--vertices", "--target-env", "--templates", "--ban",
+                          "--pin", "--set", "--max-error", "--hand-port", "--time-part"})
+      refuseOption(*cmd, o, "with --manifest: each variant's inputs and options are the manifest's");
+    const GenerateOptions given = args.resolve();  // --device-profile, in place of the manifest's
+    Manifest m = loadManifest(manifestPath);
+    if (!given.deviceProfilePath.empty()) {
+      m.deviceProfile = given.deviceProfilePath;
+      m.portableProfiles = given.portableProfilePaths;
+    }
+    const std::vector<Variant> all = expandVariants(m);
+    auto named = [&](const std::string& name, const char* option) {
+      auto v = std::find_if(all.begin(), all.end(), [&](const Variant& x) { return x.name == name; });
+      if (v == all.end()) throw CLI::ValidationError(option, fmt::format("'{}' is no variant of {}", name, manifestPath));
+      return *v;
+    };
+    std::vector<Variant> variants;
+    for (const auto& name : variantNames) variants.push_back(named(name, "--variant"));
+    if (variantNames.empty()) variants = all;
+    resolveMeasuring();
+    const std::string mesh = cmd->count("--mesh") ? bo.render.mesh : m.mesh.empty() ? bo.render.mesh : m.mesh;
+    auto optionsOf = [&](const Variant& v) {
+      GpuBenchOptions one = bo;
+      one.render.gen = generateOptionsOf(m, v, BuildOptions{});
+      one.render.gen.gltf = given.gltf;
+      one.render.gen.pin.reset();  // the candidates are the profile's, not an earlier measurement's
+      one.render.mesh = mesh;
+      return one;
+    };
+    if (!timeVariant.empty()) {  // the child: one variant, its report to the parent
+      if (reportPath.empty()) throw CLI::ValidationError("--time-variant", "needs --child-report");
+      writeFreshProcessReport(reportPath, [&] { return runGpuBench(optionsOf(named(timeVariant, "--time-variant"))); });
+      return 0;
+    }
+    if (!pinOut.empty()) std::filesystem::create_directories(pinOut);
+    int failed = 0;
+    std::vector<std::string> broken;
+    for (const Variant& v : variants)
+      if (!runReportingFailure(SourceLoc{m.file, 0, 0}, fmt::format("variant {} failed:", v.name), [&] {
+            GpuBenchReport rep = oneProcess ? runGpuBench(optionsOf(v))
+                                            : benchInFreshProcess(commandLine, {"--time-variant", v.name}, v.name, false);
+            std::cout << fmt::format("## {}\n\n", v.name);
+            const int f = report(rep);
+            failed += f;
+            if (!pinOut.empty() && f == 0) writePin(rep, (std::filesystem::path(pinOut) / (v.name + ".pin.yaml")).string());
+            std::cout << "\n";
+          }))
+        broken.push_back(v.name);
+    if (!broken.empty())
+      throw InputError(SourceLoc{m.file, 0, 0}, fmt::format("{} of {} variant(s) failed ({}); the others were timed",
+                                                            broken.size(), variants.size(), fmt::join(broken, ", ")));
+    return failed ? 1 : 0;
+  }
+
   // The fastest validated plan as a pin (pipeline/pin.h).
-  void writePin(const GpuBenchReport& rep) const {
+  void writePin(const GpuBenchReport& rep, const std::string& path) const {
     const int chosen = pinnedPlan(rep);
     if (chosen < 0) throw std::runtime_error("--pin-out: no plan was timed by " + rep.predictionClock);
     const GpuBenchRow& f = rep.rows[size_t(chosen)];
@@ -213,8 +293,8 @@ struct BenchCommand {
     pin.nsPerVertex = medianRound(f);
     pin.generatedNsPerVertex = medianRound(rep.rows.front());
     for (const auto& row : rep.rows) pin.candidates += row.hasCost && row.validation == "pass";
-    writeFilesAtomically({{pinOut, formatPin(pin)}});
-    std::cout << fmt::format("{}: pins {} (its median round {:.4f} ns per vertex; the generated plan's {:.4f})\n", pinOut,
+    writeFilesAtomically({{path, formatPin(pin)}});
+    std::cout << fmt::format("{}: pins {} (its median round {:.4f} ns per vertex; the generated plan's {:.4f})\n", path,
                              f.label, pin.nsPerVertex, pin.generatedNsPerVertex);
   }
 
@@ -273,7 +353,7 @@ void registerRender(CLI::App& app, CliState& state) {
                                             "port and a pass-through floor on the GPU (timestamp queries), each validated on that "
                                             "device first (one that fails is not timed; exit status 1)");
   bench->cmd = b;
-  bench->args.add(*b);
+  bench->args.add(*b, false);  // --manifest stands in for --rig, -f and -r
   b->add_option("--hand-port", bench->bo.handPortPath, "A hand-written vertex shader with the same interface "
                                                        "(a_<attribute>, u_<uniform>, gl_VertexIndex, the generated program's storage buffers "
                                                        "at their bindings), e.g. examples/dawn/listing-3-3.vert");
@@ -306,9 +386,15 @@ void registerRender(CLI::App& app, CliState& state) {
                 "Vulkan device name (substring); default lavapipe. A named device's own limits constrain the search, "
                 "as in validate --device");
   b->add_flag("--no-validation-layers", bench->noLayers, "Run without the Khronos validation layer (use for timings)");
-  addOneProcessFlag(*b, bench->oneProcess, "part");
+  addOneProcessFlag(*b, bench->oneProcess, "part or variant");
+  b->add_option("--manifest", bench->manifestPath,
+                "Time the variants of a build manifest (docs/variants.md) in place of --rig/-f/-r, each as `build` generates "
+                "it, each in a fresh process unless --one-process; with --pin-out DIR, DIR/<variant>.pin.yaml each, what "
+                "the manifest's `pins: DIR` reads");
+  b->add_option("--variant", bench->variantNames, "With --manifest: only this variant (repeatable)");
   b->add_option("--time-part", bench->timePart)->group("");  // a fresh process's one part (cli/fresh_process.h)
   b->add_option("--child-report", bench->reportPath)->group("");
+  b->add_option("--time-variant", bench->timeVariant)->group("");
   b->callback([bench, &state] {
     bench->commandLine = state.commandLine;
     state.run = [bench] { return bench->run(); };

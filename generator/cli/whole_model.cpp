@@ -30,28 +30,30 @@ void checkWholeModelAnimation(const std::vector<GltfPart>& parts, const std::str
   findGltfAnimation(first->data, animation);
 }
 
+bool runReportingFailure(const SourceLoc& at, const std::string& headline, const std::function<void()>& body) {
+  std::vector<std::string> messages;
+  try {
+    body();
+    return true;
+  } catch (const InputError& e) {
+    messages.push_back(renderDiagnostic(e.diagnostic()));
+    size_t shown = 0;
+    for (const auto& d : e.related)
+      if (++shown <= 20) messages.push_back(renderDiagnostic(d));
+  } catch (const std::exception& e) {
+    messages.push_back(fmt::format("shadergen: error: {}", e.what()));
+  }
+  std::cerr << formatDiagnostic(Diagnostic{Severity::Error, at, headline}) << "\n";
+  for (const auto& m : messages) std::cerr << m << "\n";
+  return false;
+}
+
 std::vector<std::string> forEachPart(const std::vector<GltfPart>& parts,
                                      const std::function<void(const GltfPart&)>& body) {
   std::vector<std::string> failed;
-  for (const auto& part : parts) {
-    std::vector<std::string> messages;
-    try {
-      body(part);
-      continue;
-    } catch (const InputError& e) {
-      messages.push_back(renderDiagnostic(e.diagnostic()));
-      size_t shown = 0;
-      for (const auto& d : e.related)
-        if (++shown <= 20) messages.push_back(renderDiagnostic(d));
-    } catch (const std::exception& e) {
-      messages.push_back(fmt::format("shadergen: error: {}", e.what()));
-    }
-    failed.push_back(part.name);
-    std::cerr << formatDiagnostic(Diagnostic{Severity::Error, SourceLoc{part.ref, 0, 0},
-                                             fmt::format("primitive {} failed:", part.name)})
-              << "\n";
-    for (const auto& m : messages) std::cerr << m << "\n";
-  }
+  for (const auto& part : parts)
+    if (!runReportingFailure(SourceLoc{part.ref, 0, 0}, fmt::format("primitive {} failed:", part.name), [&] { body(part); }))
+      failed.push_back(part.name);
   return failed;
 }
 

@@ -21,6 +21,10 @@ std::optional<std::vector<GltfPart>> wholeModelParts(const std::string& rigPath)
 // before the primitives run, instead of once per primitive. ("" = the first: nothing to check.)
 void checkWholeModelAnimation(const std::vector<GltfPart>& parts, const std::string& animation);
 
+// Runs `body`; if it throws (InputError or any std::exception), prints `headline` as an error at
+// `at`, then the error (and up to 20 related diagnostics), and returns false.
+bool runReportingFailure(const SourceLoc& at, const std::string& headline, const std::function<void()>& body);
+
 // Runs `body` on every part. A part that throws (InputError or any std::exception) is
 // reported on standard error, its primitive named, and the next part still runs. Returns the
 // names of the parts that failed, in order.

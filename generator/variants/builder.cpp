@@ -215,8 +215,8 @@ std::optional<ValidationResult> parseValidation(const std::string& body) {
   return r;
 }
 
-// What `generate` is given to make this variant (the build loads the files once and
-// prepares from them; the validator regenerates the capture build from these).
+}  // namespace
+
 GenerateOptions generateOptionsOf(const Manifest& m, const Variant& v, const BuildOptions& opts) {
   GenerateOptions o;
   if (auto w = opts.workloads.find(v.name); w != opts.workloads.end()) o.workload = w->second;
@@ -239,6 +239,8 @@ GenerateOptions generateOptionsOf(const Manifest& m, const Variant& v, const Bui
   o.outputName = (fs::path(m.outputDir) / (v.name + ".vert")).string();
   return o;
 }
+
+namespace {
 
 // ---- one variant ------------------------------------------------------------------------
 

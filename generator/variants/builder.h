@@ -63,6 +63,11 @@ struct BuildOptions {
   GltfReadOptions gltf;  // how glTF rigs are read (--no-normalize-weights, --Werror)
 };
 
+// What `generate` is given to make variant `v` (the build loads the files once and prepares
+// from them; the validator regenerates the capture build from these; bench --manifest times the
+// variant's candidates from them). opts: its workloads and glTF reading.
+GenerateOptions generateOptionsOf(const Manifest& m, const Variant& v, const BuildOptions& opts);
+
 struct BuiltVariant {
   const Variant* variant = nullptr;
   bool ok = false;

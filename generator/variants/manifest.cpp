@@ -334,8 +334,17 @@ Manifest loadManifestText(const std::string& text, const std::string& file) {
         y.fail(root["name"], fmt::format("'name' uses unknown axis '{{{}}}'", axis));
     }
   }
-  if (root["pins"]) {  // { variant: pin file }: checked against the variants' names
-    y.expectMap(root["pins"], "'pins' (variant name: pin file)");
+  if (root["pins"] && root["pins"].IsScalar()) {  // a directory: <variant>.pin.yaml where one exists
+    m.pinsDir = resolvePath(file, y.scalar(root["pins"], "'pins'"));
+    std::error_code ec;
+    // Not there yet: no variant is pinned (the first bench --manifest --pin-out makes it).
+    if (fs::exists(m.pinsDir, ec) && !fs::is_directory(m.pinsDir, ec))
+      y.fail(root["pins"], fmt::format("'pins' names '{}', which is not a directory (a map names one pin file per variant)", m.pinsDir));
+    for (const Variant& v : expandVariants(m))
+      if (const std::string f = (fs::path(m.pinsDir) / (v.name + ".pin.yaml")).string(); fs::is_regular_file(f, ec))
+        m.pins.emplace(v.name, loadPin(f));
+  } else if (root["pins"]) {  // { variant: pin file }: checked against the variants' names
+    y.expectMap(root["pins"], "'pins' (a directory, or variant name: pin file)");
     const std::vector<Variant> variants = expandVariants(m);
     for (const auto& kv : root["pins"]) {
       const std::string name = y.scalar(kv.first, "a variant name");

@@ -100,6 +100,7 @@ struct Manifest {
   // `pins:` variant name -> its pin (`bench --pin-out`, pipeline/pin.h): that variant's plan is the
   // one a device timed fastest (docs/variants.md, "Pinning a plan"). Every name is a variant's.
   std::map<std::string, Pin> pins;
+  std::string pinsDir;  // `pins: DIR`: each variant's DIR/<name>.pin.yaml, where it exists (bench --manifest --pin-out DIR)
   bool emits(const std::string& kind) const;
 };
 

@@ -833,6 +833,33 @@ YAML
   expect 1 "explain --pin, a stale pin" -- "$SG" explain "${DAWN[@]}" --pin stale.pin.yaml --no-alternatives
   grep -q "^stale.pin.yaml:[0-9]*:[0-9]*: error: the pinned plan is not what these inputs give" last.err &&
     ok "explain: a stale pin is the same located error" || fail "explain, stale pin: $(cat last.err)"
+  # A whole manifest tuned at once: bench --manifest --pin-out DIR times each variant's candidates and
+  # pins each; the manifest's `pins: DIR` then builds every variant as generate --pin writes it.
+  cat > tune.variants.yaml <<YAML
+rules: $E/rules.yaml
+output: tuned
+device_profile: $SRC/devices/llvmpipe-2core.yaml
+mesh: head
+rigs: { face: $E/face.rig.yaml }
+passes: { color: $E/face.frag, depth: $E/depth.frag }
+pins: tuned-pins
+YAML
+  expect 0 "build, pins: DIR not made yet" -- "$SG" build tune.variants.yaml -q --no-cache
+  grep -q '"pin"' tuned/index.json && fail "a variant pinned before any pin was made" || ok "pins: DIR not there yet: no variant pinned"
+  expect 0 "bench --manifest --candidates 3 --pin-out DIR" -- "$SG" bench --manifest tune.variants.yaml --raster off --draws 1 \
+    --min-frame-vertices 0 --frames 2 --rounds 1 --no-floor --no-validation-layers --candidates 3 --pin-out tuned-pins
+  [ "$(grep -c '^## face-' last.out)" -eq 2 ] && [ -s tuned-pins/face-color.pin.yaml ] && [ -s tuned-pins/face-depth.pin.yaml ] &&
+    ok "bench --manifest: both variants timed and pinned" || fail "bench --manifest: $(ls tuned-pins) $(grep '^##' last.out)"
+  expect 0 "build, pins: DIR" -- "$SG" build tune.variants.yaml -q --no-cache
+  for pass in color depth; do
+    frag=$E/face.frag; [ $pass = depth ] && frag=$E/depth.frag
+    expect 0 "generate --pin, the $pass variant's pin" -- "$SG" generate --rig "$E/face.rig.yaml" -f "$frag" -r "$E/rules.yaml" \
+      --pin tuned-pins/face-$pass.pin.yaml --emit glsl -o tuned-$pass.vert -q
+    [ -n "$(glsl_rules tuned-$pass.vert)" ] && [ "$(glsl_rules tuned/face-$pass.vert)" = "$(glsl_rules tuned-$pass.vert)" ] &&
+      grep -q "\"pin\": {\"file\": \"tuned-pins/face-$pass.pin.yaml\"" tuned/index.json &&
+      ok "pins: DIR: face-$pass is its pin's plan, index.json names it" ||
+      fail "pins: DIR, face-$pass: $(glsl_rules tuned/face-$pass.vert) vs $(glsl_rules tuned-$pass.vert)"
+  done
   ;;
 
 *)
