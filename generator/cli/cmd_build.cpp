@@ -47,6 +47,9 @@ std::string cmakeListing(const Manifest& m, const std::vector<Variant>& variants
   std::string out = fmt::format("# `shadergen build {} --list-cmake`: one build edge per variant\n", m.file);
   out += "set(SHADERGEN_LIST_CONFIGURE_DEPENDS" + quote(m.file);  // what the list itself depends on
   for (const auto& f : m.wholeModelFiles) out += quote(f);
+  // `pins: DIR`: a pin written for a variant that had none changes which files a variant reads
+  // (its depfile names only the pins it had); the directory's time changes when one is written.
+  if (std::error_code ec; !m.pinsDir.empty() && std::filesystem::is_directory(m.pinsDir, ec)) out += quote(m.pinsDir);
   out += ")\nset(SHADERGEN_LIST_VARIANTS";
   for (const auto& v : variants) out += " " + v.name;  // safe file stems
   out += ")\n";

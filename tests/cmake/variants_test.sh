@@ -138,12 +138,31 @@ grep -q 'regenerate-during-build' "$T/touch-model.log" && grep -q -- "model.vari
   ok "touching the whole model re-expands its manifest and rebuilds its variant" || fail "$(cat "$T/touch-model.log")"
 noop "after touching the whole model"
 
+# `pins: DIR` (docs/variants.md): a pin written for one variant (bench --manifest --pin-out on
+# lavapipe) re-runs CMake at the next build (the directory is a configure dependency) and
+# rebuilds exactly that variant, pinned.
+mkdir -p "$P/pins"
+tick; echo "pins: pins" >>"$P/chars.variants.yaml"
+build add-pins
+noop "after adding pins: DIR"
+tick
+"$SG" bench --manifest "$P/chars.variants.yaml" --variant face-depth-m3-i2 --mesh head --raster off --draws 1 --min-frame-vertices 0 \
+  --frames 1 --rounds 1 --no-floor --no-validation-layers --candidates 2 --pin-out "$P/pins" >"$T/tune.log" 2>&1 ||
+  fail "bench --manifest: $(cat "$T/tune.log")"
+build pin-one
+grep -q 'regenerate-during-build' "$T/pin-one.log" && [ "$(ran pin-one)" = face-depth-m3-i2 ] &&
+  grep -q '"pin": {"file": "[^"]*pins/face-depth-m3-i2.pin.yaml"' "$OUT/index.json" &&
+  ok "a new pin in pins: DIR re-runs CMake and rebuilds exactly its variant, pinned" ||
+  fail "after a new pin, ran: $(ran pin-one | tr '\n' ' '); $(grep -c '"pin"' "$OUT/index.json") pinned"
+same_as_single "after a pin"
+noop "after a pin"
+
 # A broken manifest fails the next build with its file:line:col error.
 tick; echo "unknown_key: 1" >>"$P/chars.variants.yaml"
 if "$NINJA" -C "$B" >"$T/bad.log" 2>&1; then
   fail "a broken manifest built"
 else
-  grep -q "chars.variants.yaml:10:1: error: unknown" "$T/bad.log" && ok "a broken manifest: its error at configure" ||
+  grep -q "chars.variants.yaml:11:1: error: unknown" "$T/bad.log" && ok "a broken manifest: its error at configure" ||
     fail "$(cat "$T/bad.log")"
 fi
 [ "$fails" -eq 0 ] && echo "PASS" || { echo "$fails failure(s)"; exit 1; }
