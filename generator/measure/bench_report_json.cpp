@@ -109,6 +109,7 @@ std::string benchReportJson(const GpuBenchReport& r) {
                   {"draws_per_frame", r.drawsPerFrame},
                   {"frames", r.frames},
                   {"rounds", r.rounds},
+                  {"processes", r.processes},
                   {"width", r.width},
                   {"height", r.height},
                   {"rows", rows},
@@ -161,6 +162,7 @@ GpuBenchReport benchReportFromJson(const std::string& text) {
     r.drawsPerFrame = j.at("draws_per_frame");
     r.frames = j.at("frames");
     r.rounds = j.at("rounds");
+    r.processes = j.at("processes");
     r.width = j.at("width");
     r.height = j.at("height");
     for (const auto& row : j.at("rows")) r.rows.push_back(rowFrom(row));

@@ -481,10 +481,10 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   // The clock predictions are checked by: raster on, timestamps on a GPU; on a CPU device the
   // one calibrate fits there (isCpuDevice). Each round's figure by it is kept.
   double GpuBenchRow::*clock = &GpuBenchRow::rasterOnNsPerVertex;
-  rep.predictionClock = "raster on, timestamps";
+  rep.predictionClock = kClockTimestamps;
   if (isCpuDevice(rep.device)) {
     clock = opts.rasterOff ? &GpuBenchRow::rasterOffCpuNsPerVertex : &GpuBenchRow::rasterOnWallNsPerVertex;
-    rep.predictionClock = opts.rasterOff ? "raster off, process CPU time (a CPU device)" : "raster on, host time (a CPU device)";
+    rep.predictionClock = opts.rasterOff ? kClockCpuRasterOff : kClockCpuRasterOn;
   }
   auto best = [&](GpuBenchRow& row, double GpuBenchRow::*field, double v) {
     row.*field = row.*field < 0 ? v : std::min(row.*field, v);
@@ -531,6 +531,51 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
       }
     }
   for (const auto& p : programs) rep.rows.push_back(p.row);
+  summarize(rep);
+  const auto& msgs = validator.harness().validationMessages();
+  if (!msgs.empty()) throw std::runtime_error("validation layer: " + msgs.front());
+  return rep;
+}
+
+GpuBenchReport mergeProcessRuns(const std::vector<GpuBenchReport>& runs) {
+  if (runs.empty()) throw std::runtime_error("no timed process to merge");
+  GpuBenchReport rep = runs.front();
+  for (size_t i = 1; i < runs.size(); ++i) {
+    const GpuBenchReport& other = runs[i];
+    if (other.rows.size() != rep.rows.size() || other.predictionClock != rep.predictionClock || other.device != rep.device)
+      throw std::runtime_error(fmt::format("process {} of {} timed other programs or another clock", i + 1, runs.size()));
+    for (size_t k = 0; k < rep.rows.size(); ++k) {
+      GpuBenchRow& row = rep.rows[k];
+      const GpuBenchRow& o = other.rows[k];
+      if (o.label != row.label || o.program != row.program)
+        throw std::runtime_error(fmt::format("process {} of {} timed '{}' ({}) where the first timed '{}' ({})", i + 1,
+                                             runs.size(), o.label, o.program, row.label, row.program));
+      if (o.validation != "pass" && !o.validation.empty()) row.validation = o.validation;  // a failure anywhere is one
+      for (double GpuBenchRow::*f : {&GpuBenchRow::rasterOnNsPerVertex, &GpuBenchRow::rasterOffNsPerVertex,
+                                     &GpuBenchRow::rasterOnWallNsPerVertex, &GpuBenchRow::rasterOffCpuNsPerVertex,
+                                     &GpuBenchRow::rasterOffWallNsPerVertex})
+        if (o.*f >= 0) row.*f = row.*f < 0 ? o.*f : std::min(row.*f, o.*f);
+      row.roundNsPerVertex.insert(row.roundNsPerVertex.end(), o.roundNsPerVertex.begin(), o.roundNsPerVertex.end());
+    }
+    rep.rounds += other.rounds;  // the notes are loading's: the same in every process
+  }
+  rep.processes = uint32_t(runs.size());
+  summarize(rep);
+  return rep;
+}
+
+namespace {
+
+double GpuBenchRow::*predictionClockOf(const GpuBenchReport& rep) {
+  if (rep.predictionClock == kClockCpuRasterOff) return &GpuBenchRow::rasterOffCpuNsPerVertex;
+  if (rep.predictionClock == kClockCpuRasterOn) return &GpuBenchRow::rasterOnWallNsPerVertex;
+  return &GpuBenchRow::rasterOnNsPerVertex;
+}
+
+}  // namespace
+
+void summarize(GpuBenchReport& rep) {
+  double GpuBenchRow::*clock = predictionClockOf(rep);
   std::vector<double> cost, on, off, offWall;
   for (const auto& r : rep.rows)
     if (r.hasCost && r.validation == "pass") {
@@ -552,9 +597,6 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
   rep.fastestPlan = predictedOn.fastest;
   if (rep.fastestPlan >= 0 && rep.rows.front().*clock > 0)
     rep.fastestOverGenerated = rep.rows[size_t(rep.fastestPlan)].*clock / rep.rows.front().*clock;
-  const auto& msgs = validator.harness().validationMessages();
-  if (!msgs.empty()) throw std::runtime_error("validation layer: " + msgs.front());
-  return rep;
 }
 
 std::string inputMemoryLine(rt::InputMemory placement, const std::string& memoryTypes) {
@@ -593,10 +635,11 @@ std::string describeDriverStatistics(const std::vector<rt::ShaderStatistic>& sta
 }
 
 std::string formatGpuBench(const GpuBenchReport& r) {
-  std::string s = fmt::format("device: {} (driver: {})\n{}mesh: {} vertices, {} triangles; {} draws per frame, median of {} frames, best of {} rounds; "
+  std::string s = fmt::format("device: {} (driver: {})\n{}mesh: {} vertices, {} triangles; {} draws per frame, median of {} frames, best of {} rounds{}; "
                               "rasterization on: {}x{} target\n\n",
                               r.device, r.driver, r.limits.empty() ? "" : r.limits + "\n", r.vertices, r.triangles,
-                              r.drawsPerFrame, r.frames, r.rounds, r.width, r.height);
+                              r.drawsPerFrame, r.frames, r.rounds,
+                              r.processes > 1 ? fmt::format(" in {} processes", r.processes) : "", r.width, r.height);
   s.insert(s.size() - 1, "workload: " + describeWorkload(r.workload) + "\n");
   if (!r.inputMemory.empty()) s.insert(s.size() - 1, r.inputMemory + "\n");
   if (r.shadedVerticesPerVertex >= 0)

@@ -94,6 +94,7 @@ struct GpuBenchReport {
   // fragments are workload.fragmentsPerVertex); -1 where the device cannot count.
   double shadedVerticesPerVertex = -1;
   uint32_t drawsPerFrame = 0, frames = 0, rounds = 0, width = 0, height = 0;
+  uint32_t processes = 1;  // fresh processes whose rounds these are (mergeProcessRuns)
   std::vector<GpuBenchRow> rows;
   // Over the generated plan and its alternatives (rows with a cost): Pearson correlation of
   // plan cost with time per vertex, and Spearman (rank) correlation; NaN if < 3 rows.
@@ -118,6 +119,23 @@ struct GpuBenchReport {
 };
 
 GpuBenchReport runGpuBench(const GpuBenchOptions& opts);
+
+// The prediction clocks (GpuBenchReport::predictionClock): timestamps on a GPU, the process's
+// CPU time or the host's wall time on a CPU device (isCpuDevice).
+inline constexpr const char* kClockTimestamps = "raster on, timestamps";
+inline constexpr const char* kClockCpuRasterOff = "raster off, process CPU time (a CPU device)";
+inline constexpr const char* kClockCpuRasterOn = "raster on, host time (a CPU device)";
+
+// Runs of the same bench in several fresh processes (bench --processes N) as one report: each
+// program's rounds are all the processes' rounds (its figures the best of them), so the
+// median round a pin is chosen by (pinnedPlan) is taken over every process. On lavapipe a
+// program once ran 25 % slower in every round of one process out of seven, and the others
+// not (docs/performance.md): a process is a sample, as a round is. Throws if the runs timed
+// other programs (a different candidate list) or on another device.
+GpuBenchReport mergeProcessRuns(const std::vector<GpuBenchReport>& runs);
+// The summary figures of a report (correlations, the fastest plan, the by-round spread) from
+// its rows; runGpuBench and mergeProcessRuns end with it.
+void summarize(GpuBenchReport& rep);
 
 // The plan a measured choice pins (bench --pin-out): of the validated plans the prediction clock
 // timed, the one whose median round is the fastest (-1: none). Not the best round, which the

@@ -846,10 +846,12 @@ pins: tuned-pins
 YAML
   expect 0 "build, pins: DIR not made yet" -- "$SG" build tune.variants.yaml -q --no-cache
   grep -q '"pin"' tuned/index.json && fail "a variant pinned before any pin was made" || ok "pins: DIR not there yet: no variant pinned"
-  expect 0 "bench --manifest --candidates 3 --pin-out DIR" -- "$SG" bench --manifest tune.variants.yaml --raster off --draws 1 \
-    --min-frame-vertices 0 --frames 2 --rounds 1 --no-floor --no-validation-layers --candidates 3 --pin-out tuned-pins
+  expect 0 "bench --manifest --candidates 3 --processes 2 --pin-out DIR" -- "$SG" bench --manifest tune.variants.yaml --raster off \
+    --draws 1 --min-frame-vertices 0 --frames 2 --rounds 1 --no-floor --no-validation-layers --candidates 3 --processes 2 --pin-out tuned-pins
   [ "$(grep -c '^## face-' last.out)" -eq 2 ] && [ -s tuned-pins/face-color.pin.yaml ] && [ -s tuned-pins/face-depth.pin.yaml ] &&
-    ok "bench --manifest: both variants timed and pinned" || fail "bench --manifest: $(ls tuned-pins) $(grep '^##' last.out)"
+    [ "$(grep -c 'best of 2 rounds in 2 processes' last.out)" -eq 2 ] &&
+    ok "bench --manifest: both variants timed in 2 processes each, and pinned" ||
+    fail "bench --manifest: $(ls tuned-pins) $(grep -E '^##|^mesh' last.out)"
   expect 0 "build, pins: DIR" -- "$SG" build tune.variants.yaml -q --no-cache
   for pass in color depth; do
     frag=$E/face.frag; [ $pass = depth ] && frag=$E/depth.frag

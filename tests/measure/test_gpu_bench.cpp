@@ -113,6 +113,44 @@ TEST(GpuBench, APinTakesThePlanWhoseMedianRoundIsFastest) {
   EXPECT_EQ(sg::pinnedPlan(rep), -1);
 }
 
+TEST(GpuBench, ProcessesMergeTheirRoundsSoOneSlowProcessDoesNotPick) {
+  // What lavapipe did (docs/performance.md, --processes): one process of three ran the fastest
+  // plan, b, 25 % slower in every round. Alone, that process pins a; the three merged pin b
+  // (its median round over 9 is 8, a's 9). Each figure is the best over every process.
+  auto run = [](std::vector<double> a, std::vector<double> b) {
+    sg::GpuBenchReport r;
+    r.device = "llvmpipe";
+    r.predictionClock = sg::kClockCpuRasterOff;
+    r.rounds = 3;
+    r.rows = {roundsRow("a", true, "pass", a), roundsRow("b", true, "pass", b)};
+    for (auto& row : r.rows) {
+      row.program = row.label == "a" ? "aaaa" : "bbbb";
+      row.rasterOffCpuNsPerVertex = *std::min_element(row.roundNsPerVertex.begin(), row.roundNsPerVertex.end());
+    }
+    return r;
+  };
+  const sg::GpuBenchReport slow = run({9, 9, 9.1}, {10, 10, 10.1});
+  EXPECT_EQ(sg::pinnedPlan(slow), 0);
+  const sg::GpuBenchReport merged = sg::mergeProcessRuns({slow, run({9, 8.9, 9}, {8, 8.1, 8}), run({9.2, 9, 9}, {8, 7.9, 8})});
+  EXPECT_EQ(sg::pinnedPlan(merged), 1);
+  EXPECT_EQ(merged.processes, 3u);
+  EXPECT_EQ(merged.rounds, 9u);
+  ASSERT_EQ(merged.rows[1].roundNsPerVertex.size(), 9u);
+  EXPECT_DOUBLE_EQ(sg::medianRound(merged.rows[1]), 8.0);
+  EXPECT_DOUBLE_EQ(merged.rows[1].rasterOffCpuNsPerVertex, 7.9);
+  EXPECT_DOUBLE_EQ(merged.rows[0].rasterOffCpuNsPerVertex, 8.9);
+  EXPECT_EQ(merged.fastestPlan, 1);  // the summary is taken again over the merged rows
+  // A failure in any process is the row's; runs of other programs are not merged.
+  sg::GpuBenchReport failed = run({9, 9, 9}, {8, 8, 8});
+  failed.rows[0].validation = "FAIL: out";
+  EXPECT_EQ(sg::mergeProcessRuns({slow, failed}).rows[0].validation, "FAIL: out");
+  sg::GpuBenchReport other = run({9, 9, 9}, {8, 8, 8});
+  other.rows[1].program = "cccc";
+  EXPECT_THROW(sg::mergeProcessRuns({slow, other}), std::runtime_error);
+  other.rows.pop_back();
+  EXPECT_THROW(sg::mergeProcessRuns({slow, other}), std::runtime_error);
+}
+
 TEST(GpuBench, CaptureQualifiersGoOnEveryOutputAndUnknownOutputsAreErrors) {
   sg::EmittedGlsl capture;
   capture.captureStride = 32;
