@@ -56,6 +56,8 @@ def reference(paths):
                     t = float(cells[header.index('measured ns/vertex')])
                 except ValueError:
                     continue
+                if not cells[header.index('program')].startswith('plan:'):
+                    continue  # the floors are not plans to pin or to beat
                 prog = cells[header.index('SPIR-V SHA-256')]
                 key = (cells[1], cells[0])
                 pairs.setdefault(key, {})
