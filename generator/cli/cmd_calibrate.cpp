@@ -239,7 +239,7 @@ struct CalibrateCommand {
     if (!oneProcess)
       co.timeRig = [this](const RigTiming& t) {
         const std::string what = fmt::format("{} on '{}'", rigLabel(t.rig), t.mesh);
-        return benchInFreshProcess(commandLine, {"--time-rig", rigTimingJson(t)}, what, true);
+        return benchInFreshProcesses(commandLine, {"--time-rig", rigTimingJson(t)}, what, true, co.processes, co.stop);
       };
     co.check = !noCheck;
     co.probes = !noProbes;
@@ -376,6 +376,7 @@ void registerCalibrate(CLI::App& app, CliState& state) {
                 "lavapipe they price an input as no plan pays it; docs/device-profiles.md)");
   sub->add_flag("--no-validation-layers", cmd->noLayers, "Run without the Khronos validation layer (use for timings)");
   addOneProcessFlag(*sub, cmd->oneProcess, "rig");
+  addProcessesOption(*sub, cmd->co.processes, "rig");
   sub->add_option("--time-rig", cmd->timeRig)->group("");  // a fresh process's one rig (cli/fresh_process.h)
   sub->add_option("--child-report", cmd->report)->group("");
   sub->callback([cmd, &state] {

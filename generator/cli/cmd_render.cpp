@@ -151,13 +151,9 @@ struct BenchCommand {
   std::vector<std::string> variantNames;
   uint32_t processes = 1;  // --processes: fresh processes per rig, part or variant, their rounds merged
 
-  // A rig, part or variant timed in fresh processes (the child told by `childArgs`): one, or
-  // --processes of them merged (measure/gpu_bench.h mergeProcessRuns).
+  // A rig, part or variant timed in --processes fresh processes (the child told by `childArgs`).
   GpuBenchReport timedFresh(const std::vector<std::string>& childArgs, const std::string& what) const {
-    if (processes <= 1) return benchInFreshProcess(commandLine, childArgs, what, false);
-    std::vector<GpuBenchReport> runs;
-    for (uint32_t i = 0; i < processes; ++i) runs.push_back(benchInFreshProcess(commandLine, childArgs, what, false));
-    return mergeProcessRuns(runs);
+    return benchInFreshProcesses(commandLine, childArgs, what, false, processes);
   }
 
   int run() {
@@ -171,7 +167,6 @@ struct BenchCommand {
 
   // The render and measuring options every mode shares, from the command line.
   void resolveMeasuring() {
-    if (processes > 1 && oneProcess) throw CLI::ValidationError("--one-process", "does not apply with --processes N (N fresh processes)");
     bo.render.limits = {!bo.render.device.empty(), args.maxAttributes->count() > 0, args.maxUniformBytes->count() > 0};
     bo.render.validationLayers = !noLayers;
     unsigned w = 0, h = 0;
@@ -398,11 +393,7 @@ void registerRender(CLI::App& app, CliState& state) {
                 "as in validate --device");
   b->add_flag("--no-validation-layers", bench->noLayers, "Run without the Khronos validation layer (use for timings)");
   addOneProcessFlag(*b, bench->oneProcess, "part or variant");
-  b->add_option("--processes", bench->processes,
-                "Time each rig, part or variant in N fresh processes and merge their rounds: the median round that "
-                "--pin-out decides by is then taken over every process (default 1; on lavapipe one process in seven "
-                "ran one program 25 % slower in every round)")
-      ->check(CLI::Range(1, 32));
+  addProcessesOption(*b, bench->processes, "rig, part or variant");
   b->add_option("--manifest", bench->manifestPath,
                 "Time the variants of a build manifest (docs/variants.md) in place of --rig/-f/-r, each as `build` generates "
                 "it, each in a fresh process unless --one-process; with --pin-out DIR, DIR/<variant>.pin.yaml each, what "

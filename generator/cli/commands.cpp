@@ -12,6 +12,16 @@ void refuseOption(const CLI::App& cmd, const std::string& option, const std::str
   if (cmd.count(option) > 0) throw CLI::ValidationError(option, "does not apply " + why);
 }
 
+void addProcessesOption(CLI::App& cmd, uint32_t& processes, const std::string& what) {
+  cmd.add_option("--processes", processes,
+                 fmt::format("Time each {0} in N fresh processes and merge their rounds (default 1): a {0}'s figures are then "
+                             "the best, and the median round that --pin-out decides by the median, over every process. On "
+                             "lavapipe one process in seven ran a program 25 % slower in every round (bench/data/pin38)",
+                             what))
+      ->check(CLI::Range(1, 32))
+      ->excludes("--one-process");
+}
+
 CLI::Validator finiteNumber(bool positive) {
   return CLI::Validator(
       [positive](std::string& s) -> std::string {

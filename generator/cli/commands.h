@@ -55,6 +55,9 @@ void addInputMemoryOption(CLI::App& cmd, rt::InputMemory& memory);
 // --one-process, for every command that times several rigs (bench MODEL.glb#*, calibrate): time
 // them all in this process instead of each in a fresh one (cli/fresh_process.h). `what`: "rig", "part".
 void addOneProcessFlag(CLI::App& cmd, bool& oneProcess, const std::string& what);
+// --processes N, beside --one-process (which it excludes): each `what` timed in N fresh processes,
+// their rounds merged (cli/fresh_process.h benchInFreshProcesses).
+void addProcessesOption(CLI::App& cmd, uint32_t& processes, const std::string& what);
 
 // Every file `in` was loaded from (plus `extra`), named for refuseClobbering (output_files.h).
 std::vector<InputFile> inputFiles(const LoadedInputs& in, const std::vector<std::string>& extra = {});

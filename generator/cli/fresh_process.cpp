@@ -64,6 +64,14 @@ GpuBenchReport benchInFreshProcess(const std::vector<std::string>& commandLine, 
   return benchReportFromJson(text);  // an InputError the child wrote is thrown from here
 }
 
+GpuBenchReport benchInFreshProcesses(const std::vector<std::string>& commandLine, const std::vector<std::string>& extra,
+                                     const std::string& what, bool finishOnInterrupt, uint32_t processes,
+                                     const std::atomic<bool>* stop) {
+  std::vector<GpuBenchReport> runs{benchInFreshProcess(commandLine, extra, what, finishOnInterrupt)};
+  while (runs.size() < processes && !(stop && stop->load())) runs.push_back(benchInFreshProcess(commandLine, extra, what, finishOnInterrupt));
+  return runs.size() == 1 ? runs.front() : mergeProcessRuns(runs);
+}
+
 void writeFreshProcessReport(const std::string& path, const std::function<GpuBenchReport()>& time) {
   std::string text;
   try {

@@ -4,6 +4,8 @@
 // `bench MODEL.glb#*` and `calibrate` time each rig in a fresh shadergen process: this executable
 // again, with the command line it was started with and the options that name the one rig.
 #pragma once
+#include <atomic>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -21,6 +23,13 @@ namespace sg {
 // (calibrate's rule); otherwise an interrupt ends the child with its parent (bench).
 GpuBenchReport benchInFreshProcess(const std::vector<std::string>& commandLine, const std::vector<std::string>& extra,
                                    const std::string& what, bool finishOnInterrupt);
+
+// `processes` such children, one after another, as one report (measure/gpu_bench.h
+// mergeProcessRuns; one: that child's report as it is). Once `stop` is set (calibrate's
+// interrupt) no further child starts, and the ones timed are merged.
+GpuBenchReport benchInFreshProcesses(const std::vector<std::string>& commandLine, const std::vector<std::string>& extra,
+                                     const std::string& what, bool finishOnInterrupt, uint32_t processes,
+                                     const std::atomic<bool>* stop = nullptr);
 
 // In the child: times with `time` and writes its report, or the input error it threw, to `path`
 // for the parent.

@@ -856,8 +856,9 @@ CalibrationReport calibrateDevice(const CalibrationOptions& opts) {
   // would otherwise bury the vertex stage (the Dawn face's plans on the head: ~8 us per vertex
   // raster on, bench/data/lavapipe-calibrate-busy.log).
   rep.clock = hostClock ? "process CPU time over submit-to-fence, rasterizer discarded (a CPU device)" : "GPU timestamps";
-  rep.clock += fmt::format(" over {} draws per frame (a smaller mesh more: at least {} vertices), median of {} frames, best of {} rounds",
-                           opts.drawsPerFrame, opts.minVerticesPerFrame, opts.frames, std::max<uint32_t>(1, opts.rounds));
+  rep.clock += fmt::format(" over {} draws per frame (a smaller mesh more: at least {} vertices), median of {} frames, best of {} rounds{}",
+                           opts.drawsPerFrame, opts.minVerticesPerFrame, opts.frames, std::max<uint32_t>(1, opts.rounds),
+                           opts.processes > 1 ? fmt::format(" in each of {} processes", opts.processes) : "");
   double GpuBenchRow::*const clock = hostClock ? &GpuBenchRow::rasterOffCpuNsPerVertex : &GpuBenchRow::rasterOnNsPerVertex;
   std::string inputMemory;  // inputMemoryLine of the first timing, for the clock's line
 

@@ -100,6 +100,9 @@ struct CalibrationOptions {
   // reproducibly (bench/data/h100-order25), so the CLI times each rig in a fresh process of its own
   // (cli/fresh_process.h; docs/device-profiles.md, "One process per rig").
   std::function<GpuBenchReport(const RigTiming&)> timeRig;
+  // How many processes timeRig times each rig in, their rounds merged (bench --processes,
+  // measure/gpu_bench.h mergeProcessRuns): the clock line says it.
+  uint32_t processes = 1;
 };
 
 struct CalibrationSample {

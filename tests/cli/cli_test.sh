@@ -595,7 +595,10 @@ device_profile)
   # profile moves at least one plan away from the instruction-slot plan (it reads the skin from buffers).
   PU=(--no-probes --corpus 3 --seed 4242 --meshes head -r "$SRC/examples/dawn/rules.yaml" --templates "$SRC/templates"
       --no-check --refits 0 --frames 1 --rounds 1 --draws 1 --min-frame-vertices 0)
-  expect 0 "calibrate --plans-under" -- "$SG" calibrate "${PU[@]}" --plans-under "$SRC/devices/nvidia-h200-raster.yaml" -o pu.yaml
+  expect 0 "calibrate --plans-under --processes 2" -- "$SG" calibrate "${PU[@]}" --plans-under "$SRC/devices/nvidia-h200-raster.yaml" \
+    --processes 2 -o pu.yaml
+  grep -q "^device: .*best of 1 rounds in each of 2 processes" last.out && ok "calibrate --processes 2: each rig's rounds from 2 processes" ||
+    fail "calibrate --processes: $(head -1 last.out)"
   generated() { grep -E "^\| head \| $1 \| $2 \|" last.out | cut -d'|' -f5-13; }
   # The label names the profile by its file's stem and the first 12 hex digits of its SHA-256.
   fp=$(sha256sum "$SRC/devices/nvidia-h200-raster.yaml" | cut -c1-12)
