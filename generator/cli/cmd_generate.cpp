@@ -20,6 +20,7 @@ namespace sg {
 const char* shadergenVersionString() { return shadergenVersion(); }
 
 void GenerateArgs::add(CLI::App& cmd, bool inputsRequired) {
+  const size_t before = cmd.get_options().size();
   cmd.add_option("--rig", opts.rigPath, "Rig description (YAML)")->required(inputsRequired);
   cmd.add_option("--fragment,-f", opts.fragmentPath, "Fragment shader whose inputs must be fed (GLSL 450)")->required(inputsRequired);
   cmd.add_option("--rules,-r", opts.rulesPaths, "Rules file(s) (YAML)")->required(inputsRequired);
@@ -71,6 +72,8 @@ void GenerateArgs::add(CLI::App& cmd, bool inputsRequired) {
                  "(vertex.normal=0.1deg), a fraction of the bounds diagonal for a position (vertex.position=1e-4), of the "
                  "target's scale for a morph delta (morph.position=1e-4). Stored encodings that can err more are not offered to the search "
                  "(docs/rig-format.md, \"Encodings\")");
+  const std::vector<CLI::Option*> all = cmd.get_options();
+  generateOptions.assign(all.begin() + std::ptrdiff_t(before), all.end());
   addGltfReadOptions(cmd, opts.gltf);
 }
 

@@ -228,10 +228,10 @@ struct BenchCommand {
   // without its old pin; a YAML rig on --mesh, else the manifest's `mesh:`, else dawn; a glTF rig
   // on its own mesh. A variant that fails is reported and the others still run.
   int runManifest() {
-    for (const char* o : {"--rig", "--fragment", "--rules", "--map", "--conventions", "--heuristic", "--search",
-                          "--max-attributes", "--max-uniform-bytes", "--vertices", "--target-env", "--templates", "--ban",
-                          "--pin", "--set", "--max-error", "--hand-port", "--time-part"})
-      refuseOption(*cmd, o, "with --manifest: each variant's inputs and options are the manifest's");
+    const std::string why = "with --manifest: each variant's inputs and options are the manifest's";
+    for (const CLI::Option* o : args.generateOptions)
+      if (o->get_name() != "--device-profile") refuseOption(*cmd, o->get_name(), why);
+    for (const char* o : {"--hand-port", "--time-part"}) refuseOption(*cmd, o, why);
     const GenerateOptions given = args.resolve();  // --device-profile, in place of the manifest's
     Manifest m = loadManifest(manifestPath);
     if (!given.deviceProfilePath.empty()) {

@@ -32,6 +32,7 @@ struct GenerateArgs {
   std::string pin;  // --pin: a measured choice (pipeline/pin.h), read by resolve
   CLI::Option* maxAttributes = nullptr;  // whether the device limits were given (applyDeviceLimits)
   CLI::Option* maxUniformBytes = nullptr;
+  std::vector<CLI::Option*> generateOptions;  // every option add() registers but the glTF reading ones
   void add(CLI::App& cmd, bool inputsRequired = true);  // false: the command checks --rig, -f, -r itself
   GenerateOptions resolve() const;  // parses --map and --target-env (throws CLI::ValidationError), reads --pin
 };
