@@ -69,10 +69,11 @@ def main(argv):
     out = argv[1]
     refs = argv[argv.index('--reference') + 1:] if '--reference' in argv else []
     ref = reference(refs)
-    lines = ["| pair | mesh | pinned | pinned / fastest | generated / fastest | plans timed |"
+    lines = ["| pair | mesh | pinned | pinned / fastest | generated / fastest | plans timed | tune timed |"
              + (" reference: pinned / fastest |" if refs else ""),
-             "|---|---|---|---:|---:|---:|" + ("---:|" if refs else "")]
+             "|---|---|---|---:|---:|---:|---:|" + ("---:|" if refs else "")]
     stats = {"check": [], "generated": [], "ref": []}
+    tuned = []  # validated plans each pin's tune timed (its `candidates:`; more than K where it widened)
     for name in sorted(os.listdir(os.path.join(out, 'pins'))):
         pin = pin_file(os.path.join(out, 'pins', name))
         pair, mesh = name[:-len('.pin.yaml')].rsplit('-', 1)
@@ -85,7 +86,8 @@ def main(argv):
             stats["check"].append(r)
             stats["generated"].append(g)
             cell = [f"{r:.3f}", f"{g:.3f}", str(len(rows))]
-        row = f"| {pair} | {mesh} | {pin['plan']} | " + " | ".join(cell) + " |"
+        tuned.append(int(pin.get('candidates', 0)))
+        row = f"| {pair} | {mesh} | {pin['plan']} | " + " | ".join(cell) + f" | {tuned[-1]} |"
         if refs:
             rig = re.sub(r'^s\d+-', '', pair) + '.rig.yaml'
             progs = ref.get((rig, mesh), {})
@@ -98,6 +100,8 @@ def main(argv):
         lines.append(row)
     print("\n".join(lines))
     print()
+    if tuned:
+        print(f"the tune timed {sum(tuned) / len(tuned):.2f} plans a pair on average, most {max(tuned)}")
     for key, what in (("check", "pinned / fastest (check run)"), ("generated", "generated / fastest (check run)"),
                       ("ref", "pinned / fastest (reference logs)")):
         v = stats[key]

@@ -150,13 +150,49 @@ struct BenchCommand {
   std::string manifestPath, timeVariant;
   std::vector<std::string> variantNames;
   uint32_t processes = 1;  // --processes: fresh processes per rig, part or variant, their rounds merged
+  // --max-candidates: how far --candidates K widens where the timed plans do not rank as the
+  // objective does (0: 3K, at most 64); --time-candidates: a fresh child's count, the parent's.
+  size_t maxCandidates = 0, timeCandidates = 0;
 
-  // A rig, part or variant timed in --processes fresh processes (the child told by `childArgs`).
-  GpuBenchReport timedFresh(const std::vector<std::string>& childArgs, const std::string& what) const {
-    return benchInFreshProcesses(commandLine, childArgs, what, false, processes);
+  // A rig, part or variant timed in this process, or in --processes fresh ones (`fresh`; the
+  // child told by `childArgs`). With --candidates K, timed once more with the --max-candidates
+  // cheapest where the K do not rank as the objective ranks them (rankCandidates): the measured
+  // choice then looks past a short list its profile cannot order.
+  GpuBenchReport timeOne(GpuBenchOptions one, bool fresh, const std::vector<std::string>& childArgs,
+                         const std::string& what) const {
+    auto time = [&](size_t candidates) {
+      one.candidates = candidates;
+      if (!fresh) return runGpuBench(one);
+      std::vector<std::string> child = childArgs;
+      if (candidates > 0) child.insert(child.end(), {"--time-candidates", std::to_string(candidates)});
+      return benchInFreshProcesses(commandLine, child, what, false, processes);
+    };
+    const size_t first = one.candidates;
+    const size_t widest = maxCandidates > 0 ? maxCandidates : std::min<size_t>(64, 3 * first);
+    GpuBenchReport rep = time(first);
+    if (first == 0 || widest <= first) return rep;
+    size_t plans = 0;
+    for (const auto& row : rep.rows) {
+      if (row.validation.rfind("FAIL", 0) == 0) return rep;  // no pin from this run: nothing to widen for
+      plans += row.hasCost;
+    }
+    if (plans < first) return rep;  // every plan there is was timed
+    const CandidateRanking ranking = rankCandidates(rep);
+    if (!ranking.cannotRank) return rep;
+    GpuBenchReport wide = time(widest);
+    wide.notes.push_back(Diagnostic{
+        Severity::Note, SourceLoc{what, 0, 0},
+        fmt::format("the search's objective puts the {} cheapest plans {:.3g} % apart and the device measured {:.3g} %: it "
+                    "cannot rank them here, so the {} cheapest were timed (--max-candidates)",
+                    ranking.plans, 100 * ranking.predictedSpread, 100 * ranking.measuredSpread, widest)});
+    return wide;
   }
 
   int run() {
+    if (timeCandidates > 0) bo.candidates = timeCandidates;
+    if (maxCandidates > 0 && bo.candidates == 0) throw CLI::ValidationError("--max-candidates", "needs --candidates");
+    if (maxCandidates > 0 && maxCandidates < bo.candidates)
+      throw CLI::ValidationError("--max-candidates", fmt::format("{} is fewer than --candidates {}", maxCandidates, bo.candidates));
     if (!manifestPath.empty()) return runManifest();
     for (const char* o : {"--rig", "--fragment", "--rules"})
       if (cmd->count(o) == 0) throw CLI::RequiredError(std::string(o) + " (or --manifest)");
@@ -209,7 +245,7 @@ struct BenchCommand {
       std::vector<std::string> broken = forEachPart(*parts, [&](const GltfPart& part) {
         GpuBenchOptions one = bo;
         one.render.gen.rigPath = part.ref;
-        GpuBenchReport rep = oneProcess ? runGpuBench(one) : timedFresh({"--time-part", part.ref}, part.ref);
+        GpuBenchReport rep = timeOne(one, !oneProcess, {"--time-part", part.ref}, part.ref);
         std::cout << fmt::format("## {} ({})\n\n", part.name, part.ref);
         failed += report(rep);
         std::cout << "\n";
@@ -217,8 +253,7 @@ struct BenchCommand {
       failIfPartsFailed(model, parts->size(), broken, "the others were timed");
       return failed ? 1 : 0;
     }
-    const GpuBenchReport rep =
-        processes > 1 ? timedFresh({"--time-part", bo.render.gen.rigPath}, bo.render.gen.rigPath) : runGpuBench(bo);
+    const GpuBenchReport rep = timeOne(bo, processes > 1, {"--time-part", bo.render.gen.rigPath}, bo.render.gen.rigPath);
     if (report(rep)) return 1;  // no pin from a run where a program failed on the device
     if (!pinOut.empty()) writePin(rep, pinOut);
     return 0;
@@ -267,7 +302,7 @@ struct BenchCommand {
     std::vector<std::string> broken;
     for (const Variant& v : variants)
       if (!runReportingFailure(SourceLoc{m.file, 0, 0}, fmt::format("variant {} failed:", v.name), [&] {
-            GpuBenchReport rep = oneProcess ? runGpuBench(optionsOf(v)) : timedFresh({"--time-variant", v.name}, v.name);
+            GpuBenchReport rep = timeOne(optionsOf(v), !oneProcess, {"--time-variant", v.name}, v.name);
             std::cout << fmt::format("## {}\n\n", v.name);
             const int f = report(rep);
             failed += f;
@@ -385,6 +420,12 @@ void registerRender(CLI::App& app, CliState& state) {
                 "Time the K plans cheapest under the search's objective (the device profile's predicted time), the generated "
                 "one first, instead of its forced alternatives: the candidates of a measured choice (--pin-out)")
       ->check(CLI::Range(1, 64));
+  b->add_option("--max-candidates", bench->maxCandidates,
+                "With --candidates K: where the device does not show the differences the objective predicts between the K "
+                "(it predicts 5 % or more and the device shows under a tenth of that), time the M cheapest instead "
+                "(default 3K, at most 64; K: never)")
+      ->check(CLI::Range(1, 64));
+  b->add_option("--time-candidates", bench->timeCandidates)->group("");  // a fresh child's --candidates
   b->add_option("--pin-out", bench->pinOut,
                 "Write the fastest validated plan as a pin file (YAML): generate --pin writes that plan on any machine "
                 "(docs/performance.md, \"A measured choice\")");

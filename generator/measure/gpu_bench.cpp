@@ -268,6 +268,24 @@ int pinnedPlan(const GpuBenchReport& r) {
   return best;
 }
 
+CandidateRanking rankCandidates(const GpuBenchReport& r) {
+  CandidateRanking c;
+  double leastCost = INFINITY, mostCost = -INFINITY, leastTime = INFINITY, mostTime = -INFINITY;
+  for (const auto& row : r.rows) {
+    if (!row.hasCost || row.validation != "pass" || std::isnan(medianRound(row))) continue;
+    ++c.plans;
+    leastCost = std::min(leastCost, double(row.planCost));
+    mostCost = std::max(mostCost, double(row.planCost));
+    leastTime = std::min(leastTime, medianRound(row));
+    mostTime = std::max(mostTime, medianRound(row));
+  }
+  if (c.plans < 2 || !(leastCost > 0) || !(leastTime > 0)) return c;
+  c.predictedSpread = mostCost / leastCost - 1;
+  c.measuredSpread = mostTime / leastTime - 1;
+  c.cannotRank = c.predictedSpread >= kRankedSpread && c.measuredSpread < kShownFraction * c.predictedSpread;
+  return c;
+}
+
 bool isCpuDevice(const std::string& deviceName) { return deviceName.find("llvmpipe") != std::string::npos; }
 
 void timeCpuDevicesSingleThreaded() { setenv("LP_NUM_THREADS", "0", /*overwrite=*/0); }

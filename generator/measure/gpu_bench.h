@@ -145,6 +145,25 @@ void summarize(GpuBenchReport& rep);
 int pinnedPlan(const GpuBenchReport& r);
 double medianRound(const GpuBenchRow& row);  // NaN: never timed
 
+// Whether the timed candidates rank as the search's objective ranks them (bench --candidates
+// widens to --max-candidates where they do not): over the plans pinnedPlan weighs, the
+// objective's spread (greatest plan cost over least, less 1) against the measured spread of
+// their median rounds. The objective "cannot rank" them where it predicts at least
+// kRankedSpread between them and the device shows less than kShownFraction of it: its
+// differences are not what the device pays there, so the next plans it ranks lower are no
+// likelier to be slower. Session 38's H100 run: RobotExpressive's hand (256 vertices, 250
+// draws a frame) was predicted 24.8 % apart over its 4 cheapest plans and measured 0.2 %; its
+// fastest plan was the 12th cheapest, 0.944x the others.
+struct CandidateRanking {
+  size_t plans = 0;               // validated plans timed by the prediction clock
+  double predictedSpread = NAN;   // NaN: fewer than two, or a plan cost not above 0
+  double measuredSpread = NAN;
+  bool cannotRank = false;
+};
+inline constexpr double kRankedSpread = 0.05;
+inline constexpr double kShownFraction = 0.1;
+CandidateRanking rankCandidates(const GpuBenchReport& r);
+
 // Draws per timed frame of a mesh of `vertices`: at least `draws`, and enough that the frame
 // draws `minVertices` vertices, at most kMostDrawsPerFrame.
 inline constexpr uint32_t kMostDrawsPerFrame = 100000;

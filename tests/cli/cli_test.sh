@@ -778,7 +778,7 @@ pin)
   # the device, under any profile or none; a pin the inputs no longer give is a located error.
   BENCH=("${DAWN[@]}" --device-profile "$SRC/devices/llvmpipe-2core.yaml" --mesh head --raster off --draws 1
          --min-frame-vertices 0 --frames 2 --rounds 1 --no-floor --no-validation-layers)
-  expect 0 "bench --candidates 3 --pin-out" -- "$SG" bench "${BENCH[@]}" --candidates 3 --pin-out face.pin.yaml
+  expect 0 "bench --candidates 3 --pin-out" -- "$SG" bench "${BENCH[@]}" --candidates 3 --max-candidates 3 --pin-out face.pin.yaml
   mv last.out bench.out
   rows=$(grep -cE '^\| (generated|cheapest plan #[0-9]+) \| pass' bench.out)
   [ "$rows" -eq 3 ] && ok "bench: 3 candidates timed, each validated" || fail "bench: $rows candidates passed, expected 3: $(cat bench.out)"
@@ -836,6 +836,35 @@ YAML
   expect 1 "explain --pin, a stale pin" -- "$SG" explain "${DAWN[@]}" --pin stale.pin.yaml --no-alternatives
   grep -q "^stale.pin.yaml:[0-9]*:[0-9]*: error: the pinned plan is not what these inputs give" last.err &&
     ok "explain: a stale pin is the same located error" || fail "explain, stale pin: $(cat last.err)"
+  # A short list the objective cannot rank is widened: a profile that prices only a vertex location past
+  # the 4th (1,000 ns each) puts limb8_palette300's two 4-location plans at 0.01 ns and its two 8-location
+  # plans at 4,000 ns; lavapipe shows them within a few percent. --candidates 2 (the two 4-location
+  # plans, predicted equal) times 2; --candidates 3 (an 8-location plan too: 4e7 % predicted, nothing
+  # like it measured) times all 4 (--max-candidates 4), and the pin says so.
+  cat > locations.device.yaml <<YAML
+device: "llvmpipe"
+unit: ns
+weights: { vertices: 0.01 }
+vertices_per_draw: 2009
+thresholds:
+  locations: { at: 4, ns: 1000 }
+YAML
+  V="$SRC/tests/validate/data"
+  LIMB=(--rig "$V/limb8_palette300.rig.yaml" -f "$V/world.frag" -r "$SRC/rules/standard.yaml" --device-profile locations.device.yaml
+        --mesh head --raster off --draws 1 --min-frame-vertices 0 --frames 2 --rounds 1 --no-floor --no-validation-layers)
+  timed() { grep -cE '^\| (generated|cheapest plan #[0-9]+) \| pass' "$1"; }
+  expect 0 "bench --candidates 2, predicted equal" -- "$SG" bench "${LIMB[@]}" --candidates 2 --max-candidates 4 --pin-out equal.pin.yaml
+  [ "$(timed last.out)" -eq 2 ] && grep -q '^candidates: 2$' equal.pin.yaml && ! grep -q 'cannot rank' last.err &&
+    ok "bench: candidates the objective prices alike are not widened" || fail "bench --candidates 2: $(cat last.err; cat equal.pin.yaml)"
+  expect 0 "bench --candidates 3, an order the device does not show" -- "$SG" bench "${LIMB[@]}" --candidates 3 --max-candidates 4 --processes 2 --pin-out widened.pin.yaml
+  [ "$(timed last.out)" -eq 4 ] && grep -q '^candidates: 4$' widened.pin.yaml &&
+    grep -q "limb8_palette300.rig.yaml: note: the search's objective puts the 3 cheapest plans 4e+07 % apart and the device measured [0-9.e+-]* %: it cannot rank them here, so the 4 cheapest were timed" last.err &&
+    grep -q 'best of 2 rounds in 2 processes' last.out &&
+    ok "bench: an unranked short list widened to --max-candidates, in fresh processes, and pinned from all 4" ||
+    fail "bench --candidates 3: $(timed last.out) timed; $(cat last.err; cat widened.pin.yaml)"
+  expect 0 "bench --candidates 3 --max-candidates 3" -- "$SG" bench "${LIMB[@]}" --candidates 3 --max-candidates 3
+  [ "$(timed last.out)" -eq 3 ] && ! grep -q 'cannot rank' last.err && ok "bench: --max-candidates K never widens" ||
+    fail "--max-candidates 3: $(timed last.out) timed"
   # A whole manifest tuned at once: bench --manifest --pin-out DIR times each variant's candidates and
   # pins each; the manifest's `pins: DIR` then builds every variant as generate --pin writes it.
   cat > tune.variants.yaml <<YAML
@@ -850,7 +879,8 @@ YAML
   expect 0 "build, pins: DIR not made yet" -- "$SG" build tune.variants.yaml -q --no-cache
   grep -q '"pin"' tuned/index.json && fail "a variant pinned before any pin was made" || ok "pins: DIR not there yet: no variant pinned"
   expect 0 "bench --manifest --candidates 3 --processes 2 --pin-out DIR" -- "$SG" bench --manifest tune.variants.yaml --raster off \
-    --draws 1 --min-frame-vertices 0 --frames 2 --rounds 1 --no-floor --no-validation-layers --candidates 3 --processes 2 --pin-out tuned-pins
+    --draws 1 --min-frame-vertices 0 --frames 2 --rounds 1 --no-floor --no-validation-layers --candidates 3 --max-candidates 3 \
+    --processes 2 --pin-out tuned-pins
   [ "$(grep -c '^## face-' last.out)" -eq 2 ] && [ -s tuned-pins/face-color.pin.yaml ] && [ -s tuned-pins/face-depth.pin.yaml ] &&
     [ "$(grep -c 'best of 2 rounds in 2 processes' last.out)" -eq 2 ] &&
     ok "bench --manifest: both variants timed in 2 processes each, and pinned" ||

@@ -151,6 +151,43 @@ TEST(GpuBench, ProcessesMergeTheirRoundsSoOneSlowProcessDoesNotPick) {
   EXPECT_THROW(sg::mergeProcessRuns({slow, other}), std::runtime_error);
 }
 
+TEST(GpuBench, CandidatesTheObjectiveCannotRankAreThoseItsDifferencesDoNotShowIn) {
+  // Session 38's H100 hand, the 4 cheapest: plan costs 4.389, 4.967, 5.312, 5.476 (24.8 %
+  // apart) and median rounds 5.2305..5.2345 ns (0.08 % apart): the device shows under a tenth of
+  // what the objective predicts, so it cannot rank them. Floors and failed plans do not count.
+  auto row = [](const char* label, int64_t cost, double ns) {
+    sg::GpuBenchRow r = roundsRow(label, true, "pass", {ns, ns * 1.01, ns * 0.99});
+    r.planCost = cost;
+    return r;
+  };
+  sg::GpuBenchReport hand;
+  hand.rows = {row("generated", 4388891, 5.2305), row("#2", 4966655, 5.2265), row("#3", 5311831, 5.2395),
+               row("#4", 5476447, 5.2335), roundsRow("floor", false, "", {1, 1, 1})};
+  hand.rows.push_back(row("failed", 100, 1));
+  hand.rows.back().validation = "FAIL: out";
+  sg::CandidateRanking c = sg::rankCandidates(hand);
+  EXPECT_EQ(c.plans, 4u);
+  EXPECT_NEAR(c.predictedSpread, 5476447.0 / 4388891.0 - 1, 1e-12);
+  EXPECT_NEAR(c.measuredSpread, 5.2395 / 5.2265 - 1, 1e-12);
+  EXPECT_TRUE(c.cannotRank);
+  // The device showing a tenth of the predicted spread (or more) ranks them: 24.8 % predicted, 2.5 % measured.
+  hand.rows[3].roundNsPerVertex = {5.2265 * (1 + 0.1 * c.predictedSpread) * 1.0001};
+  EXPECT_FALSE(sg::rankCandidates(hand).cannotRank);
+  // Predicted within 5 %: nothing to rank, whatever the device shows.
+  sg::GpuBenchReport close;
+  close.rows = {row("generated", 1000, 5.0), row("#2", 1049, 5.0)};
+  EXPECT_NEAR(sg::rankCandidates(close).predictedSpread, 0.049, 1e-12);
+  EXPECT_FALSE(sg::rankCandidates(close).cannotRank);
+  close.rows[1].planCost = 1050;
+  EXPECT_TRUE(sg::rankCandidates(close).cannotRank);
+  // One plan, or a cost of 0 (a profile that prices nothing here): no spread to judge.
+  close.rows.pop_back();
+  EXPECT_TRUE(std::isnan(sg::rankCandidates(close).predictedSpread));
+  EXPECT_FALSE(sg::rankCandidates(close).cannotRank);
+  close.rows = {row("generated", 0, 5.0), row("#2", 100, 5.0)};
+  EXPECT_FALSE(sg::rankCandidates(close).cannotRank);
+}
+
 TEST(GpuBench, CaptureQualifiersGoOnEveryOutputAndUnknownOutputsAreErrors) {
   sg::EmittedGlsl capture;
   capture.captureStride = 32;
