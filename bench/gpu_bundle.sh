@@ -4,7 +4,8 @@
 # Vulkan loader (the target brings those; its GPU driver brings the ICD), the rules,
 # templates, device profiles and the Dawn example, bench/gpu_run.sh, gpu_calibrate.sh and
 # gpu_layouts.sh (and gpu_env.sh, which they source).
-# Usage: bash bench/gpu_bundle.sh [BUILD_DIR=build] [OUT=build/shadergen-gpu.tar.gz]
+# Usage: bash bench/gpu_bundle.sh [BUILD_DIR=build] [OUT=build/shadergen-gpu.tar.gz]; an OUT ending in .tar.xz is
+# xz-compressed: 25 MB where gzip gives 40 (Embree's library is most of it), for a carry limit the checkout shares.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$root/build}
@@ -40,5 +41,8 @@ done
 cp "$root/tests/gltf/data/gltfpack/AnimatedMorphSphere.meshopt-cc-kv.glb" "$stage/sg/examples/models/"
 cp "$root/bench/gpu_env.sh" "$root/bench/gpu_run.sh" "$root/bench/gpu_calibrate.sh" "$root/bench/gpu_layouts.sh" \
   "$root/bench/gpu_collect.sh" "$root/bench/gpu_verify.sh" "$root/bench/gpu_pin.sh" "$stage/sg/"
-tar -C "$stage" -czf "$out" sg
+case "$out" in
+  *.xz) tar -C "$stage" -cf - sg | xz -T0 -9 > "$out" ;;
+  *) tar -C "$stage" -czf "$out" sg ;;
+esac
 echo "$out: $(du -h "$out" | cut -f1)"
