@@ -258,11 +258,16 @@ double medianRound(const GpuBenchRow& row) {
   return medianOf(row.roundNsPerVertex);
 }
 
+namespace {
+// A plan a measured choice weighs (pinnedPlan, rankCandidates): validated and timed in rounds.
+bool weighedPlan(const GpuBenchRow& row) { return row.hasCost && row.validation == "pass" && !std::isnan(medianRound(row)); }
+}  // namespace
+
 int pinnedPlan(const GpuBenchReport& r) {
   int best = -1;
   for (size_t i = 0; i < r.rows.size(); ++i) {
     const GpuBenchRow& row = r.rows[i];
-    if (!row.hasCost || row.validation != "pass" || std::isnan(medianRound(row))) continue;
+    if (!weighedPlan(row)) continue;
     if (best < 0 || medianRound(row) < medianRound(r.rows[size_t(best)])) best = int(i);
   }
   return best;
@@ -272,7 +277,7 @@ CandidateRanking rankCandidates(const GpuBenchReport& r) {
   CandidateRanking c;
   double leastCost = INFINITY, mostCost = -INFINITY, leastTime = INFINITY, mostTime = -INFINITY;
   for (const auto& row : r.rows) {
-    if (!row.hasCost || row.validation != "pass" || std::isnan(medianRound(row))) continue;
+    if (!weighedPlan(row)) continue;
     ++c.plans;
     leastCost = std::min(leastCost, double(row.planCost));
     mostCost = std::max(mostCost, double(row.planCost));

@@ -152,7 +152,7 @@ double medianRound(const GpuBenchRow& row);  // NaN: never timed
 // kRankedSpread between them and the device shows less than kShownFraction of it: its
 // differences are not what the device pays there, so the next plans it ranks lower are no
 // likelier to be slower. Session 38's H100 run: RobotExpressive's hand (256 vertices, 250
-// draws a frame) was predicted 24.8 % apart over its 4 cheapest plans and measured 0.2 %; its
+// draws a frame) was predicted 24.8 % apart over its 4 cheapest plans and measured 0.24 %; its
 // fastest plan was the 12th cheapest, 0.944x the others.
 struct CandidateRanking {
   size_t plans = 0;               // validated plans timed by the prediction clock

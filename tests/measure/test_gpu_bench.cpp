@@ -153,7 +153,7 @@ TEST(GpuBench, ProcessesMergeTheirRoundsSoOneSlowProcessDoesNotPick) {
 
 TEST(GpuBench, CandidatesTheObjectiveCannotRankAreThoseItsDifferencesDoNotShowIn) {
   // Session 38's H100 hand, the 4 cheapest: plan costs 4.389, 4.967, 5.312, 5.476 (24.8 %
-  // apart) and median rounds 5.2305..5.2345 ns (0.08 % apart): the device shows under a tenth of
+  // apart) and its check run's times 5.2265..5.2395 ns (0.25 % apart): the device shows under a tenth of
   // what the objective predicts, so it cannot rank them. Floors and failed plans do not count.
   auto row = [](const char* label, int64_t cost, double ns) {
     sg::GpuBenchRow r = roundsRow(label, true, "pass", {ns, ns * 1.01, ns * 0.99});
