@@ -11,25 +11,19 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from pin_table import CLOCK_COLUMN  # noqa: E402
+from pin_table import CLOCK_COLUMN, passing_rows  # noqa: E402
 
 
 def plans(path):
     """[(predicted, measured)] in the table's order (the objective's), rows that passed and were timed; the time
     by the first prediction clock (pin_table.CLOCK_COLUMN) the row has a figure for: raster-on timestamps on a
     GPU, the process's CPU time with raster off on lavapipe."""
-    header, out = None, []
-    for line in open(path):
-        cells = [c.strip() for c in line.strip().strip('|').split('|')]
-        if line.startswith('| program |'):
-            header = cells
-        elif header and line.startswith('| ') and len(cells) == len(header) and cells[1] == 'pass':
-            times = {c: cells[header.index(c)].split(' ')[0] for c in CLOCK_COLUMN.values() if c in header}
-            t = next((float(v) for v in times.values() if v != '—'), None)
-            if t is not None:
-                out.append((float(cells[header.index('predicted')]), t))
-        elif header and not line.startswith('|') and out:
-            break
+    out = []
+    for row in passing_rows(path):
+        times = [row[c].split(' ')[0] for c in CLOCK_COLUMN.values() if c in row]
+        t = next((float(v) for v in times if v != '—'), None)
+        if t is not None:
+            out.append((float(row['predicted']), t))
     return out
 
 

@@ -25,20 +25,28 @@ def pin_file(path):
     return pin
 
 
-def bench_rows(path, clock):
-    """label -> time by the clock's column, for rows that passed on the device."""
-    header, rows = None, {}
+def passing_rows(path):
+    """The rows of a bench log's program table that passed on the device, in its order (the objective's),
+    each a dict from column name to cell."""
+    header, rows = None, []
     for line in open(path):
         cells = [c.strip() for c in line.strip().strip('|').split('|')]
         if line.startswith('| program |'):
             header = cells
         elif header and line.startswith('| ') and len(cells) == len(header) and cells[1] == 'pass':
-            v = cells[header.index(CLOCK_COLUMN[clock])].split(' ')[0]
-            if v != '—':
-                rows[cells[0]] = float(v)
-        elif header and not line.startswith('|'):
-            if rows:
-                break
+            rows.append(dict(zip(header, cells)))
+        elif header and not line.startswith('|') and rows:
+            break
+    return rows
+
+
+def bench_rows(path, clock):
+    """label -> time by the clock's column, for rows that passed on the device."""
+    rows = {}
+    for row in passing_rows(path):
+        v = row[CLOCK_COLUMN[clock]].split(' ')[0]
+        if v != '—':
+            rows[row['program']] = float(v)
     return rows
 
 
