@@ -591,9 +591,9 @@ device_profile)
     --templates "$SRC/templates" -o corpus-case --emit glsl
   expect 2 "--write-corpus without --corpus (a usage error)" -- "$SG" calibrate --write-corpus corpus6
   # --plans-under: each rig's plan under that profile is timed too, with its forced alternatives, so
-  # a held-out log holds the plan the profile would choose. Of seed 4242's three rigs, the H200
+  # a held-out log holds the plan the profile would choose. Of seed 4242's first two rigs, the H200
   # profile moves at least one plan away from the instruction-slot plan (it reads the skin from buffers).
-  PU=(--no-probes --corpus 3 --seed 4242 --meshes head -r "$SRC/examples/dawn/rules.yaml" --templates "$SRC/templates"
+  PU=(--no-probes --corpus 2 --seed 4242 --meshes head -r "$SRC/examples/dawn/rules.yaml" --templates "$SRC/templates"
       --no-check --refits 0 --frames 1 --rounds 1 --draws 1 --min-frame-vertices 0)
   expect 0 "calibrate --plans-under --processes 2" -- "$SG" calibrate "${PU[@]}" --plans-under "$SRC/devices/nvidia-h200-raster.yaml" \
     --processes 2 -o pu.yaml
@@ -609,7 +609,7 @@ device_profile)
     [ -n "$a" ] && [ -n "$b" ] && both=$((both + 1))
     [ -n "$b" ] && [ "$a" != "$b" ] && moved=$((moved + 1))
   done
-  [ "$both" -eq 3 ] && [ "$moved" -ge 1 ] && ok "each rig's plan timed under both ($moved moved by the profile)" ||
+  [ "$both" -eq 2 ] && [ "$moved" -ge 1 ] && ok "each rig's plan timed under both ($moved moved by the profile)" ||
     fail "rigs with both plans: $both, moved: $moved; $(grep -c 'plan under' last.out) rows under the profile"
   cp last.out pu.log
   expect 0 "the log reads back, its plans under the profile among them" -- "$SG" calibrate --from-log pu.log
@@ -622,7 +622,7 @@ device_profile)
   own=$(grep -c '(its plan)' last.out)
   mkdir -p edited && { cat "$SRC/devices/nvidia-h200-raster.yaml"; echo "# edited"; } > edited/nvidia-h200-raster.yaml
   expect 0 "--evaluate an edited profile of the same name" -- "$SG" calibrate --evaluate edited/nvidia-h200-raster.yaml --check-log pu.log
-  [ "$own" -eq 3 ] && ! grep -q '(its plan)' last.out && ok "its own plan counted in 3 pairs, an edited profile's in none" ||
+  [ "$own" -eq 2 ] && ! grep -q '(its plan)' last.out && ok "its own plan counted in 2 pairs, an edited profile's in none" ||
     fail "own plans: $own under the profile, $(grep -c '(its plan)' last.out) under the edited one"
   # --per-plan lists each pair's plans: as many rows as the pairs' plan counts add up to, one chosen per pair.
   expect 0 "--evaluate --per-plan" -- "$SG" calibrate --evaluate "$SRC/devices/nvidia-h200-raster.yaml" --check-log pu.log --per-plan
@@ -630,13 +630,13 @@ device_profile)
   plans=$(sed -n '/^held-out check:/,/^held-out check over/p' last.out | grep -E '^\| corpus-' | awk -F'|' '{ n += $4 } END { print n }')
   rows=$(sed -n '/^held-out check, every plan/,$p' last.out | grep -cE '^\| corpus-')
   chosen=$(sed -n '/^held-out check, every plan/,$p' last.out | grep -c '| chosen (its plan)')
-  [ "$pairs" -eq 3 ] && [ "$rows" -eq "$plans" ] && [ "$chosen" -eq 3 ] && ok "every plan listed ($rows), each pair's own plan marked" ||
+  [ "$pairs" -eq 2 ] && [ "$rows" -eq "$plans" ] && [ "$chosen" -eq 2 ] && ok "every plan listed ($rows), each pair's own plan marked" ||
     fail "pairs $pairs, plans $plans, rows $rows, chosen $chosen"
   # A refit's leave-one-rig-out lists its plans too, one chosen per pair; without the flag, no plan table.
   expect 0 "--from-log --per-plan" -- "$SG" calibrate --from-log pu.log --per-plan
   pairs=$(sed -n '/^leave-one-rig-out:/,/^leave-one-rig-out over/p' last.out | grep -E '^\| corpus-' | wc -l)
   chosen=$(sed -n '/^leave-one-rig-out, every plan/,$p' last.out | grep -cE '\| chosen( \(its plan\))?( \||, )')
-  [ "$pairs" -eq 3 ] && [ "$chosen" -eq 3 ] && ok "the leave-one-rig-out's plans listed, one chosen a pair" ||
+  [ "$pairs" -eq 2 ] && [ "$chosen" -eq 2 ] && ok "the leave-one-rig-out's plans listed, one chosen a pair" ||
     fail "pairs $pairs, chosen $chosen"
   "$SG" calibrate --from-log pu.log | grep -q "every plan" && fail "a plan table without --per-plan" || ok "no plan table without --per-plan"
   # --outside-pipes: the raster form prices locations and buffer loads outside the pipes too by
@@ -752,7 +752,10 @@ fresh_process)
     fail "fresh: $(head -3 fresh.err); one process: $(head -3 last.err)"
   # An interrupt sent to the whole process group (`timeout -s INT`, Ctrl-C) reaches the rig's
   # process too: it finishes its rig, and the calibration fits what was timed, as in one process.
-  setsid "$SG" calibrate "${DAWN[@]}" --meshes head,dawn --draws 2 --frames 2 --rounds 10 --no-probes \
+  # The head alone, 5 rounds: the process timing at the signal finishes all its rounds (at Dawn
+  # scale that took 35 s here, 46 s under the sanitizers). Uninterrupted, this run (a process
+  # timing the rig, then one checking the fit) takes 9 s on 2 cores, so the signal comes mid-run.
+  setsid "$SG" calibrate "${DAWN[@]}" --meshes head --draws 2 --frames 2 --rounds 5 --no-probes \
     --no-validation-layers -o group.yaml >group.out 2>group.err &
   pid=$!
   sleep 4
