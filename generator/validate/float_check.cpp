@@ -23,7 +23,8 @@ struct Axis {
 
 FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::Mesh& floatMesh,
                               const UniformValues& uniforms, const std::vector<InputErrorBound>& bounds,
-                              const std::vector<std::string>& semantics) {
+                              const std::vector<std::string>& semantics,
+                              const std::map<std::string, std::vector<glm::vec4>>& stored) {
   // Compiled once per set of semantics: the perturbations change stream values in place. An
   // input is perturbed only for the semantics that can read it.
   Interpreter reference(rules, shape, floatMesh, uniforms);
@@ -191,11 +192,39 @@ FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::M
     }
   }
 
+  // The stored data itself, every bounded input at once, where it lies within its bounds.
+  std::vector<std::vector<double>> reached;
+  bool anyStored = false;
+  for (const InputErrorBound& b : bounds) {
+    const auto it = stored.find(b.semantic);
+    if (it == stored.end()) continue;
+    std::vector<glm::vec4>& stream = floatMesh.streams.at(b.semantic);
+    const std::vector<glm::vec4>& given = saved.at(b.semantic);
+    for (size_t v = 0; v < n && v < stream.size() && v < it->second.size() && v < b.bound.size(); ++v) {
+      const glm::vec4 y = it->second[v];
+      if (b.ball) {
+        if (glm::length(glm::dvec3(y) - glm::dvec3(given[v])) <= b.bound[v].x)
+          stream[v] = glm::vec4(glm::vec3(y), given[v].w), anyStored = true;
+      } else {
+        for (int k = 0; k < 4; ++k)
+          if (b.bound[v][k] > 0 && std::abs(double(y[k]) - double(given[v][k])) <= b.bound[v][k])
+            stream[v][k] = y[k], anyStored = true;
+      }
+    }
+  }
+  if (anyStored) {
+    reached = evaluator(all)();
+    for (const auto& [sem, given] : saved) std::copy(given.begin(), given.end(), floatMesh.streams.at(sem).begin());
+  }
+
   out.tolerance = std::move(first);
   for (size_t s = 0; s < f0.size(); ++s) {
     const size_t w = widths[s];
-    for (size_t i = 0; i < f0[s].size(); ++i)
-      out.tolerance[s][i] = unbounded[i / w] ? INFINITY : out.tolerance[s][i] + second[s][i] + corner[s][i];
+    for (size_t i = 0; i < f0[s].size(); ++i) {
+      double t = out.tolerance[s][i] + second[s][i] + corner[s][i];
+      if (anyStored && std::isfinite(reached[s][i]) && std::isfinite(f0[s][i])) t = std::max(t, std::abs(reached[s][i] - f0[s][i]));
+      out.tolerance[s][i] = unbounded[i / w] ? INFINITY : t;
+    }
   }
   return out;
 }

@@ -4,6 +4,7 @@
 // through the reference, plus second-order terms. Derivation: docs/validation.md, "Against
 // the float data".
 #pragma once
+#include <map>
 #include <string>
 #include <vector>
 
@@ -25,10 +26,16 @@ struct FloatReference {
 //   + |f(x + c) + f(x - c) - 2 f(x)|, c the corner of the bounds where the first-order
 //     change of that value is largest (the cross terms along it)
 // with the derivatives from central differences of the reference: two evaluations per
-// bounded input component, and two per component of each semantic. `floatMesh` is
-// perturbed and restored in place.
+// bounded input component, and two per component of each semantic. Where `stored` holds a
+// bounded input as the device's data has it (quantizeForRig's values, at the same vertices),
+// the tolerance is at least |f(stored) - f(x)|: the stored data is a point within the bounds,
+// so what they allow reaches that far at least, and the sum above can fall short of it when an
+// extremum lies inside a wide bound (1 - (n.v)^2 at a silhouette as a 2-bit weight rounds).
+// A stored component outside its bound is not used (the check then fails as without it).
+// One more evaluation. `floatMesh` is perturbed and restored in place.
 FloatReference floatReference(const RuleSet& rules, const RigShape& shape, rt::Mesh& floatMesh,
                               const UniformValues& uniforms, const std::vector<InputErrorBound>& bounds,
-                              const std::vector<std::string>& semantics);
+                              const std::vector<std::string>& semantics,
+                              const std::map<std::string, std::vector<glm::vec4>>& stored);
 
 }  // namespace sg

@@ -332,6 +332,7 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
     for (size_t v = 0; v < b.bound.size(); v += floatStride) b.bound[v / floatStride] = b.bound[v];
   for (InputErrorBound& b : bounds) b.bound.resize((b.bound.size() + floatStride - 1) / floatStride);
   std::optional<rt::Mesh> floatMesh;  // built when a pose first needs it
+  std::map<std::string, std::vector<glm::vec4>> storedInputs;  // the bounded inputs as the device's data holds them
   rep.floatCheckStride = floatStride;
   for (size_t pi = 0; pi < poses.size(); ++pi) {
     const rt::Pose& pose = poses[pi];
@@ -415,10 +416,12 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
       if (!floatMissing.empty()) {
         if (!floatMesh) {
           floatMesh = rt::everyNthVertex(mesh, floatStride);
+          for (const InputErrorBound& b : bounds)
+            if (floatMesh->has(b.semantic)) storedInputs[b.semantic] = floatMesh->at(b.semantic);
           for (auto& [sem, stream] : rt::everyNthVertex(scene.mesh, floatStride).streams) floatMesh->streams[sem] = std::move(stream);
           fillWidenedComponents(rig, *floatMesh);
         }
-        FloatReference f = floatReference(rules, shape, *floatMesh, pr.uniforms, bounds, floatMissing);
+        FloatReference f = floatReference(rules, shape, *floatMesh, pr.uniforms, bounds, floatMissing, storedInputs);
         for (size_t k = 0; k < floatMissing.size(); ++k) {
           pr.floatValues[floatMissing[k]] = std::move(f.values[k]);
           pr.floatTolerance[floatMissing[k]] = std::move(f.tolerance[k]);
@@ -503,9 +506,9 @@ RunReport Validator::runQuantized(const GenerateResult& r, const rt::Mesh& mesh,
           if (err > opts_.tolerance.abs + opts_.tolerance.rel * scale) out.storedPass = false;
         }
         if (cmp.floatRefs.empty() || v % floatStride != 0) continue;
-        // Second check: the float tolerance (at the float reference's scale) plus the derived
-        // bound of what storing the inputs changes.
-        double floatScale = 1.0;
+        // Second check: the float tolerance (at the larger of the two references' scales: the
+        // device rounds at the stored data's) plus the derived bound of what storing the inputs changes.
+        double floatScale = scale;
         for (size_t c = 0; c < comps; ++c)
           if (std::isfinite(floatRef[c])) floatScale = std::max(floatScale, std::abs(floatRef[c]));
         OutputReport::FloatCheck& fc = out.floatCheck;
