@@ -534,6 +534,15 @@ TEST(Calibrate, TheFitFindsTheConstantCachesCapacityAndItsMissPrice) {
   EXPECT_EQ(fitDeviceProfile(train, "cached device", 180000, 0, ProfileForm::Raster).constantCacheEntries, 0);
   const DeviceProfile flat = fitDeviceProfile(cacheRows(1, 200, capacity, 1.0), "flat device", 180000, 0, FitOptions(ProfileForm::Raster, true));
   EXPECT_EQ(flat.constantCacheEntries, 0);
+  // A capacity needs kMinRowsPerSideOfCapacity footprints past it: the first 120 rows hold one
+  // (the 200, four), and a fit on them keeps no cache rather than a cliff one row says.
+  const std::vector<CalibrationSample> fewer = cacheRows(1, 120, capacity, miss);
+  ASSERT_EQ(std::count_if(fewer.begin(), fewer.end(),
+                          [&](const CalibrationSample& s) {
+                            return s.amounts[kTermIndexedUniformLoads] > 0 && s.workload.paletteEntriesPerWarp > capacity;
+                          }),
+            1);
+  EXPECT_EQ(fitDeviceProfile(fewer, "cached device", 180000, 0, FitOptions(ProfileForm::Raster, true)).constantCacheEntries, 0);
   // Written and read back, it predicts the same; past the capacity a warp costs miss x as much.
   CalibrationReport r;
   r.profile = raster;
