@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <set>
@@ -321,22 +322,32 @@ struct BenchCommand {
     const int chosen = pinnedPlan(rep);
     if (chosen < 0) throw std::runtime_error("--pin-out: no plan was timed by " + rep.predictionClock);
     const GpuBenchRow& f = rep.rows[size_t(chosen)];
+    auto sortedNames = [](const std::vector<std::string>& names) {
+      const std::set<std::string> once(names.begin(), names.end());
+      return std::vector<std::string>(once.begin(), once.end());
+    };
     Pin pin;
-    pin.device = rep.device;
-    pin.driver = rep.driver;
-    pin.clock = rep.predictionClock;
+    PinTiming timing;
+    timing.device = rep.device;
+    timing.driver = rep.driver;
+    timing.clock = rep.predictionClock;
+    timing.nsPerVertex = timing.fastestNsPerVertex = medianRound(f);
+    timing.generatedNsPerVertex = medianRound(rep.rows.front());
+    pin.devices = {timing};
     pin.label = f.label;
     pin.program = f.program;
-    std::set<std::string> rules(f.rules.begin(), f.rules.end());
-    pin.rules.assign(rules.begin(), rules.end());
-    pin.bans = f.pin;
+    pin.rules = sortedNames(f.rules);
+    pin.bans = sortedNames(f.pin);
     pin.inputs = rep.inputs;
-    pin.nsPerVertex = medianRound(f);
-    pin.generatedNsPerVertex = medianRound(rep.rows.front());
-    for (const auto& row : rep.rows) pin.candidates += row.hasCost && row.validation == "pass";
+    // Every plan weighed, for a choice over several devices (pin merge).
+    for (const auto& row : rep.rows)
+      if (row.hasCost && row.validation == "pass" && !std::isnan(medianRound(row))) {
+        ++pin.candidates;
+        pin.timed.push_back({row.label, row.program, sortedNames(row.rules), sortedNames(row.pin), medianRound(row)});
+      }
     writeFilesAtomically({{path, formatPin(pin)}});
     std::cout << fmt::format("{}: pins {} (its median round {:.4f} ns per vertex; the generated plan's {:.4f})\n", path,
-                             f.label, pin.nsPerVertex, pin.generatedNsPerVertex);
+                             f.label, timing.nsPerVertex, timing.generatedNsPerVertex);
   }
 
   // Prints the report; returns how many programs failed on the device.

@@ -69,6 +69,7 @@ void registerCommands(CLI::App& app, CliState& state) {
   registerCalibrate(app, state);
   registerBuild(app, state);
   registerPack(app, state);
+  registerPin(app, state);
 }
 
 }  // namespace sg

@@ -86,6 +86,7 @@ void registerExplain(CLI::App& app, CliState& state);  // cmd_explain.cpp: expla
 void registerRig(CLI::App& app, CliState& state);      // cmd_rig.cpp: rig import
 void registerBuild(CLI::App& app, CliState& state);    // cmd_build.cpp: variant manifests
 void registerPack(CLI::App& app, CliState& state);     // cmd_pack.cpp: vertex streams from float data
+void registerPin(CLI::App& app, CliState& state);      // cmd_pin.cpp: pin merge (several devices' measured choices)
 void registerBake(CLI::App& app, CliState& state);     // cmd_bake.cpp: bake occlusion
 void registerRender(CLI::App& app, CliState& state);   // cmd_render.cpp: render + bench (GPU timing)
 void registerCalibrate(CLI::App& app, CliState& state);  // cmd_calibrate.cpp: device profiles

@@ -77,22 +77,80 @@ double time(const YamlCtx& y, const YAML::Node& n, const char* what) {
   return v;
 }
 
+// The flat keys of one device's timing (bench's pins) and the keys of a `devices:` entry.
+void formatTiming(std::string& s, const PinTiming& t, const char* indent, bool fastest) {
+  s += fmt::format("{}device: {}\n", indent, quoted(t.device));
+  s += fmt::format("{}driver: {}\n", indent, quoted(t.driver));
+  s += fmt::format("{}clock: {}\n", indent, quoted(t.clock));
+  s += fmt::format("{}ns_per_vertex: {}\n", indent, t.nsPerVertex);  // shortest text that reads back as the same double
+  if (fastest) s += fmt::format("{}fastest_ns_per_vertex: {}\n", indent, t.fastestNsPerVertex);
+  s += fmt::format("{}generated_ns_per_vertex: {}\n", indent, t.generatedNsPerVertex);
+}
+
+PinTiming parseTiming(const YamlCtx& y, const YAML::Node& n, bool fastest) {
+  PinTiming t;
+  t.device = textOf(y, n["device"], "device");
+  t.driver = textOf(y, n["driver"], "driver");
+  t.clock = textOf(y, n["clock"], "clock");
+  t.nsPerVertex = time(y, n["ns_per_vertex"], "ns_per_vertex");
+  t.generatedNsPerVertex = time(y, n["generated_ns_per_vertex"], "generated_ns_per_vertex");
+  t.fastestNsPerVertex = fastest ? time(y, n["fastest_ns_per_vertex"], "fastest_ns_per_vertex") : t.nsPerVertex;
+  if (t.fastestNsPerVertex > t.nsPerVertex) y.fail(n, "fastest_ns_per_vertex: more than the pinned plan's ns_per_vertex");
+  return t;
+}
+
+void requireKeys(const YamlCtx& y, const YAML::Node& n, std::initializer_list<const char*> keys, const char* writer) {
+  for (const char* key : keys)
+    if (!n[key]) y.fail(n, fmt::format("a pin needs '{}' ({} writes every key)", key, writer));
+}
+
+std::vector<std::string> bansOf(const YamlCtx& y, const YAML::Node& n, const std::vector<std::string>& rules) {
+  std::vector<std::string> bans = names(y, n, "ban");
+  for (const auto& b : bans)
+    if (std::binary_search(rules.begin(), rules.end(), b)) y.fail(n, fmt::format("ban: '{}' is a rule of the pinned plan", b));
+  return bans;
+}
+
 }  // namespace
 
+std::string Pin::deviceNames() const {
+  std::vector<std::string> names;
+  for (const PinTiming& t : devices) names.push_back(t.device);
+  return fmt::format("{}", fmt::join(names, " + "));
+}
+
 std::string formatPin(const Pin& p) {
-  std::string s = "# shadergen pin: the plan this device timed fastest (bench --pin-out); generate --pin writes it\n";
+  const bool merged = p.devices.size() != 1;
+  std::string s = merged ? "# shadergen pin: the plan whose worst regret over these devices' timings is least (pin merge); "
+                           "generate --pin writes it\n"
+                         : "# shadergen pin: the plan this device timed fastest (bench --pin-out); generate --pin writes it\n";
   s += "# docs/performance.md, \"A measured choice\"\n";
-  s += fmt::format("device: {}\n", quoted(p.device));
-  s += fmt::format("driver: {}\n", quoted(p.driver));
-  s += fmt::format("clock: {}\n", quoted(p.clock));
+  if (merged) {
+    s += "devices:\n";
+    for (const PinTiming& t : p.devices) {
+      std::string one;
+      formatTiming(one, t, "    ", true);
+      s += "  - " + one.substr(4);
+    }
+  }
+  if (!merged) s += fmt::format("device: {}\ndriver: {}\nclock: {}\n", quoted(p.devices[0].device), quoted(p.devices[0].driver),
+                                quoted(p.devices[0].clock));
   s += fmt::format("candidates: {}\n", p.candidates);
   s += fmt::format("plan: {}\n", quoted(p.label));
   s += fmt::format("program: {}\n", quoted(p.program));
-  s += fmt::format("ns_per_vertex: {}\n", p.nsPerVertex);  // shortest text that reads back as the same double
-  s += fmt::format("generated_ns_per_vertex: {}\n", p.generatedNsPerVertex);
+  if (!merged) {
+    s += fmt::format("ns_per_vertex: {}\n", p.devices[0].nsPerVertex);
+    s += fmt::format("generated_ns_per_vertex: {}\n", p.devices[0].generatedNsPerVertex);
+  }
   s += fmt::format("rules: {}\n", flowList(p.rules));
   s += fmt::format("ban: {}\n", flowList(p.bans));
   s += fmt::format("inputs: {}\n", p.inputs);
+  if (!p.timed.empty()) {
+    s += "timed:  # every validated plan bench timed, its median round (pin merge weighs them)\n";
+    for (const TimedPlan& t : p.timed)
+      s += fmt::format("  - {{plan: {}, program: {}, ns_per_vertex: {}, rules: {}, ban: {}}}\n", quoted(t.label), quoted(t.program),
+                       t.nsPerVertex, flowList(t.rules), flowList(t.bans));
+  }
   return s;
 }
 
@@ -100,32 +158,60 @@ Pin parsePin(const std::string& text, const std::string& file) {
   const YAML::Node root = parseYaml(text, file);
   YamlCtx y{file};
   y.expectMap(root, "a pin (bench --pin-out writes them)");
-  y.checkKeys(root, {"device", "driver", "clock", "candidates", "plan", "program", "ns_per_vertex", "generated_ns_per_vertex", "rules",
-                     "ban", "inputs"});
-  for (const char* key : {"device", "driver", "clock", "candidates", "plan", "program", "ns_per_vertex", "generated_ns_per_vertex",
-                          "rules", "ban", "inputs"})
-    if (!root[key]) y.fail(root, fmt::format("a pin needs '{}' (bench --pin-out writes every key)", key));
+  const bool merged = bool(root["devices"]);
+  if (merged) {
+    y.checkKeys(root, {"devices", "candidates", "plan", "program", "rules", "ban", "inputs"});
+    requireKeys(y, root, {"devices", "candidates", "plan", "program", "rules", "ban", "inputs"}, "pin merge");
+  } else {
+    y.checkKeys(root, {"device", "driver", "clock", "candidates", "plan", "program", "ns_per_vertex", "generated_ns_per_vertex", "rules",
+                       "ban", "inputs", "timed"});
+    requireKeys(y, root,
+                {"device", "driver", "clock", "candidates", "plan", "program", "ns_per_vertex", "generated_ns_per_vertex", "rules", "ban",
+                 "inputs"},
+                "bench --pin-out");
+  }
   Pin p;
   p.file = file;
-  p.device = textOf(y, root["device"], "device");
-  p.driver = textOf(y, root["driver"], "driver");
-  p.clock = textOf(y, root["clock"], "clock");
+  p.loc = locOf(root, file);
+  if (merged) {
+    y.expectSeq(root["devices"], "devices");
+    if (root["devices"].size() < 2) y.fail(root["devices"], "devices: a merged pin weighs two devices at least");
+    for (const auto& d : root["devices"]) {
+      y.expectMap(d, "a device of a merged pin");
+      y.checkKeys(d, {"device", "driver", "clock", "ns_per_vertex", "fastest_ns_per_vertex", "generated_ns_per_vertex"});
+      requireKeys(y, d, {"device", "driver", "clock", "ns_per_vertex", "fastest_ns_per_vertex", "generated_ns_per_vertex"}, "pin merge");
+      p.devices.push_back(parseTiming(y, d, true));
+    }
+  } else {
+    p.devices.push_back(parseTiming(y, root, false));
+  }
   const long long candidates = y.integer(root["candidates"], "candidates");
   if (candidates < 1) y.fail(root["candidates"], "candidates: expected a count of at least 1");
   p.candidates = size_t(candidates);
   p.label = textOf(y, root["plan"], "plan");
   p.program = textOf(y, root["program"], "program");
-  p.nsPerVertex = time(y, root["ns_per_vertex"], "ns_per_vertex");
-  p.generatedNsPerVertex = time(y, root["generated_ns_per_vertex"], "generated_ns_per_vertex");
   p.rules = names(y, root["rules"], "rules");
   if (p.rules.empty()) y.fail(root["rules"], "rules: a plan has at least one rule");
-  p.bans = names(y, root["ban"], "ban");
-  for (const auto& b : p.bans)
-    if (std::binary_search(p.rules.begin(), p.rules.end(), b))
-      y.fail(root["ban"], fmt::format("ban: '{}' is a rule of the pinned plan", b));
+  p.bans = bansOf(y, root["ban"], p.rules);
   p.inputs = y.scalar(root["inputs"], "inputs");
   if (p.inputs.size() != 64 || p.inputs.find_first_not_of("0123456789abcdef") != std::string::npos)
     y.fail(root["inputs"], "inputs: expected a SHA-256 (64 lowercase hex digits)");
+  if (const YAML::Node timed = root["timed"]) {
+    y.expectSeq(timed, "timed");
+    for (const auto& t : timed) {
+      y.expectMap(t, "a timed plan");
+      y.checkKeys(t, {"plan", "program", "ns_per_vertex", "rules", "ban"});
+      requireKeys(y, t, {"plan", "program", "ns_per_vertex", "rules", "ban"}, "bench --pin-out");
+      TimedPlan plan;
+      plan.label = textOf(y, t["plan"], "plan");
+      plan.program = textOf(y, t["program"], "program");
+      plan.nsPerVertex = time(y, t["ns_per_vertex"], "ns_per_vertex");
+      plan.rules = names(y, t["rules"], "rules");
+      if (plan.rules.empty()) y.fail(t["rules"], "rules: a plan has at least one rule");
+      plan.bans = bansOf(y, t["ban"], plan.rules);
+      p.timed.push_back(plan);
+    }
+  }
   p.rulesLoc = locOf(root["rules"], file);
   p.banLoc = locOf(root["ban"], file);
   p.inputsLoc = locOf(root["inputs"], file);
@@ -139,7 +225,64 @@ std::optional<Diagnostic> pinInputsChanged(const Pin& pin, const std::string& in
   return Diagnostic{Severity::Warning, pin.inputsLoc,
                     fmt::format("the inputs' bytes differ from those the pin was measured with on {} (the pin still "
                                 "gives its plan; its timing may not hold)",
-                                pin.device)};
+                                pin.deviceNames())};
+}
+
+Pin mergePins(const std::vector<Pin>& pins) {
+  if (pins.size() < 2) throw InputError(SourceLoc{}, "pin merge: weighs two pins at least (one per device)");
+  for (const Pin& p : pins) {
+    if (p.devices.size() != 1)
+      throw InputError(p.loc, "pin merge: a merged pin is not merged again (merge the devices' own pins, bench --pin-out)");
+    if (p.timed.empty())
+      throw InputError(p.loc, "pin merge: the pin lists no timed plans (bench --pin-out writes them since session 41: run it again)");
+    if (p.inputs != pins[0].inputs)
+      throw InputError(p.inputsLoc, fmt::format("pin merge: measured with other inputs' bytes than {} (the same rig, request, "
+                                                "rules and templates on every device)",
+                                                pins[0].file));
+  }
+  // A plan is the same on two devices where its rules and its program are.
+  auto find = [](const Pin& p, const TimedPlan& t) -> const TimedPlan* {
+    for (const TimedPlan& u : p.timed)
+      if (u.rules == t.rules && u.program == t.program) return &u;
+    return nullptr;
+  };
+  std::vector<double> fastest;
+  for (const Pin& p : pins) {
+    double f = INFINITY;
+    for (const TimedPlan& t : p.timed) f = std::min(f, t.nsPerVertex);
+    fastest.push_back(f);
+  }
+  const TimedPlan* best = nullptr;
+  double bestRegret = INFINITY;
+  size_t common = 0;
+  for (const TimedPlan& t : pins[0].timed) {
+    double worst = 0;
+    bool everywhere = true;
+    for (size_t d = 0; d < pins.size() && everywhere; ++d)
+      if (const TimedPlan* u = find(pins[d], t)) worst = std::max(worst, u->nsPerVertex / fastest[d]);
+      else everywhere = false;
+    if (!everywhere) continue;
+    ++common;
+    if (worst < bestRegret) bestRegret = worst, best = &t;
+  }
+  if (!best)
+    throw InputError(pins[0].loc, fmt::format("pin merge: no plan was timed on every device ({} plans here; time the same candidates "
+                                              "everywhere: bench --candidates K with the same profiles)",
+                                              pins[0].timed.size()));
+  Pin out;
+  out.label = best->label;
+  out.program = best->program;
+  out.rules = best->rules;
+  out.bans = best->bans;
+  out.inputs = pins[0].inputs;
+  out.candidates = common;
+  for (size_t d = 0; d < pins.size(); ++d) {
+    PinTiming t = pins[d].devices[0];
+    t.nsPerVertex = find(pins[d], *best)->nsPerVertex;
+    t.fastestNsPerVertex = fastest[d];
+    out.devices.push_back(t);
+  }
+  return out;
 }
 
 }  // namespace sg

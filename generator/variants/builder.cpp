@@ -410,7 +410,7 @@ std::string indexEntry(const Manifest& m, const BuiltVariant& b) {
     out += fmt::format("      \"bans\": {},\n", jsonStringArray(v.rig->bans));
   if (auto pin = m.pins.find(v.name); pin != m.pins.end())  // a measured choice: where it was timed fastest
     out += fmt::format("      \"pin\": {{\"file\": {}, \"device\": {}, \"plan\": {}}},\n", jsonString(pin->second.file),
-                       jsonString(pin->second.device), jsonString(pin->second.label));
+                       jsonString(pin->second.deviceNames()), jsonString(pin->second.label));
   out += fmt::format("      \"spirv_sha256\": {},\n", jsonString(b.spirvHash));
   out += fmt::format("      \"validated\": {},\n", b.validation ? "true" : "false");
   if (const auto& val = b.validation)  // where and when the result was made (cached with it)

@@ -801,6 +801,29 @@ pin)
   done
   expect 0 "generate --pin again" -- "$SG" generate "${DAWN[@]}" --pin face.pin.yaml --emit glsl -o again.vert -q
   cmp -s pinned-slots.vert again.vert && ok "generate --pin: two runs, the same bytes" || fail "generate --pin: two runs differ"
+  # Several devices (docs/performance.md, "Several devices"): each device's pin lists every plan it timed;
+  # pin merge keeps the plan whose worst time over a device's fastest is least. Two benches here stand for
+  # two devices; the choice is checked against the regrets worked out from the two files' timed plans.
+  timed_plans() { sed -n 's/^  - {plan: "\([^"]*\)", program: "\([0-9a-f]*\)", ns_per_vertex: \([0-9.e+-]*\),.*/\1|\2|\3/p' "$1"; }
+  [ "$(timed_plans face.pin.yaml | wc -l)" -eq 3 ] && timed_plans face.pin.yaml | grep -q "^$label|" &&
+    ok "the pin lists the 3 plans bench timed, the pinned one among them" || fail "timed plans: $(timed_plans face.pin.yaml)"
+  expect 0 "bench --candidates 3 --pin-out, a second 'device'" -- "$SG" bench "${BENCH[@]}" --candidates 3 --max-candidates 3 --pin-out second.pin.yaml
+  expect 0 "pin merge" -- "$SG" pin merge face.pin.yaml second.pin.yaml -o both.pin.yaml
+  want=$(awk -F'|' 'FNR == 1 { f++ } { t[f, $2] = $3; if (!(f in best) || $3 < best[f]) best[f] = $3; if (f == 1) order[++n] = $1 "|" $2 }
+    END { w = 1e300; for (i = 1; i <= n; i++) { split(order[i], o, "|"); r = 0; ok = 1
+            for (d = 1; d <= f; d++) { if (!((d, o[2]) in t)) ok = 0; else if (t[d, o[2]] / best[d] > r) r = t[d, o[2]] / best[d] }
+            if (ok && r < w) { w = r; pick = o[1] } } print pick }' <(timed_plans face.pin.yaml) <(timed_plans second.pin.yaml))
+  [ -n "$want" ] && grep -q "^plan: \"$want\"$" both.pin.yaml && [ "$(grep -c '^  - device: "llvmpipe' both.pin.yaml)" -eq 2 ] &&
+    grep -q '^candidates: 3$' both.pin.yaml && [ "$(grep -c '^| llvmpipe .* | [0-9.]* | [0-9.]* | [0-9.]* |$' last.out)" -eq 2 ] &&
+    ok "pin merge: the least worst regret over both ($want), each device's row printed" ||
+    fail "pin merge: want '$want': $(cat both.pin.yaml last.out | head -20)"
+  merged_rules=$(sed -n 's/^rules: \[\(.*\)\]$/\1/p' both.pin.yaml | tr -d ',"' | tr ' ' '\n' | sort -u | tr '\n' ' ')
+  expect 0 "generate --pin, a merged pin" -- "$SG" generate "${DAWN[@]}" --pin both.pin.yaml --emit glsl -o both.vert -q
+  [ -n "$merged_rules" ] && [ "$(glsl_rules both.vert)" = "$merged_rules" ] && ok "generate --pin writes the merged pin's plan" ||
+    fail "merged pin: rules $(glsl_rules both.vert), pinned $merged_rules"
+  expect 1 "pin merge, a merged pin again" -- "$SG" pin merge both.pin.yaml face.pin.yaml -o again.pin.yaml
+  grep -q "^both.pin.yaml:3:1: error: pin merge: a merged pin is not merged again" last.err && [ ! -e again.pin.yaml ] &&
+    ok "pin merge: a merged pin is a located error, nothing written" || fail "merge of a merged pin: $(cat last.err)"
   # A manifest's variant pinned the same way (pins: { variant: file }): generate --pin's program.
   cat > pins.variants.yaml <<YAML
 rules: $E/rules.yaml
