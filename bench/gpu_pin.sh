@@ -7,7 +7,7 @@
 # SG_PIN_CHECK=N (default 12), a second, independent bench times the N cheapest (check/), the
 # figures the pin is judged by. bench/pin_table.py makes the table from OUTDIR.
 # Usage: bash gpu_pin.sh [DEVICE=NVIDIA] [OUTDIR=.] ; SG_SEEDS="68 69" (corpus seeds, 6 rigs each),
-# SG_PROFILE (default the bundle's devices/nvidia-h200-raster.yaml), SG_CANDIDATES (4),
+# SG_PROFILE (default the bundle's devices/nvidia-h200-raster.yaml; several, space-separated: a portable choice), SG_CANDIDATES (4),
 # SG_MESHES ("dawn head"), SG_SUITE=1 also the Dawn face, its body's depth pass and the suite's held-out
 # rigs, SG_MODELS=1 the shared glTF models' skinned and morphed parts on their own meshes, SG_RASTER (on; off on lavapipe: its clock is then the process's CPU time, as calibrate's), SG_ROUNDS (3),
 # SG_PROCESSES (1): each bench, the tune and the check, in that many fresh processes, their rounds merged (3 on lavapipe,
@@ -17,9 +17,12 @@ here=$(cd "$(dirname "$0")" && pwd)
 device=${1-NVIDIA}
 outdir=${2:-.}
 source "$here/gpu_env.sh"
-profile=${SG_PROFILE:-$here/devices/nvidia-h200-raster.yaml}
+# Several profiles (space-separated): the portable objective, the same on every device, whose pins
+# `shadergen pin merge` weighs together (docs/performance.md, "Several devices").
+profiles=()
+for p in ${SG_PROFILE:-$here/devices/nvidia-h200-raster.yaml}; do profiles+=(--device-profile "$p"); done
 t=(--no-validation-layers --raster "${SG_RASTER:-on}" --no-floor --draws 32 --min-frame-vertices 64000 --frames 7 --rounds "${SG_ROUNDS:-3}"
-   --device "$device" --device-profile "$profile" --processes "${SG_PROCESSES:-1}")
+   --device "$device" "${profiles[@]}" --processes "${SG_PROCESSES:-1}")
 dawnRules=(-r "$here/examples/dawn/rules.yaml" --templates "$here/templates")
 std=(-r "$here/rules/standard.yaml" --templates "$here/templates")
 mkdir -p "$outdir/pins" "$outdir/tune" "$outdir/check" "$outdir/corpus"
