@@ -77,16 +77,18 @@ double time(const YamlCtx& y, const YAML::Node& n, const char* what) {
   return v;
 }
 
-// The flat keys of one device's timing (bench's pins) and the keys of a `devices:` entry.
-void formatTiming(std::string& s, const PinTiming& t, const char* indent, bool fastest) {
-  s += fmt::format("{}device: {}\n", indent, quoted(t.device));
-  s += fmt::format("{}driver: {}\n", indent, quoted(t.driver));
-  s += fmt::format("{}clock: {}\n", indent, quoted(t.clock));
-  s += fmt::format("{}ns_per_vertex: {}\n", indent, t.nsPerVertex);  // shortest text that reads back as the same double
-  if (fastest) s += fmt::format("{}fastest_ns_per_vertex: {}\n", indent, t.fastestNsPerVertex);
-  s += fmt::format("{}generated_ns_per_vertex: {}\n", indent, t.generatedNsPerVertex);
+// One entry of a merged pin's `devices:`.
+std::string formatTiming(const PinTiming& t) {
+  std::string s = fmt::format("  - device: {}\n", quoted(t.device));
+  s += fmt::format("    driver: {}\n", quoted(t.driver));
+  s += fmt::format("    clock: {}\n", quoted(t.clock));
+  s += fmt::format("    ns_per_vertex: {}\n", t.nsPerVertex);
+  s += fmt::format("    fastest_ns_per_vertex: {}\n", t.fastestNsPerVertex);
+  s += fmt::format("    generated_ns_per_vertex: {}\n", t.generatedNsPerVertex);
+  return s;
 }
 
+// A bench pin's flat keys (`fastest`: false; its plan is its fastest) or a `devices:` entry.
 PinTiming parseTiming(const YamlCtx& y, const YAML::Node& n, bool fastest) {
   PinTiming t;
   t.device = textOf(y, n["device"], "device");
@@ -127,19 +129,16 @@ std::string formatPin(const Pin& p) {
   s += "# docs/performance.md, \"A measured choice\"\n";
   if (merged) {
     s += "devices:\n";
-    for (const PinTiming& t : p.devices) {
-      std::string one;
-      formatTiming(one, t, "    ", true);
-      s += "  - " + one.substr(4);
-    }
+    for (const PinTiming& t : p.devices) s += formatTiming(t);
+  } else {
+    s += fmt::format("device: {}\ndriver: {}\nclock: {}\n", quoted(p.devices[0].device), quoted(p.devices[0].driver),
+                     quoted(p.devices[0].clock));
   }
-  if (!merged) s += fmt::format("device: {}\ndriver: {}\nclock: {}\n", quoted(p.devices[0].device), quoted(p.devices[0].driver),
-                                quoted(p.devices[0].clock));
   s += fmt::format("candidates: {}\n", p.candidates);
   s += fmt::format("plan: {}\n", quoted(p.label));
   s += fmt::format("program: {}\n", quoted(p.program));
   if (!merged) {
-    s += fmt::format("ns_per_vertex: {}\n", p.devices[0].nsPerVertex);
+    s += fmt::format("ns_per_vertex: {}\n", p.devices[0].nsPerVertex);  // shortest text that reads back as the same double
     s += fmt::format("generated_ns_per_vertex: {}\n", p.devices[0].generatedNsPerVertex);
   }
   s += fmt::format("rules: {}\n", flowList(p.rules));
