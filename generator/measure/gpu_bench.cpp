@@ -398,8 +398,13 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     p.row.bans = std::move(bans);
     for (int a : p.render.plan.actions) p.row.rules.push_back(p.render.in.problem.actions[a].name);
     p.row.pin = bansPinning(p.render.in.problem, p.render.plan, render.bannedRules);
+    const auto sameRules = [](std::vector<std::string> a, std::vector<std::string> b) {  // in any order
+      std::sort(a.begin(), a.end());
+      std::sort(b.begin(), b.end());
+      return a == b;
+    };
     for (const auto& q : programs)
-      if (q.row.hasCost && q.row.rules == p.row.rules) return false;  // the same plan again
+      if (q.row.hasCost && sameRules(q.row.rules, p.row.rules)) return false;  // the same plan again
     p.capture = generateFrom(in, capture);
     p.row.hasCost = p.row.hasAmounts = true;
     p.row.planCost = p.render.plan.cost;
@@ -420,6 +425,11 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     const std::vector<RankedPlan> ranked = cheapestPlans(in, gen, opts.candidates);
     for (size_t i = 0; i < ranked.size(); ++i)
       if (!ranked[i].bans.empty()) addGenerated(fmt::format("cheapest plan #{}", i + 1), ranked[i].bans);
+    // A portable objective's list is a prediction for every device: each device's own cheapest
+    // joins it (a plan already listed is not timed twice), so that pin merge can weigh it.
+    const std::vector<RankedPlan> own = eachDevicesCheapest(in, gen);
+    for (size_t d = 0; d < own.size(); ++d)
+      addGenerated(fmt::format("cheapest on {}", d == 0 ? in.profile->device : in.portable[d - 1].device), own[d].bans);
   } else if (opts.alternatives) {
     const Problem& p = chosen.in.problem;
     for (int a : chosen.plan.actions) {

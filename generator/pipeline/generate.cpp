@@ -366,6 +366,25 @@ std::vector<RankedPlan> cheapestPlans(const LoadedInputs& in, const GenerateOpti
   return out;
 }
 
+std::vector<RankedPlan> eachDevicesCheapest(const LoadedInputs& in, const GenerateOptions& opts) {
+  std::vector<RankedPlan> out;
+  if (!in.profile || in.portable.empty()) return out;
+  std::vector<DeviceProfile> all{*in.profile};
+  all.insert(all.end(), in.portable.begin(), in.portable.end());
+  for (const DeviceProfile& d : all) {
+    LoadedInputs one = in;
+    one.profile = d;
+    one.portable.clear();
+    one.portableBest.clear();
+    applyDeviceProfile(one.problem, d);
+    const Plan plan = searchUnderOptions(one, opts, nullptr);
+    std::set<std::string> names;
+    for (int a : plan.actions) names.insert(one.problem.actions[size_t(a)].name);
+    out.push_back(RankedPlan{bansPinning(one.problem, plan, {}), {names.begin(), names.end()}, plan.cost});
+  }
+  return out;
+}
+
 std::vector<std::string> bansPinning(const Problem& p, const Plan& plan, const std::vector<std::string>& searchedWith) {
   std::set<std::string> used, others(searchedWith.begin(), searchedWith.end());
   std::set<int> facts;

@@ -118,6 +118,12 @@ struct RankedPlan {
 };
 std::vector<RankedPlan> cheapestPlans(const LoadedInputs& in, const GenerateOptions& opts, size_t k,
                                       size_t maxSearches = 512);
+// A portable choice's devices (in.profile, then in.portable): each one's cheapest plan under its
+// own profile alone, with the bans beside opts' own that leave it the only derivation of its facts
+// (bansPinning), so the portable search returns it. A measured portable choice times them beside
+// the cheapest under the worst regret: where a profile mispredicts another device, the plan one
+// device runs best can be the least worst regret (bench/data/pin41). Empty without several profiles.
+std::vector<RankedPlan> eachDevicesCheapest(const LoadedInputs& in, const GenerateOptions& opts);
 // The bans that leave `plan` the only derivation its facts have: every other rule producing a
 // fact the plan produces, and the bans it was searched with (`p` no longer has those rules). A
 // plan pinned by them stays the plan whatever the costs (the workload, the profile) it is

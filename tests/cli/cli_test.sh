@@ -805,7 +805,7 @@ pin)
   # pin merge keeps the plan whose worst time over a device's fastest is least. Two benches here stand for
   # two devices; the choice is checked against the regrets worked out from the two files' timed plans.
   timed_plans() { sed -n 's/^  - {plan: "\([^"]*\)", program: "\([0-9a-f]*\)", ns_per_vertex: \([0-9.e+-]*\),.*/\1|\2|\3/p' "$1"; }
-  [ "$(timed_plans face.pin.yaml | wc -l)" -eq 3 ] && timed_plans face.pin.yaml | grep -q "^$label|" &&
+  [ "$(timed_plans face.pin.yaml | wc -l)" -eq 3 ] && grep -q "^$label|" <(timed_plans face.pin.yaml) &&
     ok "the pin lists the 3 plans bench timed, the pinned one among them" || fail "timed plans: $(timed_plans face.pin.yaml)"
   expect 0 "bench --candidates 3 --pin-out, a second 'device'" -- "$SG" bench "${BENCH[@]}" --candidates 3 --max-candidates 3 --pin-out second.pin.yaml
   expect 0 "pin merge" -- "$SG" pin merge face.pin.yaml second.pin.yaml -o both.pin.yaml
@@ -824,6 +824,20 @@ pin)
   expect 1 "pin merge, a merged pin again" -- "$SG" pin merge both.pin.yaml face.pin.yaml -o again.pin.yaml
   grep -q "^both.pin.yaml:3:1: error: pin merge: a merged pin is not merged again" last.err && [ ! -e again.pin.yaml ] &&
     ok "pin merge: a merged pin is a located error, nothing written" || fail "merge of a merged pin: $(cat last.err)"
+  # Under a portable objective (two profiles) the candidates hold each device's own cheapest plan too,
+  # as generate under that profile alone writes it, so a merge can weigh it.
+  PORTABLE=(--rig "$SRC/tests/validate/data/limb8_palette300.rig.yaml" -f "$SRC/tests/validate/data/world.frag" -r "$SRC/rules/standard.yaml"
+            --device-profile "$SRC/devices/nvidia-h200-raster.yaml" --device-profile "$SRC/devices/llvmpipe-2core.yaml" --mesh head)
+  expect 0 "bench --candidates 2, a portable objective" -- "$SG" bench "${PORTABLE[@]}" --raster off --draws 1 --min-frame-vertices 0 \
+    --frames 2 --rounds 1 --no-floor --no-validation-layers --candidates 2 --max-candidates 2 --pin-out portable.pin.yaml
+  timed_rules() { sed -n 's/^  - {plan: .*, rules: \[\([^]]*\)\], ban: .*/\1/p' "$1" | while read -r r; do echo "$r" | tr -d ',"' | tr ' ' '\n' | sort -u | tr '\n' ' '; echo; done; }
+  for profile in llvmpipe-2core nvidia-h200-raster; do
+    expect 0 "generate under $profile alone" -- "$SG" generate --rig "$SRC/tests/validate/data/limb8_palette300.rig.yaml" \
+      -f "$SRC/tests/validate/data/world.frag" -r "$SRC/rules/standard.yaml" --device-profile "$SRC/devices/$profile.yaml" --mesh head --emit glsl -o alone.vert -q
+    timed_rules portable.pin.yaml > timed.txt  # a file: grep -q closing a pipe early fails it under pipefail
+    grep -qxF "$(glsl_rules alone.vert)" timed.txt && ok "portable candidates: $profile's own cheapest was timed" ||
+      fail "portable candidates lack $profile's cheapest: $(glsl_rules alone.vert) not in $(cat timed.txt)"
+  done
   # A manifest's variant pinned the same way (pins: { variant: file }): generate --pin's program.
   cat > pins.variants.yaml <<YAML
 rules: $E/rules.yaml
