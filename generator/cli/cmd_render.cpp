@@ -4,7 +4,6 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
-#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <set>
@@ -341,7 +340,7 @@ struct BenchCommand {
     pin.inputs = rep.inputs;
     // Every plan weighed, for a choice over several devices (pin merge).
     for (const auto& row : rep.rows)
-      if (row.hasCost && row.validation == "pass" && !std::isnan(medianRound(row))) {
+      if (weighedPlan(row)) {
         ++pin.candidates;
         pin.timed.push_back({row.label, row.program, sortedNames(row.rules), sortedNames(row.pin), medianRound(row)});
       }

@@ -258,10 +258,7 @@ double medianRound(const GpuBenchRow& row) {
   return medianOf(row.roundNsPerVertex);
 }
 
-namespace {
-// A plan a measured choice weighs (pinnedPlan, rankCandidates): validated and timed in rounds.
 bool weighedPlan(const GpuBenchRow& row) { return row.hasCost && row.validation == "pass" && !std::isnan(medianRound(row)); }
-}  // namespace
 
 int pinnedPlan(const GpuBenchReport& r) {
   int best = -1;
@@ -398,13 +395,9 @@ GpuBenchReport runGpuBench(const GpuBenchOptions& opts) {
     p.row.bans = std::move(bans);
     for (int a : p.render.plan.actions) p.row.rules.push_back(p.render.in.problem.actions[a].name);
     p.row.pin = bansPinning(p.render.in.problem, p.render.plan, render.bannedRules);
-    const auto sameRules = [](std::vector<std::string> a, std::vector<std::string> b) {  // in any order
-      std::sort(a.begin(), a.end());
-      std::sort(b.begin(), b.end());
-      return a == b;
-    };
-    for (const auto& q : programs)
-      if (q.row.hasCost && sameRules(q.row.rules, p.row.rules)) return false;  // the same plan again
+    for (const auto& q : programs)  // the same plan again, its rules found in any order
+      if (q.row.hasCost && std::is_permutation(q.row.rules.begin(), q.row.rules.end(), p.row.rules.begin(), p.row.rules.end()))
+        return false;
     p.capture = generateFrom(in, capture);
     p.row.hasCost = p.row.hasAmounts = true;
     p.row.planCost = p.render.plan.cost;

@@ -144,6 +144,9 @@ void summarize(GpuBenchReport& rep);
 // one slow round of the fastest program (another process on the CPU) then pinned a slower one.
 int pinnedPlan(const GpuBenchReport& r);
 double medianRound(const GpuBenchRow& row);  // NaN: never timed
+// A plan a measured choice weighs (pinnedPlan, rankCandidates, a pin's timed plans): a plan of the
+// search, validated and timed in rounds.
+bool weighedPlan(const GpuBenchRow& row);
 
 // Whether the timed candidates rank as the search's objective ranks them (bench --candidates
 // widens to --max-candidates where they do not): over the plans pinnedPlan weighs, the
