@@ -838,6 +838,9 @@ pin)
     grep -qxF "$(glsl_rules alone.vert)" timed.txt && ok "portable candidates: $profile's own cheapest was timed" ||
       fail "portable candidates lack $profile's cheapest: $(glsl_rules alone.vert) not in $(cat timed.txt)"
   done
+  # The H200's own cheapest is the portable plan here, found by another search: timed once.
+  [ "$(wc -l < timed.txt)" -ge 2 ] && [ -z "$(sort timed.txt | uniq -d)" ] && ok "portable candidates: no plan timed twice" ||
+    fail "portable candidates: a plan timed twice: $(sort timed.txt | uniq -d)"
   # A manifest's variant pinned the same way (pins: { variant: file }): generate --pin's program.
   cat > pins.variants.yaml <<YAML
 rules: $E/rules.yaml
